@@ -1,0 +1,8 @@
+#pragma once
+/// \file
+/// Umbrella of the core area: aliases, errors, execution policies and parallel primitives.
+
+#include "error.hpp"
+#include "host_device.hpp"
+#include "parallel.hpp"
+#include "types.hpp"

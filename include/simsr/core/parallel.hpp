@@ -1,0 +1,35 @@
+#pragma once
+/// \file
+/// Parallel primitives under every execution policy:
+///
+///     parallel_for(exec::omp, n, [&](Index i) { y[i] = 2 * x[i]; });
+///     double s = parallel_reduce(exec::seq, n, 0.0, [&](Index i) { return x[i]; }, std::plus<>{});
+///     auto g = parallel_for_accumulate(exec::omp, nt, make_zero_gradient, add_tet_gradient, add);
+///
+/// seq and omp give bitwise-identical results (fixed chunking); cuda is available under nvcc.
+
+#include "exec/omp.hpp"
+#include "exec/policy.hpp"
+#include "exec/seq.hpp"
+
+#if defined(__CUDACC__)
+#include "exec/cuda.cuh"
+#else
+namespace simsr::exec {
+/// Host compilers: the cuda policy exists as a type, but running with it needs nvcc.
+template <class Body>
+void parallel_for(cuda_t, Index, Body&&) {
+  static_assert(detail::dependent_false<Body>, "simsr::exec::cuda needs nvcc: compile this translation unit as CUDA (simsr::cuda target)");
+}
+template <class T, class Map, class Combine>
+T parallel_reduce(cuda_t, Index, T identity, Map&&, Combine&&, Index = default_chunks) {
+  static_assert(detail::dependent_false<Map>, "simsr::exec::cuda needs nvcc: compile this translation unit as CUDA (simsr::cuda target)");
+  return identity;
+}
+template <class Make, class Body, class Merge>
+auto parallel_for_accumulate(cuda_t, Index, Make&& make, Body&&, Merge&&, Index = 16) {
+  static_assert(detail::dependent_false<Make>, "simsr::exec::cuda needs nvcc: compile this translation unit as CUDA (simsr::cuda target)");
+  return make();
+}
+}  // namespace simsr::exec
+#endif

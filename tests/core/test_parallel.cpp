@@ -1,0 +1,137 @@
+#include <doctest/doctest.h>
+
+#include <simsr/core/core.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+using namespace simsr;
+
+namespace {
+std::vector<double> random_values(Index n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::lognormal_distribution<double> d(0.0, 3.0);  // wide dynamic range: rounding order matters
+  std::vector<double> v(static_cast<std::size_t>(n));
+  for (auto& x : v) x = (rng() & 1 ? 1 : -1) * d(rng);
+  return v;
+}
+}  // namespace
+
+TEST_CASE("chunk_range covers [0, n) exactly once in order") {
+  for (Index n : {0, 1, 5, 63, 64, 65, 1000, 12345})
+    for (Index req : {1, 3, 16, 64, 100000}) {
+      const Index nc = exec::detail::chunk_count(n, req);
+      Index next = 0;
+      for (Index c = 0; c < nc; ++c) {
+        auto [b, e] = exec::detail::chunk_range(n, nc, c);
+        CHECK(b == next);
+        CHECK(e >= b);
+        next = e;
+      }
+      CHECK(next == n);
+    }
+}
+
+TEST_CASE("parallel_for: seq and omp write the same values") {
+  for (unsigned seed = 0; seed < 20; ++seed) {
+    const Index n = 1 + Index(seed) * 997;
+    auto x = random_values(n, seed);
+    std::vector<double> a(x.size()), b(x.size());
+    auto body = [&](std::vector<double>& out) { return [&](Index i) { out[i] = std::sin(x[i]) * x[i] + 1.0 / (1.0 + x[i] * x[i]); }; };
+    exec::parallel_for(exec::seq, n, body(a));
+    exec::parallel_for(exec::omp, n, body(b));
+    CHECK(a == b);
+  }
+}
+
+TEST_CASE("parallel_reduce: seq and omp are bitwise identical and match a plain sum closely") {
+  for (unsigned seed = 0; seed < 50; ++seed) {
+    const Index n = Index(seed) * 4111 + Index(seed % 7);
+    auto x = random_values(n, 100 + seed);
+    auto map = [&](Index i) { return x[i]; };
+    const double s = exec::parallel_reduce(exec::seq, n, 0.0, map, std::plus<>{});
+    const double o = exec::parallel_reduce(exec::omp, n, 0.0, map, std::plus<>{});
+    CHECK(s == o);  // bitwise: same chunking, same combination order
+    long double exact = 0;
+    double absum = 0;
+    for (double v : x) exact += v, absum += std::abs(v);
+    CHECK(std::abs(double(exact) - s) <= 1e-12 * absum + 1e-300);
+    for (Index chunks : {1, 2, 7, 1000}) {
+      CHECK(exec::parallel_reduce(exec::seq, n, 0.0, map, std::plus<>{}, chunks) ==
+            exec::parallel_reduce(exec::omp, n, 0.0, map, std::plus<>{}, chunks));
+    }
+  }
+}
+
+TEST_CASE("parallel_reduce with a non-commutative-safe combine (max with index)") {
+  auto x = random_values(100000, 7);
+  using P = std::pair<double, Index>;
+  auto map = [&](Index i) { return P{x[i], i}; };
+  auto best = [](const P& a, const P& b) { return b.first > a.first ? b : a; };
+  const P s = exec::parallel_reduce(exec::seq, Index(x.size()), P{-1e300, -1}, map, best);
+  const P o = exec::parallel_reduce(exec::omp, Index(x.size()), P{-1e300, -1}, map, best);
+  const auto it = std::max_element(x.begin(), x.end());
+  CHECK(s == o);
+  CHECK(s.second == it - x.begin());
+}
+
+TEST_CASE("parallel_for_accumulate: scatter-add like FEM assembly, seq == omp bitwise") {
+  // Random "elements" scattering values into a shared vector, as element gradients do.
+  std::mt19937 rng(3);
+  const Index nodes = 500, elems = 20000;
+  std::vector<std::array<Index, 4>> conn(elems);
+  std::uniform_int_distribution<Index> node(0, nodes - 1);
+  for (auto& e : conn)
+    for (auto& v : e) v = node(rng);
+  auto vals = random_values(elems * 4, 11);
+  auto make = [&] { return std::vector<double>(nodes, 0.0); };
+  auto body = [&](Index e, std::vector<double>& acc) {
+    for (int k = 0; k < 4; ++k) acc[conn[e][k]] += vals[e * 4 + k];
+  };
+  auto merge = [](std::vector<double>& total, std::vector<double>&& part) {
+    for (std::size_t i = 0; i < total.size(); ++i) total[i] += part[i];
+  };
+  const auto s = exec::parallel_for_accumulate(exec::seq, elems, make, body, merge);
+  const auto o = exec::parallel_for_accumulate(exec::omp, elems, make, body, merge);
+  CHECK(s == o);
+  std::vector<long double> ref(nodes, 0);
+  for (Index e = 0; e < elems; ++e)
+    for (int k = 0; k < 4; ++k) ref[conn[e][k]] += vals[e * 4 + k];
+  for (Index i = 0; i < nodes; ++i) CHECK(double(ref[i]) == doctest::Approx(s[i]).epsilon(1e-9));
+}
+
+TEST_CASE("an exception thrown inside an omp body reaches the caller") {
+  auto thrower = [](Index i) {
+    if (i == 777) throw ArgumentError("element 777 is bad");
+  };
+  CHECK_THROWS_AS(exec::parallel_for(exec::omp, 10000, thrower), ArgumentError);
+  CHECK_THROWS_AS(exec::parallel_for(exec::seq, 10000, thrower), ArgumentError);
+  auto map = [](Index i) -> double {
+    if (i == 5) throw MeshError("tet", 5, "inverted");
+    return 1.0;
+  };
+  CHECK_THROWS_AS(exec::parallel_reduce(exec::omp, 100, 0.0, map, std::plus<>{}), MeshError);
+}
+
+TEST_CASE("omp really runs on several threads when asked") {
+  CHECK(exec::omp_max_threads() >= 1);
+  std::vector<int> seen(1, 0);
+#if defined(_OPENMP)
+  std::vector<int> owner(64);
+  exec::parallel_for(exec::omp, 64, [&](Index i) { owner[i] = omp_get_thread_num(); });
+  if (exec::omp_max_threads() > 1) CHECK(*std::max_element(owner.begin(), owner.end()) > 0);
+#endif
+}
+
+TEST_CASE("policy concepts") {
+  static_assert(exec::ExecutionPolicy<exec::seq_t>);
+  static_assert(exec::ExecutionPolicy<const exec::omp_t&>);
+  static_assert(exec::ExecutionPolicy<exec::cuda_t>);
+  static_assert(!exec::ExecutionPolicy<int>);
+  static_assert(exec::HostPolicy<exec::omp_t> && !exec::HostPolicy<exec::cuda_t>);
+}
