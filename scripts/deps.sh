@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs the Debian packages simsr needs for a given job, only those missing.
+#   scripts/deps.sh run    build + run the main job
+#   scripts/deps.sh test   + test peers (numpy, meshio, gmsh, tetgen) and clang for the fuzzers
+# Needs root (or sudo) only when something is missing.
+set -euo pipefail
+job=${1:-test}
+
+pkgs=(build-essential cmake ninja-build
+      libeigen3-dev libxtensor-dev libnanoflann-dev libzip-dev
+      doctest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+      python3 python3-numpy)
+if [[ $job == test ]]; then
+  pkgs+=(python3-meshio python3-scipy gmsh tetgen clang libclang-rt-dev)
+fi
+
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+((${#missing[@]} == 0)) && exit 0
+
+echo "simsr: installing missing Debian packages: ${missing[*]}" >&2
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then
+  command -v sudo >/dev/null || { echo "simsr: need root to install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -q
+"${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
