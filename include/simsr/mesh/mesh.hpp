@@ -1,0 +1,16 @@
+#pragma once
+/// \file
+/// Umbrella of the mesh area: mesh structs, topology, geometry, quality, validation, triangulation.
+
+#include "../core/core.hpp"
+#include "cotangent_laplacian.hpp"
+#include "normals.hpp"
+#include "poly_mesh.hpp"
+#include "quality.hpp"
+#include "tet_mesh.hpp"
+#include "topology.hpp"
+#include "tri_mesh.hpp"
+#include "triangulate.hpp"
+#include "validate.hpp"
+#include "vertex_areas.hpp"
+#include "volume.hpp"
