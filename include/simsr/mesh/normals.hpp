@@ -47,7 +47,7 @@ Points<typename DV::Scalar> face_normals(P policy, const Eigen::MatrixBase<DV>& 
   exec::parallel_for(policy, F.rows(), [&](Index f) {
     const Vec3<S> n = detail::area_vector2(V, F, f);
     const S len = n.norm();
-    N.row(f) = len > S(0) ? Vec3<S>(n / len).transpose() : Vec3<S>::Zero().transpose();
+    N.row(f) = (len > S(0) ? Vec3<S>(n / len) : Vec3<S>::Zero()).transpose();
   });
   return N;
 }
