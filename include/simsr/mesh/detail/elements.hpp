@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <string>
 
+#include <Eigen/Geometry>
+
 #include "../../core/error.hpp"
 #include "../../core/types.hpp"
 
