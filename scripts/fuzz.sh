@@ -13,7 +13,10 @@ build=${SIMSR_FUZZ_BUILD_DIR:-build-fuzz}
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Release \
   -DSIMSR_FUZZ=ON -DSIMSR_BUILD_TESTS=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_BUILD_EXAMPLES=OFF \
   -DSIMSR_SANITIZE_IO=OFF >/dev/null
-targets=$(cd tests/fuzz && ls fuzz_*.cpp | sed 's/\.cpp$//')
+shopt -s nullglob
+targets=""
+for f in tests/fuzz/fuzz_*.cpp; do targets+=" $(basename "$f" .cpp)"; done
+[[ -n $targets ]] || { echo "simsr: no fuzz harnesses"; exit 0; }
 cmake --build "$build" -j "$(nproc)" --target $targets
 mkdir -p "$build/crashes"
 status=0
