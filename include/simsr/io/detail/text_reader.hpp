@@ -206,7 +206,8 @@ class LineCursor {
   }
 
   /// A declared item count: an integer ≥ 0 whose items, each at least `min_bytes_per_item` bytes
-  /// long, fit in `bytes_available` (default: the bytes after this line). Guards every reserve.
+  /// long with its line end, fit in `bytes_available` (default: the bytes after this line). Guards
+  /// every reserve. A line of k tokens takes at least 2k bytes.
   std::int64_t count(std::string_view tok, std::size_t min_bytes_per_item, const std::string& what,
                      std::size_t bytes_available = std::numeric_limits<std::size_t>::max()) const {
     const auto n = integer<std::int64_t>(tok, "count of " + what);
@@ -220,7 +221,7 @@ class LineCursor {
     if (n < 0) fail("negative count of " + what + " (" + std::to_string(n) + ")");
     if (bytes_available == std::numeric_limits<std::size_t>::max()) bytes_available = bytes_left();
     const std::size_t per = std::max<std::size_t>(min_bytes_per_item, 1);
-    if (static_cast<std::uint64_t>(n) > bytes_available / per)
+    if (static_cast<std::uint64_t>(n) > (bytes_available + 1) / per)  // +1: the last line may lack its '\n'
       fail("declares " + std::to_string(n) + " " + what + " but only " + std::to_string(bytes_available) +
            " bytes follow (truncated file or absurd count)");
     if (n > std::numeric_limits<VIndex>::max()) fail("too many " + what + " (" + std::to_string(n) + ")");
