@@ -17,7 +17,7 @@ void expect_parse_error(const std::function<void()>& f, std::int64_t line, const
     f();
   } catch (const simsr::ParseError& e) {
     thrown = true;
-    INFO(e.what());
+    INFO(std::string(e.what()));
     CHECK(e.line() == line);
     CHECK(e.file() == "mem.obj");
     CHECK(std::string(e.what()).find(part) != std::string::npos);
