@@ -1,0 +1,24 @@
+// simsr: the command-line tool of the simsr library. Each subcommand lives in cmd_<name>.hpp.
+//   simsr info FILE            one JSON object describing a mesh or array file
+//   simsr convert IN OUT       convert between mesh formats by extension
+// Errors: a message on stderr naming the file, and an exit code in 1..125 (errors.hpp).
+#include "cmd_convert.hpp"
+#include "cmd_info.hpp"
+#include "errors.hpp"
+
+#include <CLI/CLI.hpp>
+
+int main(int argc, char** argv) {
+  CLI::App app{"simsr: physics-based simulation super-resolution tools"};
+  app.require_subcommand(1);
+  std::function<int()> action;
+  simsr::cli::add_info(app, action);
+  simsr::cli::add_convert(app, action);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : simsr::cli::exit_usage;
+  }
+  return simsr::cli::run_guarded(action);
+}

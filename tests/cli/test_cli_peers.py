@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""`simsr info` / `simsr convert` against reference peers: Gmsh (live, .msh 2.2 and 4.1), meshio
+(MEDIT, TetGen, VTU it writes or reads back) and numpy (volumes, bounding boxes).
+
+    /usr/bin/python3 tests/cli/test_cli_peers.py SIMSR_EXE WORK_DIR DATA_DIR
+
+Exit 0: all checks passed; 1: a check failed; 77: a peer (gmsh, meshio, numpy) is missing.
+Run with Debian's /usr/bin/python3 (python3-meshio, python3-numpy, gmsh)."""
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+try:
+    import numpy as np
+    import meshio
+except ImportError as e:  # peer missing: skip, do not pass silently
+    print(f"SKIP: {e}")
+    sys.exit(77)
+
+SIMSR, WORK, DATA = sys.argv[1], sys.argv[2], sys.argv[3]
+os.makedirs(WORK, exist_ok=True)
+failures = []
+checks = 0
+
+
+def check(cond, what):
+    global checks
+    checks += 1
+    if not cond:
+        failures.append(what)
+        print("FAIL:", what)
+
+
+def simsr(*args, expect=0):
+    p = subprocess.run([SIMSR, *args], capture_output=True, text=True)
+    check(p.returncode == expect, f"simsr {' '.join(args)}: exit {p.returncode}, expected {expect}; stderr: {p.stderr.strip()}")
+    return p
+
+
+def info(path):
+    p = simsr("info", path)
+    return json.loads(p.stdout) if p.returncode == 0 else {}
+
+
+def tet_volume(points, tets):
+    a, b, c, d = (points[tets[:, i]] for i in range(4))
+    return float(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)).sum() / 6.0)
+
+
+def cells(m, kind):
+    return np.concatenate([c.data for c in m.cells if c.type == kind]) if any(c.type == kind for c in m.cells) else np.zeros((0, 4 if kind == "tetra" else 3), int)
+
+
+def agree_with_meshio(path, m, what):
+    """simsr info of `path` against meshio's arrays `m` of the same mesh."""
+    j = info(path)
+    tets, tris = cells(m, "tetra"), cells(m, "triangle")
+    check(j.get("vertices") == len(m.points), f"{what}: vertices {j.get('vertices')} vs meshio {len(m.points)}")
+    check(j.get("tets", 0) == len(tets), f"{what}: tets {j.get('tets')} vs meshio {len(tets)}")
+    check(j.get("triangles", 0) == len(tris), f"{what}: triangles {j.get('triangles')} vs meshio {len(tris)}")
+    vol = tet_volume(m.points, tets)
+    check(abs(j.get("volume", 0) - vol) <= 1e-12 * max(1, abs(vol)), f"{what}: volume {j.get('volume')} vs numpy {vol}")
+    bbox = [m.points.min(0).tolist(), m.points.max(0).tolist()]
+    check(np.allclose(j.get("bbox"), bbox, rtol=0, atol=1e-15), f"{what}: bbox {j.get('bbox')} vs {bbox}")
+    return j
+
+
+# --- 1. Gmsh writes the same sphere-in-box mesh in 2.2 and 4.1; gmsh's own counts are the truth.
+if shutil.which("gmsh") is None:
+    print("SKIP: gmsh not found")
+    sys.exit(77)
+geo = os.path.join(WORK, "ball.geo")
+with open(geo, "w") as f:
+    f.write('SetFactory("OpenCASCADE");\nSphere(1) = {0.1, -0.2, 0.3, 1.0};\n'
+            'Physical Volume("flesh", 7) = {1};\nPhysical Surface("skin", 3) = {1};\nMesh.CharacteristicLengthMax = 0.3;\n')
+gmsh_counts = {}
+for version in ("2.2", "4.1"):
+    out = os.path.join(WORK, f"ball{version.replace('.', '')}.msh")
+    p = subprocess.run(["gmsh", "-3", geo, "-format", f"msh{version.replace('.', '')}", "-o", out], capture_output=True, text=True)
+    check(p.returncode == 0, f"gmsh {version} failed: {p.stderr}")
+    # What gmsh itself reads back from the file it wrote (its meshing log also counts the
+    # seam lines and points that the physical groups leave out of the file).
+    p = subprocess.run(["gmsh", out, "-0", "-o", os.path.join(WORK, "readback.msh")], capture_output=True, text=True)
+    nodes = int(re.findall(r"Info\s*:\s*(\d+) nodes", p.stdout)[-1])
+    elements = int(re.findall(r"Info\s*:\s*(\d+) elements", p.stdout)[-1])
+    gmsh_counts[version] = (nodes, elements)
+    j = info(out)
+    check(j.get("format") == f"msh {version}", f"format {j.get('format')} for {out}")
+    check(j.get("vertices") == nodes, f"msh {version}: vertices {j.get('vertices')} vs gmsh {nodes}")
+    check(j.get("tets", 0) + j.get("triangles", 0) == elements,
+          f"msh {version}: tets+triangles {j.get('tets')}+{j.get('triangles')} vs gmsh {elements} elements")
+    check(j.get("inverted_tets") == 0, f"msh {version}: gmsh tets should be positively oriented")
+    m = meshio.read(out)
+    agree_with_meshio(out, m, f"msh {version} vs meshio")
+check(gmsh_counts["2.2"] == gmsh_counts["4.1"], f"gmsh counts differ between versions: {gmsh_counts}")
+j22, j41 = info(os.path.join(WORK, "ball22.msh")), info(os.path.join(WORK, "ball41.msh"))
+check(j22.get("volume") == j41.get("volume"), "msh 2.2 and 4.1 volumes differ")
+check(0.9 * 4 / 3 * np.pi < j41.get("volume", 0) < 4 / 3 * np.pi, f"inscribed ball volume {j41.get('volume')} not just below 4π/3")
+
+# --- 2. meshio writes MEDIT and TetGen files of the same mesh; simsr reads what meshio wrote.
+ball = meshio.read(os.path.join(WORK, "ball41.msh"))
+ball = meshio.Mesh(ball.points, [("tetra", cells(ball, "tetra")), ("triangle", cells(ball, "triangle"))])
+ball_tets = meshio.Mesh(ball.points, [("tetra", cells(ball, "tetra"))])
+meshio.write(os.path.join(WORK, "ball_meshio.mesh"), ball, file_format="medit")
+agree_with_meshio(os.path.join(WORK, "ball_meshio.mesh"), meshio.read(os.path.join(WORK, "ball_meshio.mesh")), "medit written by meshio")
+meshio.write(os.path.join(WORK, "ball_meshio.node"), ball_tets, file_format="tetgen")
+agree_with_meshio(os.path.join(WORK, "ball_meshio.ele"), ball_tets, "tetgen written by meshio")
+
+# --- 3. simsr convert; meshio reads back what simsr wrote: points and cells equal.
+src = os.path.join(WORK, "ball41.msh")
+for ext, fmt in ((".vtu", "vtu"), (".mesh", "medit"), (".msh", "gmsh")):
+    out = os.path.join(WORK, "converted" + ext)
+    simsr("convert", src, out)
+    back = meshio.read(out, file_format=fmt)
+    check(np.array_equal(back.points, ball.points), f"{ext}: points differ after convert (max {np.abs(back.points - ball.points).max()})")
+    for kind in ("tetra", "triangle"):
+        check(np.array_equal(cells(back, kind), cells(ball, kind)), f"{ext}: {kind} cells differ after convert")
+out = os.path.join(WORK, "converted22.msh")
+simsr("convert", "--msh-version", "2.2", src, out)
+check(np.array_equal(meshio.read(out).points, ball.points), "msh 2.2 convert: points differ")
+simsr("convert", src, os.path.join(WORK, "converted.node"))
+back = meshio.read(os.path.join(WORK, "converted.node"), file_format="tetgen")
+check(np.array_equal(back.points, ball.points) and np.array_equal(cells(back, "tetra"), cells(ball, "tetra")), "tetgen convert differs")
+simsr("convert", src, os.path.join(WORK, "both.obj"), expect=5)  # tets and triangles do not fit one OBJ
+simsr("convert", "--keep", "tets", src, os.path.join(WORK, "tets.obj"))
+jt = info(os.path.join(WORK, "tets.obj"))
+check(jt.get("tets") == len(cells(ball, "tetra")) and jt.get("volume") == j41.get("volume"), "tet-soup OBJ round trip")
+
+# --- 4. The bundled data.
+bunny = os.path.join(DATA, "bunny", "lrestshape.obj")
+if os.path.exists(bunny):
+    j = info(bunny)
+    check(j.get("vertices") == 1747 and j.get("tets") == 4896, f"bunny LR: {j}")
+    check(j.get("inverted_tets") == 0, "bunny LR has inverted tets")
+    j = info(os.path.join(DATA, "bunny", "train_frames.npz"))
+    check(j.get("arrays", {}).get("lowres", {}).get("shape") == [256, 1747, 3], f"train_frames lowres: {j}")
+    check(j.get("arrays", {}).get("frame", {}).get("dtype") == "int64", "train_frames frame dtype")
+
+# --- 5. Errors: message names the file, exit code by error class.
+bad = os.path.join(WORK, "bad.msh")
+with open(bad, "w") as f:
+    f.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 999999999999 1 3\n")
+p = simsr("info", bad, expect=2)
+check(bad in p.stderr, f"error message does not name the file: {p.stderr}")
+simsr("info", os.path.join(WORK, "missing.obj"), expect=2)
+simsr("info", os.path.join(WORK, "x.unknown"), expect=5)
+simsr("convert", src, expect=64)
+
+print(f"{checks - len(failures)} passed, {len(failures)} failed")
+sys.exit(1 if failures else 0)
