@@ -210,4 +210,17 @@ TEST_CASE("obj: the official bunny rest shape is a positively oriented tet soup"
   CHECK(hr.num_vertices() == 2503);
   CHECK(hr.num_faces() == 4968);
   CHECK_FALSE(simsr::io::is_tet_soup(simsr::io::read_obj(dir / "hrestshape.obj")));
+
+  // simulated frames share the rest shape's tets
+  const auto frame = simsr::io::read_obj_tets(dir / "train_obj_sample" / "lowres_000.obj");
+  CHECK(frame.T == m.T);
+  CHECK(frame.V.rows() == m.V.rows());
+
+  const fs::path face = fs::path(SIMSR_DATA_DIR) / "ict_face" / "neutral_face_head.obj";
+  if (fs::exists(face)) {
+    const auto f = simsr::io::read_obj(face);
+    CHECK(f.num_vertices() == 11248);
+    CHECK(f.num_faces() == 11144);
+    CHECK(simsr::triangulate(f).num_faces() == static_cast<simsr::Index>(f.indices.size()) - 2 * f.num_faces());
+  }
 }

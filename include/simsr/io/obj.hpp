@@ -74,7 +74,6 @@ PolyMesh<S> parse_obj(std::string_view text, std::string name, std::vector<std::
           }
         }
         if (parts >= 2 && part[parts - 1].empty()) cur.fail("face corner " + quote(c) + " ends with '/'");
-        if (parts == 2 && part[1].empty()) cur.fail("malformed face corner " + quote(c));
         for (std::size_t p = 1; p < parts; ++p) {
           if (part[p].empty()) continue;  // a//c
           if (cur.integer<std::int64_t>(part[p], "texture/normal index") == 0) cur.fail("index 0 in face corner " + quote(c) + " (OBJ indices start at 1)");
