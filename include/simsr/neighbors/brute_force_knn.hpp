@@ -1,0 +1,229 @@
+#pragma once
+/// \file
+/// Exhaustive k-nearest neighbours for high-dimensional features (EdgeConv's dynamic graph in
+/// DGCNN, §3.1): squared distances ‖a‖² + ‖b‖² − 2a·b from Eigen GEMMs on blocks of queries ×
+/// blocks of points, a bounded sorted buffer per query row, never an N×N matrix.
+///
+///     simsr::neighbors::BruteForceKnn<float> knn(F);            // F: N×D row-major, borrowed
+///     knn.query_self_into(simsr::exec::omp, 5, r);              // 5 nearest other points per row
+///     knn.query_self_into(simsr::exec::omp, 5, r, false);       // self included (first, distance 0)
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "../core/parallel.hpp"
+#include "knn_result.hpp"
+
+namespace simsr::neighbors {
+
+/// Exact brute-force kNN over N points of dimension D (row-major N×D, float by default).
+///
+/// Exactness: the GEMM form loses relative accuracy to cancellation, so it only *selects*
+/// k + `extra_candidates` candidates per query; their distances are then recomputed directly
+/// (Σ(a−b)², accumulated in double) and the k best of them returned. The result is the exact kNN
+/// unless more than `extra_candidates` points lie within the GEMM's rounding error of the k-th
+/// distance. Reported distances are the direct ones (self = exactly 0).
+///
+/// Ties: equal distances come by ascending index. Under exec::seq and exec::omp the blocks are the
+/// same (fixed sizes, not the thread count) and each row is computed the same way, so the results
+/// are bitwise identical.
+///
+/// Lifetime and threads: the points are borrowed and must outlive the object. The object owns
+/// its scratch buffers (sized on the first query, reused after), so a query allocates nothing once
+/// `out` has its shape; the price is that one object must not run two queries at once (use one
+/// object per thread, or exec::omp inside one query).
+template <class S = float>
+class BruteForceKnn {
+  static_assert(std::is_same_v<S, float> || std::is_same_v<S, double>, "simsr::neighbors::BruteForceKnn works on float or double features");
+
+ public:
+  using scalar_type = S;
+  using point_matrix = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;  ///< N×D
+
+  struct Params {
+    Index query_block = 128;     ///< queries per GEMM block (rows of the block product)
+    Index point_block = 1024;    ///< points per GEMM block (columns)
+    Index extra_candidates = 8;  ///< candidates kept beyond k for the exact re-ranking
+  };
+
+  BruteForceKnn() = default;
+  explicit BruteForceKnn(const point_matrix& P, Params params = {}) { build(P, params); }
+  explicit BruteForceKnn(Eigen::Map<const point_matrix> P, Params params = {}) { build(P, params); }
+  BruteForceKnn(point_matrix&&, Params = {}) = delete;  // would dangle
+
+  /// Borrows P (N×D) and precomputes its squared norms. ArgumentError for non-finite values or
+  /// non-positive block sizes.
+  void build(const point_matrix& P, Params params = {}) { build_view(P.data(), P.rows(), P.cols(), params); }
+  void build(Eigen::Map<const point_matrix> P, Params params = {}) { build_view(P.data(), P.rows(), P.cols(), params); }
+  void build(point_matrix&&, Params = {}) = delete;
+
+  Index size() const { return n_; }
+  Index dim() const { return d_; }
+
+  /// k nearest points of every row of Q (#Q×D, any scalar type) into `out` (#Q×k).
+  /// ArgumentError when k < 1, k > N or a query is not finite; ShapeError when Q has ≠ D columns.
+  template <exec::HostPolicy Policy, class DQ>
+  void query_into(Policy policy, const Eigen::MatrixBase<DQ>& Q, Index k, KnnResult<S>& out) {
+    constexpr const char* where = "neighbors::BruteForceKnn::query";
+    detail::check_cols(where, "queries", Q, d_);
+    detail::check_k(where, k, n_);
+    run(policy, Q, k, false, out, where);
+  }
+
+  /// k nearest points of every point (queries = the points themselves) into `out` (N×k). With
+  /// `exclude_self` a point is not its own neighbour (k ≤ N−1); otherwise it comes first at 0.
+  template <exec::HostPolicy Policy>
+  void query_self_into(Policy policy, Index k, KnnResult<S>& out, bool exclude_self = true) {
+    constexpr const char* where = "neighbors::BruteForceKnn::query_self";
+    detail::check_k(where, k, exclude_self ? n_ - 1 : n_, exclude_self ? "other points" : "points");
+    run(policy, points(), k, exclude_self, out, where);
+  }
+
+  template <exec::HostPolicy Policy, class DQ>
+  KnnResult<S> query(Policy policy, const Eigen::MatrixBase<DQ>& Q, Index k) {
+    KnnResult<S> r;
+    query_into(policy, Q, k, r);
+    return r;
+  }
+
+  template <exec::HostPolicy Policy>
+  KnnResult<S> query_self(Policy policy, Index k, bool exclude_self = true) {
+    KnnResult<S> r;
+    query_self_into(policy, k, r, exclude_self);
+    return r;
+  }
+
+ private:
+  using PointMap = Eigen::Map<const point_matrix>;
+
+  struct Workspace {
+    point_matrix Qb;             // query block, converted to S
+    point_matrix G;              // query block × point block products
+    VecX<S> qn;                  // squared norms of the query block
+    std::vector<S> cand_d2;      // per query row: `cap` approximate squared distances, ascending
+    std::vector<VIndex> cand_i;  // matching indices
+    std::vector<Index> count;
+    std::vector<S> exact;        // re-ranking scratch: direct distances
+    std::vector<VIndex> order;
+
+    void reserve(Index qb, Index pb, Index d, Index cap) {
+      if (Qb.rows() != qb || Qb.cols() != d) Qb.resize(qb, d);
+      if (G.rows() != qb || G.cols() != pb) G.resize(qb, pb);
+      if (qn.size() != qb) qn.resize(qb);
+      const auto c = static_cast<std::size_t>(qb * cap);
+      if (cand_d2.size() < c) cand_d2.resize(c), cand_i.resize(c);
+      if (count.size() < static_cast<std::size_t>(qb)) count.resize(static_cast<std::size_t>(qb));
+      if (exact.size() < static_cast<std::size_t>(cap)) exact.resize(static_cast<std::size_t>(cap)), order.resize(static_cast<std::size_t>(cap));
+    }
+  };
+
+  PointMap points() const { return PointMap(data_, n_, d_); }
+
+  void build_view(const S* data, Index n, Index d, Params params) {
+    constexpr const char* where = "neighbors::BruteForceKnn::build";
+    if (params.query_block < 1 || params.point_block < 1 || params.extra_candidates < 0)
+      throw ArgumentError(std::string(where) + ": query_block and point_block must be >= 1 and extra_candidates >= 0");
+    if (n > Index(std::numeric_limits<VIndex>::max()))
+      throw ArgumentError(std::string(where) + ": " + std::to_string(n) + " points exceed the 32-bit index range");
+    if (d < 1) throw ShapeError(std::string(where) + ": points", {n, -1}, {n, d});
+    detail::check_finite_rows(where, "points", PointMap(data, n, d));
+    data_ = data, n_ = n, d_ = d, params_ = params;
+    norms_ = PointMap(data, n, d).rowwise().squaredNorm();
+  }
+
+  template <class Policy, class DQ>
+  void run(Policy policy, const Eigen::MatrixBase<DQ>& Q, Index k, bool exclude_self, KnnResult<S>& out, const char* where) {
+    const Index nq = Q.rows();
+    out.resize(nq, k);
+    if (nq == 0) return;
+    const Index qb = std::min(params_.query_block, nq);
+    const Index pb = std::min(params_.point_block, n_);
+    const Index cap = std::min(k + params_.extra_candidates, exclude_self ? n_ - 1 : n_);
+    const Index blocks = (nq + qb - 1) / qb;
+    Index workers = 1;
+    if constexpr (std::is_same_v<Policy, exec::omp_t>) workers = std::min<Index>(blocks, exec::omp_max_threads());
+    if (static_cast<Index>(ws_.size()) < workers) ws_.resize(static_cast<std::size_t>(workers));
+    for (Index w = 0; w < workers; ++w) ws_[static_cast<std::size_t>(w)].reserve(qb, pb, d_, cap);
+    exec::parallel_for(policy, workers, [&](Index w) {
+      Workspace& ws = ws_[static_cast<std::size_t>(w)];
+      const auto [b0, b1] = exec::detail::chunk_range(blocks, workers, w);
+      for (Index b = b0; b < b1; ++b) block(Q, b * qb, std::min(qb, nq - b * qb), k, cap, exclude_self, ws, out, where);
+    });
+  }
+
+  /// One block of m queries starting at q0: candidates from all point blocks, then re-ranking.
+  template <class DQ>
+  void block(const Eigen::MatrixBase<DQ>& Q, Index q0, Index m, Index k, Index cap, bool exclude_self, Workspace& ws,
+             KnnResult<S>& out, const char* where) const {
+    auto Qb = ws.Qb.topRows(m);
+    Qb = Q.middleRows(q0, m).template cast<S>();
+    for (Index r = 0; r < m; ++r)
+      if (!Qb.row(r).allFinite()) throw ArgumentError(std::string(where) + ": query row " + std::to_string(q0 + r) + " holds a non-finite value");
+    ws.qn.head(m) = Qb.rowwise().squaredNorm();
+    std::fill(ws.count.begin(), ws.count.begin() + m, Index(0));
+    const PointMap P = points();
+    const S inf = std::numeric_limits<S>::infinity();
+    for (Index p0 = 0; p0 < n_; p0 += params_.point_block) {
+      const Index pn = std::min(params_.point_block, n_ - p0);
+      auto G = ws.G.topLeftCorner(m, pn);
+      G.noalias() = Qb * P.middleRows(p0, pn).transpose();
+      for (Index r = 0; r < m; ++r) {
+        S* cd = ws.cand_d2.data() + r * cap;
+        VIndex* ci = ws.cand_i.data() + r * cap;
+        Index& cnt = ws.count[static_cast<std::size_t>(r)];
+        const S qn = ws.qn[r];
+        const S* g = ws.G.row(r).data();
+        const S* pnorm = norms_.data() + p0;
+        const Index self = exclude_self ? q0 + r - p0 : -1;  // column of the query itself, if any
+        S worst = cnt == cap ? cd[cap - 1] : inf;
+        for (Index j = 0; j < pn; ++j) {
+          const S d2 = qn + pnorm[j] - S(2) * g[j];
+          if (!(d2 < worst) || j == self) continue;  // later indices never win ties
+          Index t = cnt < cap ? cnt++ : cap - 1;
+          for (; t > 0 && cd[t - 1] > d2; --t) cd[t] = cd[t - 1], ci[t] = ci[t - 1];
+          cd[t] = d2;
+          ci[t] = static_cast<VIndex>(p0 + j);
+          if (cnt == cap) worst = cd[cap - 1];
+        }
+      }
+    }
+    for (Index r = 0; r < m; ++r) rerank(Qb.row(r), ws.cand_i.data() + r * cap, cap, k, ws, out, q0 + r);
+  }
+
+  /// Direct distances of the cap candidates, rounded to S as reported; the k best by (distance,
+  /// index) go to row `row`.
+  template <class Row>
+  void rerank(const Row& q, const VIndex* ci, Index cap, Index k, Workspace& ws, KnnResult<S>& out, Index row) const {
+    for (Index c = 0; c < cap; ++c) {
+      const S* p = data_ + static_cast<Index>(ci[c]) * d_;
+      double acc = 0;
+      for (Index j = 0; j < d_; ++j) {
+        const double diff = static_cast<double>(q[j]) - static_cast<double>(p[j]);
+        acc += diff * diff;
+      }
+      ws.exact[static_cast<std::size_t>(c)] = static_cast<S>(std::sqrt(acc));
+      ws.order[static_cast<std::size_t>(c)] = static_cast<VIndex>(c);
+    }
+    auto first = ws.order.begin(), last = ws.order.begin() + cap;
+    std::partial_sort(first, first + k, last, [&](VIndex a, VIndex b) {
+      return detail::closer(ws.exact[static_cast<std::size_t>(a)], ci[a], ws.exact[static_cast<std::size_t>(b)], ci[b]);
+    });
+    for (Index j = 0; j < k; ++j) {
+      const VIndex c = ws.order[static_cast<std::size_t>(j)];
+      out.indices(row, j) = ci[c];
+      out.distances(row, j) = ws.exact[static_cast<std::size_t>(c)];
+    }
+  }
+
+  const S* data_ = nullptr;
+  Index n_ = 0, d_ = 0;
+  Params params_{};
+  VecX<S> norms_;
+  std::vector<Workspace> ws_;
+};
+
+}  // namespace simsr::neighbors
