@@ -40,13 +40,15 @@ struct Assignment {
 /// implementation does (same scan order), so the two return the same columns.
 /// Throws ShapeError when N > M (pass the transpose), ArgumentError for a NaN or −inf entry
 /// (naming it) and when no assignment avoids the +inf entries (naming the row that cannot be
-/// placed). O(N²M).
+/// placed). O(N²M); pass a row-major double matrix to avoid a copy.
 template <class Derived>
 Assignment linear_assignment(const Eigen::MatrixBase<Derived>& C) {
   const Index nr = C.rows(), nc = C.cols();
   if (nr > nc)
     throw ShapeError("linear_assignment: cost matrix (rows ≤ columns; pass the transpose)", {nc, nc}, {nr, nc});
-  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> cost = C.template cast<double>();
+  // Rows are scanned contiguously: a row-major double input is used in place, anything else copied once.
+  using RowMajorCosts = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::Ref<const RowMajorCosts> cost(C.template cast<double>());
   for (Index i = 0; i < nr; ++i)
     for (Index j = 0; j < nc; ++j) {
       const double c = cost(i, j);
