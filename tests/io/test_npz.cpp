@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <xtensor/xbuilder.hpp>
+
 #include <simsr/io/npz.hpp>
 
 namespace {
@@ -289,6 +291,17 @@ TEST_CASE("npz: corrupt archives give ParseError naming the archive or member") 
     CHECK(msg.find("bad.npy") != std::string::npos);
   }
   CHECK_THROWS_AS(io::read_npz(fixtures / "missing.npz"), simsr::ParseError);
+  CHECK_THROWS_AS(io::read_npz(fixtures / "f8_c.npy"), simsr::ParseError);
   io::NpzReader ok(fixtures / "stored.npz");
   CHECK_THROWS_AS(ok.read("missing"), simsr::ArgumentError);
+  // A cap on the uncompressed member size.
+  ok.set_max_member_bytes(200);
+  CHECK(ok.read("scalar").item<int>() == 7);
+  try {
+    ok.read("frames");
+    FAIL("no error");
+  } catch (const simsr::ParseError& e) {
+    CHECK(e.file() == (fixtures / "stored.npz").string() + ":frames.npy");
+    CHECK(e.message().find("exceeds the limit of 200 bytes") != std::string::npos);
+  }
 }

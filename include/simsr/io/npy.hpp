@@ -27,7 +27,6 @@
 
 #include <Eigen/Core>
 #include <xtensor/xarray.hpp>
-#include <xtensor/xbuilder.hpp>
 #include <xtensor/xtensor.hpp>
 
 #include "../core/error.hpp"

@@ -133,6 +133,11 @@ class NpzReader {
   bool contains(std::string_view name) const { return position(name) >= 0; }
   const std::string& source() const { return source_; }
 
+  /// Largest uncompressed member read() accepts (default 16 GiB); larger ones give ParseError
+  /// before anything is allocated.
+  void set_max_member_bytes(std::uint64_t n) { max_member_bytes_ = n; }
+  std::uint64_t max_member_bytes() const { return max_member_bytes_; }
+
   /// Reads and parses one member; ArgumentError when no member has that name.
   NpyArray read(std::string_view name) {
     const auto p = position(name);
@@ -191,6 +196,9 @@ class NpzReader {
     if (st.comp_method == ZIP_CM_DEFLATE && st.size / 1032 > st.comp_size + 1)
       throw ParseError(where, 0, "declared size " + std::to_string(st.size) + " is impossible for " +
                                      std::to_string(st.comp_size) + " deflated bytes");
+    if (st.size > max_member_bytes_)
+      throw ParseError(where, 0, "declared size " + std::to_string(st.size) + " exceeds the limit of " +
+                                     std::to_string(max_member_bytes_) + " bytes");
     detail::ZipFilePtr f(zip_fopen_index(zip_.get(), entry, 0));
     if (!f) throw ParseError(where, 0, "cannot open member: " + std::string(zip_strerror(zip_.get())));
     std::uint64_t pos = 0;
@@ -218,6 +226,7 @@ class NpzReader {
   detail::ZipPtr zip_;
   std::string source_;
   std::uint64_t archive_size_ = 0;
+  std::uint64_t max_member_bytes_ = std::uint64_t{1} << 34;
   std::vector<std::string> names_;
   std::vector<zip_uint64_t> entries_;
 };

@@ -137,8 +137,8 @@ inline std::u32string utf8_decode(const std::string& s) {
   auto bad = [&] { throw ArgumentError("npy: string is not valid UTF-8 at byte " + std::to_string(i)); };
   while (i < s.size()) {
     const auto c = static_cast<unsigned char>(s[i]);
-    std::uint32_t cp;
-    int extra;
+    std::uint32_t cp = 0;
+    int extra = 0;
     if (c < 0x80) {
       cp = c;
       extra = 0;
