@@ -88,7 +88,7 @@ TEST_CASE("BruteForceKnn matches a long-double brute force (dimensions 1..64, fl
       }
 }
 
-TEST_CASE("BruteForceKnn under seq and omp is bitwise identical at a size where Eigen would thread its own GEMM") {
+TEST_CASE("BruteForceKnn under seq and omp is bitwise identical at a size where Eigen's own product would start threads") {
   std::mt19937 rng(9);
   const auto P = test::random_points<Features<float>>(3000, 64, 1, rng);
   BruteForceKnn<float> knn(P);

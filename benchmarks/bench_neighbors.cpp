@@ -1,0 +1,169 @@
+// Neighbour gathering at the paper's sizes (LR 15,872 vertices, HR surface 35,637 vertices):
+//   3-D kNN k=20 of the HR vertices among the LR ones (kd-tree build and query),
+//   EdgeConv's feature kNN N=15,872, D=64, k=5 (brute force, self included as in DGCNN),
+//   geodesic kNN k=5 on a BCC lattice graph of ~15.6k vertices (the first EdgeConv graph).
+// Uniform random points in [-1,1]^3 and standard-normal features, as scripts/peers/knn_peer.py
+// --bench uses for the scipy and torch peers. Buffers are built once and reused across iterations.
+//   build/benchmarks/bench_neighbors --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <simsr/neighbors/neighbors.hpp>
+
+#include <array>
+#include <random>
+#include <vector>
+
+using namespace simsr;
+using namespace simsr::neighbors;
+
+namespace {
+
+constexpr Index kLR = 15872, kHR = 35637, kFeatureDim = 64;
+
+const Points<double>& lr_points() {
+  static const Points<double> P = [] {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(-1, 1);
+    Points<double> X(kLR, 3);
+    for (Index i = 0; i < X.size(); ++i) X.data()[i] = u(rng);
+    return X;
+  }();
+  return P;
+}
+
+const Points<double>& hr_points() {
+  static const Points<double> Q = [] {
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<double> u(-1, 1);
+    Points<double> X(kHR, 3);
+    for (Index i = 0; i < X.size(); ++i) X.data()[i] = u(rng);
+    return X;
+  }();
+  return Q;
+}
+
+const BruteForceKnn<float>::point_matrix& features() {
+  static const BruteForceKnn<float>::point_matrix F = [] {
+    std::mt19937 rng(3);
+    std::normal_distribution<float> g(0, 1);
+    BruteForceKnn<float>::point_matrix X(kLR, kFeatureDim);
+    for (Index i = 0; i < X.size(); ++i) X.data()[i] = g(rng);
+    return X;
+  }();
+  return F;
+}
+
+/// Body-centred cubic lattice graph of nx×ny×nz cubes: cube corners, cube centres, and the BCC
+/// tetrahedralization's edges (corner–corner and centre–centre along the axes, centre–corner).
+struct Lattice {
+  Points<double> V;
+  Edges E;
+};
+
+Lattice bcc_lattice(int nx, int ny, int nz, double h) {
+  Lattice L;
+  const Index corners = Index(nx + 1) * (ny + 1) * (nz + 1);
+  L.V.resize(corners + Index(nx) * ny * nz, 3);
+  auto corner = [&](int i, int j, int k) { return VIndex(i + (nx + 1) * (j + (ny + 1) * k)); };
+  auto centre = [&](int i, int j, int k) { return VIndex(corners + i + nx * (j + ny * k)); };
+  std::vector<std::array<VIndex, 2>> e;
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) {
+        L.V.row(corner(i, j, k)) << h * i, h * j, h * k;
+        if (i < nx) e.push_back({corner(i, j, k), corner(i + 1, j, k)});
+        if (j < ny) e.push_back({corner(i, j, k), corner(i, j + 1, k)});
+        if (k < nz) e.push_back({corner(i, j, k), corner(i, j, k + 1)});
+      }
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const VIndex c = centre(i, j, k);
+        L.V.row(c) << h * (i + 0.5), h * (j + 0.5), h * (k + 0.5);
+        for (int b = 0; b < 8; ++b) e.push_back({c, corner(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1))});
+        if (i + 1 < nx) e.push_back({c, centre(i + 1, j, k)});
+        if (j + 1 < ny) e.push_back({c, centre(i, j + 1, k)});
+        if (k + 1 < nz) e.push_back({c, centre(i, j, k + 1)});
+      }
+  L.E.resize(Index(e.size()), 2);
+  for (Index r = 0; r < L.E.rows(); ++r) L.E(r, 0) = e[r][0], L.E(r, 1) = e[r][1];
+  return L;
+}
+
+const Lattice& lattice() {
+  static const Lattice L = bcc_lattice(20, 20, 18, 0.0125);  // 8,379 corners + 7,200 centres = 15,579 vertices
+  return L;
+}
+
+void BM_KdTreeBuild_LR15872(benchmark::State& state) {
+  const auto& P = lr_points();
+  KdTree<double> tree;
+  for (auto _ : state) {
+    tree.build(P);
+    benchmark::DoNotOptimize(tree);
+  }
+  state.SetItemsProcessed(state.iterations() * kLR);
+}
+BENCHMARK(BM_KdTreeBuild_LR15872)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+
+template <class Policy>
+void BM_KdTreeQuery_HR35637_in_LR15872_k20(benchmark::State& state) {
+  const KdTree<double> tree(lr_points());
+  KnnResult<double> r;
+  tree.query_into(Policy{}, hr_points(), 20, r);
+  for (auto _ : state) {
+    tree.query_into(Policy{}, hr_points(), 20, r);
+    benchmark::DoNotOptimize(r.indices.data());
+  }
+  state.SetItemsProcessed(state.iterations() * kHR);
+}
+BENCHMARK(BM_KdTreeQuery_HR35637_in_LR15872_k20<exec::seq_t>)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+BENCHMARK(BM_KdTreeQuery_HR35637_in_LR15872_k20<exec::omp_t>)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+
+template <class Policy>
+void BM_FeatureKnn_N15872_D64_k5(benchmark::State& state) {
+  BruteForceKnn<float> knn(features(), {state.range(0), state.range(1), 8});
+  KnnResult<float> r;
+  knn.query_self_into(Policy{}, 5, r, false);
+  for (auto _ : state) {
+    knn.query_self_into(Policy{}, 5, r, false);
+    benchmark::DoNotOptimize(r.indices.data());
+  }
+  state.counters["GFLOP/s"] = benchmark::Counter(2.0 * kLR * kLR * kFeatureDim * 1e-9 * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_FeatureKnn_N15872_D64_k5<exec::seq_t>)->Args({128, 1024})->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.5);
+BENCHMARK(BM_FeatureKnn_N15872_D64_k5<exec::omp_t>)
+    ->ArgNames({"qblock", "pblock"})
+    ->Args({128, 1024})
+    ->Args({256, 2048})
+    ->Args({64, 512})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinWarmUpTime(0.5);
+
+template <class Policy>
+void BM_GeodesicKnn_BCC15579_k5(benchmark::State& state) {
+  GeodesicKnn<double> g(lattice().V, lattice().E);
+  KnnResult<double> r;
+  g.query_into(Policy{}, 5, r);
+  for (auto _ : state) {
+    g.query_into(Policy{}, 5, r);
+    benchmark::DoNotOptimize(r.indices.data());
+  }
+  state.SetItemsProcessed(state.iterations() * lattice().V.rows());
+}
+BENCHMARK(BM_GeodesicKnn_BCC15579_k5<exec::seq_t>)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+BENCHMARK(BM_GeodesicKnn_BCC15579_k5<exec::omp_t>)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+
+void BM_GeodesicKnnBuild_BCC15579(benchmark::State& state) {
+  GeodesicKnn<double> g;
+  for (auto _ : state) {
+    g.build(lattice().V, lattice().E);
+    benchmark::DoNotOptimize(g);
+  }
+}
+BENCHMARK(BM_GeodesicKnnBuild_BCC15579)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+
+}  // namespace
+
+BENCHMARK_MAIN();
