@@ -10,7 +10,8 @@ Bench mode (peer timings beside benchmarks/bench_neighbors.cpp, same sizes as th
     env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE /usr/bin/python3 knn_peer.py --bench
   * cKDTree build on 15,872 uniform points and query of 35,637 points, k = 20, workers = 2;
   * torch.cdist + topk for N = 15,872 features of D = 64, k = 5 (self included), float32,
-    torch.set_num_threads(2), queries in blocks of 2,048 rows so no N x N matrix is held.
+    torch.set_num_threads(2), queries in blocks of 2,048 rows so no N x N matrix is held (and
+    once with the full N x N matrix, DGCNN's form), plus numpy on OpenBLAS with the same blocks.
 Prints the median and min of `--repeats` timed runs after one warm-up.
 """
 import argparse
@@ -83,6 +84,22 @@ def bench(args):
         return torch.topk(d, 5, dim=1, largest=False)
 
     report("torch cdist+topk N=15872 D=64 k=5, full N x N", timed(cdist_full, max(1, args.repeats // 2)))
+
+    # numpy on OpenBLAS: the same blocked |a|^2 + |b|^2 - 2 a.b with argpartition (the GEMM
+    # speed this machine's BLAS reaches; Debian's torch 1.13 matmul runs far below it here).
+    f = feats.numpy()
+    norms = (f * f).sum(1)
+
+    def numpy_blocked():
+        out = np.empty((n_lr, 5), dtype=np.int64)
+        for q0 in range(0, n_lr, block):
+            d = norms[q0:q0 + block, None] + norms[None, :] - 2 * (f[q0:q0 + block] @ f.T)
+            part = np.argpartition(d, 5, axis=1)[:, :5]
+            order = np.argsort(np.take_along_axis(d, part, 1), axis=1)
+            out[q0:q0 + block] = np.take_along_axis(part, order, 1)
+        return out
+
+    report("numpy/OpenBLAS blocked GEMM+argpartition N=15872 D=64 k=5", timed(numpy_blocked, args.repeats))
 
 
 def main():

@@ -147,7 +147,7 @@ class BruteForceKnn {
  private:
   using PointMap = Eigen::Map<const point_matrix>;
 
-  struct Workspace {
+  struct alignas(64) Workspace {  // one cache line apart: workers push to their own vectors
     point_matrix Qb;             // query block, converted to S
     point_matrix G;              // query block × point block products
     VecX<S> qn;                  // squared norms of the query block

@@ -127,7 +127,7 @@ class GeodesicKnn {
   }
 
  private:
-  struct Workspace {
+  struct alignas(64) Workspace {  // one cache line apart: workers push to their own vectors
     std::vector<S> dist;           // +inf except for touched vertices of the current source
     std::vector<std::uint8_t> settled;
     std::vector<VIndex> touched;
