@@ -1,9 +1,13 @@
 // simsr: the command-line tool of the simsr library. Each subcommand lives in cmd_<name>.hpp.
 //   simsr info FILE            one JSON object describing a mesh or array file
 //   simsr convert IN OUT       convert between mesh formats by extension
+//   simsr knn ...              Euclidean kNN (KD-tree), .npy in, .npz out
+//   simsr neighbors ...        §3.2 upsampling neighbourhoods + LR geodesic graph
 // Errors: a message on stderr naming the file, and an exit code in 1..125 (errors.hpp).
 #include "cmd_convert.hpp"
 #include "cmd_info.hpp"
+#include "cmd_knn.hpp"
+#include "cmd_neighbors.hpp"
 #include "errors.hpp"
 
 #include <CLI/CLI.hpp>
@@ -14,6 +18,8 @@ int main(int argc, char** argv) {
   std::function<int()> action;
   simsr::cli::add_info(app, action);
   simsr::cli::add_convert(app, action);
+  simsr::cli::add_knn(app, action);
+  simsr::cli::add_neighbors(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

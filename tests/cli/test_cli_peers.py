@@ -139,7 +139,41 @@ if os.path.exists(bunny):
     check(j.get("arrays", {}).get("lowres", {}).get("shape") == [256, 1747, 3], f"train_frames lowres: {j}")
     check(j.get("arrays", {}).get("frame", {}).get("dtype") == "int64", "train_frames frame dtype")
 
-# --- 5. Errors: message names the file, exit code by error class.
+# --- 5. simsr knn against scipy's cKDTree; simsr neighbors on the bunny.
+try:
+    from scipy.spatial import cKDTree
+except ImportError:
+    cKDTree = None
+if cKDTree is not None:
+    rng = np.random.default_rng(7)
+    P, Q = rng.random((2000, 3)), rng.random((700, 3))
+    np.save(os.path.join(WORK, "P.npy"), P)
+    np.save(os.path.join(WORK, "Q.npy"), Q)
+    p = simsr("knn", "--points", os.path.join(WORK, "P.npy"), "--queries", os.path.join(WORK, "Q.npy"), "--k", "9",
+              "--out", os.path.join(WORK, "knn.npz"))
+    timing = json.loads(p.stdout) if p.returncode == 0 else {}
+    check({"build_ms", "query_ms"} <= set(timing), f"knn timing JSON: {p.stdout}")
+    z = np.load(os.path.join(WORK, "knn.npz"))
+    d, i = cKDTree(P).query(Q, 9)
+    check(z["indices"].dtype == np.int64 and z["distances"].dtype == np.float64, "knn dtypes")
+    check(np.array_equal(z["indices"], i), "knn indices differ from cKDTree")
+    check(np.abs(z["distances"] - d).max() <= 1e-12, "knn distances differ from cKDTree")
+    simsr("knn", "--points", os.path.join(WORK, "P.npy"), "--queries", os.path.join(WORK, "Q.npy"), "--k", "2001",
+          "--out", os.path.join(WORK, "knn.npz"), expect=5)
+if os.path.exists(bunny):
+    out = os.path.join(WORK, "bunny_neighbors.npz")
+    p = simsr("neighbors", "--lr-rest", bunny, "--hr-rest", os.path.join(DATA, "bunny", "hrestshape.obj"), "--k", "20",
+              "--lr-k", "5", "--out", out)
+    z = np.load(out)
+    check(z["indices"].shape == (2503, 20) and z["lr_indices"].shape == (1747, 5), "neighbors shapes")
+    check(np.array_equal(z["lr_indices"][:, 0], np.arange(1747)), "LR geodesic graph: self first")
+    check(np.all(np.diff(z["distances"], axis=1) >= 0), "neighbourhood distances sorted")
+    mapped = z["lr_to_hr"]
+    check(len(np.unique(mapped)) == 1747, "LR→HR assignment is one-to-one")
+    check(np.array_equal(z["indices"][mapped, 0], np.arange(1747)) and np.all(z["distances"][mapped, 0] == 0),
+          "each mapped HR vertex has its own LR vertex first at distance 0")
+
+# --- 6. Errors: message names the file, exit code by error class.
 bad = os.path.join(WORK, "bad.msh")
 with open(bad, "w") as f:
     f.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 999999999999 1 3\n")

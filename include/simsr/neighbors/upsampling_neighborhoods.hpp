@@ -103,17 +103,23 @@ UpsamplingNeighborhoods upsampling_neighborhoods(Policy policy, const Eigen::Mat
   return nb;
 }
 
-/// Writes `nb` as an .npz: `indices` (M×k int32), `distances` (M×k float64), `lr_to_hr` (N int32),
-/// `assignment_cost` (0-d float64), `assignment_globally_optimal` (0-d bool).
-inline void save_upsampling_neighborhoods(const std::filesystem::path& path, const UpsamplingNeighborhoods& nb) {
+/// The arrays of `nb` as saved: `indices` (M×k int64), `distances` (M×k float64), `lr_to_hr`
+/// (N int64), `assignment_cost` (0-d float64), `assignment_globally_optimal` (0-d bool). Callers
+/// may add arrays (the `simsr neighbors` tool adds the LR geodesic graph) before writing.
+inline io::NpzArrays upsampling_neighborhoods_arrays(const UpsamplingNeighborhoods& nb) {
   io::NpzArrays z;
-  z["indices"] = io::make_npy(nb.indices);
+  z["indices"] = io::make_npy(nb.indices.cast<std::int64_t>().eval());
   z["distances"] = io::make_npy(nb.distances);
-  z["lr_to_hr"] = io::make_npy(nb.lr_to_hr);
+  z["lr_to_hr"] = io::make_npy(nb.lr_to_hr.cast<std::int64_t>().eval());
   z["assignment_cost"] = io::make_npy<double>({}, &nb.assignment_cost);
   const bool opt = nb.assignment_globally_optimal;
   z["assignment_globally_optimal"] = io::make_npy<bool>({}, &opt);
-  io::write_npz(path, z, io::NpzCompression::Deflate);
+  return z;
+}
+
+/// Writes `nb` as a compressed .npz (see upsampling_neighborhoods_arrays for the arrays).
+inline void save_upsampling_neighborhoods(const std::filesystem::path& path, const UpsamplingNeighborhoods& nb) {
+  io::write_npz(path, upsampling_neighborhoods_arrays(nb), io::NpzCompression::Deflate);
 }
 
 /// Reads what save_upsampling_neighborhoods wrote. Throws ParseError (unreadable file), ArgumentError
