@@ -1,0 +1,86 @@
+#pragma once
+/// \file
+/// The paper's "Embedded" baseline (§5, Table 2/Fig. 6): the HR rest surface is embedded in the
+/// LR rest tets by barycentric weights, and every frame's HR displacement is the weighted sum of
+/// the LR displacements of the 4 vertices of its tet. Reproduces any affine displacement field
+/// exactly (also at extrapolated points outside the LR mesh).
+///
+///     interp::Embedded<> e;  e.fit(problem);                 // problem.lr: TetMesh, problem.hr: TriMesh
+///     e.apply(lr_displacement, hr_displacement);             // N×3 → M×3, no allocation
+///     e.apply(exec::omp, lr_displacement, hr_displacement);
+
+#include <string>
+
+#include "../core/error.hpp"
+#include "../core/parallel.hpp"
+#include "../core/types.hpp"
+#include "../discretize/embedding.hpp"
+#include "problem.hpp"
+
+namespace simsr::interp {
+
+/// Barycentric-embedding interpolator. `S` the scalar, `Policy` the execution policy of fit and
+/// of the policy-less apply. Satisfies interp::Interpolator.
+template <class S = Scalar, exec::HostPolicy Policy = exec::seq_t>
+class Embedded {
+ public:
+  using scalar_type = S;
+  using policy_type = Policy;
+
+  explicit Embedded(const EmbeddingOptions& options = {}) : options_(options) {}
+
+  /// Embeds problem.hr.V (M×3) in problem.lr (tets over N vertices). Throws MeshError for an
+  /// empty or degenerate LR mesh, ArgumentError for non-finite HR vertices.
+  void fit(UpsamplingProblem<S>& problem) { fit(problem.lr, problem.hr.V); }
+
+  /// Embeds the points `hr_rest` (M×3) in the tet mesh `lr_rest`.
+  template <class DQ>
+  void fit(const TetMesh<S>& lr_rest, const Eigen::MatrixBase<DQ>& hr_rest) {
+    embedding_ = embed(Policy{}, lr_rest, hr_rest, options_);
+    const Index m = embedding_.size();
+    ids_.resize(m, 4);
+    for (Index q = 0; q < m; ++q) ids_.row(q) = lr_rest.T.row(embedding_.tet[q]);
+    num_lr_ = lr_rest.num_vertices();
+  }
+
+  /// hr_displacement.row(q) = Σ_k w_qk · lr_displacement.row(id_qk). Sizes N×3 and M×3 are
+  /// checked (ShapeError); nothing is allocated.
+  template <exec::HostPolicy P, class DI, class DO>
+  void apply(P policy, const Eigen::MatrixBase<DI>& lr_displacement, Eigen::MatrixBase<DO>& hr_displacement) const {
+    if (lr_displacement.rows() != num_lr_ || lr_displacement.cols() != 3)
+      throw ShapeError("Embedded::apply: LR displacement", {num_lr_, 3}, {lr_displacement.rows(), lr_displacement.cols()});
+    if (hr_displacement.rows() != num_hr() || hr_displacement.cols() != 3)
+      throw ShapeError("Embedded::apply: HR displacement", {num_hr(), 3}, {hr_displacement.rows(), hr_displacement.cols()});
+    const auto& W = embedding_.weights;
+    exec::parallel_for(policy, num_hr(), [&](Index q) {
+      for (int d = 0; d < 3; ++d) {
+        S x = S(0);
+        for (int k = 0; k < 4; ++k) x += W(q, k) * S(lr_displacement(ids_(q, k), d));
+        hr_displacement(q, d) = x;
+      }
+    });
+  }
+
+  /// apply under the class's policy.
+  template <class DI, class DO>
+  void apply(const Eigen::MatrixBase<DI>& lr_displacement, Eigen::MatrixBase<DO>& hr_displacement) const {
+    apply(Policy{}, lr_displacement, hr_displacement);
+  }
+
+  /// N, the LR vertex count fitted on (0 before fit).
+  Index num_lr() const { return num_lr_; }
+  /// M, the HR vertex count fitted on (0 before fit).
+  Index num_hr() const { return embedding_.size(); }
+  /// The embedding of the HR rest vertices (tet, weights, inside, distance per HR vertex).
+  const Embedding<S>& embedding() const { return embedding_; }
+  /// M×4 LR vertex ids of each HR vertex's tet (the columns of `embedding().weights`).
+  const Tets& lr_vertex_ids() const { return ids_; }
+
+ private:
+  EmbeddingOptions options_;
+  Embedding<S> embedding_;
+  Tets ids_;
+  Index num_lr_ = 0;
+};
+
+}  // namespace simsr::interp
