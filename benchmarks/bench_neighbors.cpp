@@ -7,6 +7,7 @@
 //   build/benchmarks/bench_neighbors --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <simsr/discretize/bcc_lattice.hpp>
 #include <simsr/neighbors/neighbors.hpp>
 
 #include <array>
@@ -53,45 +54,25 @@ const BruteForceKnn<float>::point_matrix& features() {
   return F;
 }
 
-/// Body-centred cubic lattice graph of nx×ny×nz cubes: cube corners, cube centres, and the BCC
-/// tetrahedralization's edges (corner–corner and centre–centre along the axes, centre–corner).
+/// Body-centred cubic lattice graph: the nodes (cube corners and centres) and edges of the BCC
+/// lattice mesh of a full box of nx×ny×nz cubes (discretize::build_lattice; its boundary faces
+/// carry the pyramid diagonals).
 struct Lattice {
   Points<double> V;
   Edges E;
 };
 
-Lattice bcc_lattice(int nx, int ny, int nz, double h) {
-  Lattice L;
-  const Index corners = Index(nx + 1) * (ny + 1) * (nz + 1);
-  L.V.resize(corners + Index(nx) * ny * nz, 3);
-  auto corner = [&](int i, int j, int k) { return VIndex(i + (nx + 1) * (j + (ny + 1) * k)); };
-  auto centre = [&](int i, int j, int k) { return VIndex(corners + i + nx * (j + ny * k)); };
-  std::vector<std::array<VIndex, 2>> e;
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) {
-        L.V.row(corner(i, j, k)) << h * i, h * j, h * k;
-        if (i < nx) e.push_back({corner(i, j, k), corner(i + 1, j, k)});
-        if (j < ny) e.push_back({corner(i, j, k), corner(i, j + 1, k)});
-        if (k < nz) e.push_back({corner(i, j, k), corner(i, j, k + 1)});
-      }
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const VIndex c = centre(i, j, k);
-        L.V.row(c) << h * (i + 0.5), h * (j + 0.5), h * (k + 0.5);
-        for (int b = 0; b < 8; ++b) e.push_back({c, corner(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1))});
-        if (i + 1 < nx) e.push_back({c, centre(i + 1, j, k)});
-        if (j + 1 < ny) e.push_back({c, centre(i, j + 1, k)});
-        if (k + 1 < nz) e.push_back({c, centre(i, j, k + 1)});
-      }
-  L.E.resize(Index(e.size()), 2);
-  for (Index r = 0; r < L.E.rows(); ++r) L.E(r, 0) = e[r][0], L.E(r, 1) = e[r][1];
-  return L;
-}
-
 const Lattice& lattice() {
-  static const Lattice L = bcc_lattice(20, 20, 18, 0.0125);  // 8,379 corners + 7,200 centres = 15,579 vertices
+  static const Lattice L = [] {
+    discretize::VoxelSet box;
+    box.grid.h = 0.0125;
+    box.grid.dims = {20, 20, 18};
+    for (Index k = 0; k < 18; ++k)
+      for (Index j = 0; j < 20; ++j)
+        for (Index i = 0; i < 20; ++i) box.cells.push_back({i, j, k});
+    const auto bcc = discretize::build_lattice(box);  // 8,379 corners + 7,200 centres = 15,579 vertices
+    return Lattice{bcc.mesh.V, unique_edges(bcc.mesh.T)};
+  }();
   return L;
 }
 

@@ -1,7 +1,9 @@
 #include <doctest/doctest.h>
 
+#include <simsr/discretize/bcc_lattice.hpp>
 #include <simsr/io/npy.hpp>
 #include <simsr/io/obj.hpp>
+#include <simsr/mesh/generators.hpp>
 #include <simsr/neighbors/linear_assignment.hpp>
 #include <simsr/neighbors/upsampling_neighborhoods.hpp>
 
@@ -17,82 +19,16 @@ using namespace simsr::neighbors;
 
 namespace {
 
-/// Closed ellipsoid surface (semi-axes a, b, c) with exactly nv ≥ 8 vertices: two poles and
-/// latitude rings whose vertex counts follow sin θ, consecutive rings zipped in angular order.
-/// The same generator drives benchmarks/bench_assignment.cpp at 35,637 vertices.
-void ellipsoid_surface(Index nv, double a, double b, double c, Points<>& V, Tris& F) {
-  const double pi = std::numbers::pi;
-  const Index R = std::max<Index>(3, Index(std::lround(std::sqrt(pi * double(nv - 2) / 4))));
-  std::vector<Index> n(static_cast<std::size_t>(R - 1));
-  Index total = 0;
-  for (Index r = 1; r < R; ++r) total += n[r - 1] = std::max<Index>(3, std::lround(2.0 * R * std::sin(pi * r / R)));
-  for (Index r = 0; total != nv - 2; r = (r + 1) % (R - 1)) {  // fix the count from the equator outwards
-    const Index ring = (R - 1) / 2 + (r % 2 ? -(r + 1) / 2 : r / 2);
-    if (total < nv - 2) ++n[ring], ++total;
-    else if (n[ring] > 3) --n[ring], --total;
-  }
-  V.resize(nv, 3);
-  std::vector<std::vector<VIndex>> rings;
-  V.row(0) << 0, 0, c;
-  Index next = 1;
-  for (Index r = 1; r < R; ++r) {
-    const double th = pi * r / R;
-    std::vector<VIndex> ids;
-    for (Index i = 0; i < n[r - 1]; ++i) {
-      const double ph = 2 * pi * (i + 0.5 * (r % 2)) / n[r - 1];
-      V.row(next) << a * std::sin(th) * std::cos(ph), b * std::sin(th) * std::sin(ph), c * std::cos(th);
-      ids.push_back(static_cast<VIndex>(next++));
-    }
-    rings.push_back(std::move(ids));
-  }
-  V.row(next) << 0, 0, -c;
-  std::vector<std::array<VIndex, 3>> tris;
-  const auto fan = [&](VIndex pole, const std::vector<VIndex>& ring) {
-    for (std::size_t i = 0; i < ring.size(); ++i) tris.push_back({pole, ring[i], ring[(i + 1) % ring.size()]});
-  };
-  fan(0, rings.front());
-  for (std::size_t r = 0; r + 1 < rings.size(); ++r) {
-    const auto &A = rings[r], &B = rings[r + 1];
-    const double oa = 0.5 * double((r + 1) % 2), ob = 0.5 * double((r + 2) % 2);
-    std::size_t i = 0, j = 0;
-    while (i < A.size() || j < B.size()) {
-      const double na = (double(i + 1) + oa) / double(A.size()), nb = (double(j + 1) + ob) / double(B.size());
-      if (j == B.size() || (i < A.size() && na < nb)) {
-        tris.push_back({A[i % A.size()], B[j % B.size()], A[(i + 1) % A.size()]});
-        ++i;
-      } else {
-        tris.push_back({A[i % A.size()], B[j % B.size()], B[(j + 1) % B.size()]});
-        ++j;
-      }
-    }
-  }
-  fan(static_cast<VIndex>(nv - 1), rings.back());
-  F.resize(Index(tris.size()), 3);
-  for (Index f = 0; f < F.rows(); ++f) F.row(f) << tris[f][0], tris[f][1], tris[f][2];
+/// The library's ellipsoid surface (exactly nv vertices) as separate V, F.
+void ellipsoid(Index nv, double a, double b, double c, Points<>& V, Tris& F) {
+  auto m = ellipsoid_surface(nv, a, b, c);
+  V = std::move(m.V);
+  F = std::move(m.F);
 }
 
-/// Body-centred cubic lattice points strictly inside the ellipsoid, the `count` innermost kept.
+/// Exactly `count` BCC lattice nodes inside 0.97 × the ellipsoid, innermost kept.
 Points<> bcc_inside(Index count, double a, double b, double c) {
-  const auto inside = [&](double h) {
-    std::vector<std::pair<double, Vec3<>>> p;
-    const Index m = Index(std::ceil(std::max({a, b, c}) / h)) + 1;
-    for (int off = 0; off < 2; ++off)
-      for (Index i = -m; i <= m; ++i)
-        for (Index j = -m; j <= m; ++j)
-          for (Index k = -m; k <= m; ++k) {
-            const Vec3<> x = h * Vec3<>(i + 0.5 * off, j + 0.5 * off, k + 0.5 * off);
-            const double e = std::sqrt(std::pow(x[0] / a, 2) + std::pow(x[1] / b, 2) + std::pow(x[2] / c, 2));
-            if (e < 0.97) p.push_back({e, x});
-          }
-    return p;
-  };
-  double lo = 1e-3, hi = std::max({a, b, c});
-  for (int it = 0; it < 60; ++it) (Index(inside(0.5 * (lo + hi)).size()) >= count ? lo : hi) = 0.5 * (lo + hi);
-  auto p = inside(lo);
-  std::stable_sort(p.begin(), p.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-  Points<> P(count, 3);
-  for (Index i = 0; i < count; ++i) P.row(i) = p[i].second.transpose();
-  return P;
+  return discretize::bcc_points_inside(ellipsoid_surface(2000, 0.97 * a, 0.97 * b, 0.97 * c), count);
 }
 
 /// k nearest sources by running one Dijkstra per source (the reference), ties by source id.
@@ -141,7 +77,7 @@ TEST_CASE("ellipsoid fixture: closed surface with the requested vertex count") {
   Points<> V;
   Tris F;
   for (const Index nv : {8, 50, 641, 3001}) {
-    ellipsoid_surface(nv, 1.0, 0.8, 0.6, V, F);
+    ellipsoid(nv, 1.0, 0.8, 0.6, V, F);
     CHECK(V.rows() == nv);
     CHECK(F.rows() == 2 * nv - 4);                   // Euler: closed sphere
     CHECK(unique_edges(F).rows() == 3 * nv - 6);     // every edge in two triangles
@@ -154,7 +90,7 @@ TEST_CASE("k-label Dijkstra equals one Dijkstra per source, bit for bit, ties by
   std::mt19937 rng(1);
   Points<> V;
   Tris F;
-  SUBCASE("ellipsoid") { ellipsoid_surface(400, 1.0, 0.7, 0.5, V, F); }
+  SUBCASE("ellipsoid") { ellipsoid(400, 1.0, 0.7, 0.5, V, F); }
   SUBCASE("grid with exact ties") { grid(15, V, F); }
   SUBCASE("random heights") {
     grid(13, V, F);
@@ -203,7 +139,7 @@ TEST_CASE("geodesic_k_nearest_sources: errors") {
 TEST_CASE("upsampling_neighborhoods: lattice inside an ellipsoid; seq == omp; save/load round trip") {
   Points<> V;
   Tris F;
-  ellipsoid_surface(1500, 1.0, 0.8, 0.6, V, F);
+  ellipsoid(1500, 1.0, 0.8, 0.6, V, F);
   const Points<> L = bcc_inside(600, 1.0, 0.8, 0.6);
   UpsamplingOptions opt;
   opt.assignment.k = 4;
