@@ -1,0 +1,15 @@
+#pragma once
+/// \file
+/// Umbrella of interp/: LR volume displacements → HR surface displacements (SPEC §6), every
+/// method an `interp::Interpolator` (fit once on rest shapes, apply per frame).
+///  - Embedded: barycentric embedding of the HR surface in the LR tets (the paper's baseline);
+///  - IDW: inverse distance weights over the §3.2 neighbourhoods;
+///  - RBF: global Gaussian RBF (appendix A.2, Eq. 8–11), geodesic or Euclidean distances;
+///  - MLS: moving least squares (appendix A.3, Eq. 12–16), as written or 3-D linear.
+
+#include "concepts.hpp"
+#include "embedded.hpp"
+#include "idw.hpp"
+#include "mls.hpp"
+#include "problem.hpp"
+#include "rbf.hpp"
