@@ -1,0 +1,5 @@
+#pragma once
+/// \file
+/// Umbrella of the eval area: error statistics and the files that report them.
+#include "error_statistics.hpp"
+#include "report.hpp"

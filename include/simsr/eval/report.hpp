@@ -1,0 +1,137 @@
+#pragma once
+/// \file
+/// Files people open directly: frame-wise errors as CSV (Fig. 5), the statistics table as CSV,
+/// and a self-contained SVG line plot of per-frame errors (no plotting library needed).
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <locale>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../core/error.hpp"
+#include "error_statistics.hpp"
+
+namespace simsr::eval {
+
+/// One method's frame-wise series.
+struct Series {
+  std::string name;
+  std::vector<double> values;
+};
+
+namespace detail {
+inline void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw ParseError(path.string(), 0, "cannot open file for writing");
+  out << text;
+  if (!out) throw ParseError(path.string(), 0, "write failed");
+}
+inline std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+inline std::string xml_text(const std::string& s) {
+  std::string o;
+  for (char c : s) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
+  return o;
+}
+}  // namespace detail
+
+/// CSV with a `frame` column and one column per series (all series the same length).
+inline void write_frame_csv(const std::filesystem::path& path, const std::vector<Series>& series,
+                            const std::vector<long long>& frame_ids = {}) {
+  if (series.empty()) throw ArgumentError("write_frame_csv: no series");
+  const std::size_t n = series.front().values.size();
+  for (const auto& s : series)
+    if (s.values.size() != n) throw ShapeError("write_frame_csv: series " + s.name, {Index(n)}, {Index(s.values.size())});
+  if (!frame_ids.empty() && frame_ids.size() != n) throw ShapeError("write_frame_csv: frame ids", {Index(n)}, {Index(frame_ids.size())});
+  std::ostringstream o;
+  o.imbue(std::locale::classic());
+  o << std::setprecision(10) << "frame";
+  for (const auto& s : series) o << ',' << detail::csv_field(s.name);
+  o << '\n';
+  for (std::size_t f = 0; f < n; ++f) {
+    o << (frame_ids.empty() ? static_cast<long long>(f) : frame_ids[f]);
+    for (const auto& s : series) o << ',' << s.values[f];
+    o << '\n';
+  }
+  detail::write_file(path, o.str());
+}
+
+/// CSV of Table-1 statistics, one row per method: raw, relative to the diagonal, and normalized to
+/// the largest value across methods.
+inline void write_statistics_csv(const std::filesystem::path& path, const std::vector<std::string>& methods,
+                                 const std::vector<ErrorStatistics>& raw, double diagonal) {
+  if (methods.size() != raw.size()) throw ShapeError("write_statistics_csv: methods vs statistics", {Index(methods.size())}, {Index(raw.size())});
+  const auto norm = normalized_to_largest(raw);
+  std::ostringstream o;
+  o.imbue(std::locale::classic());
+  o << std::setprecision(10);
+  o << "method,count,mean,median,std,max,min,rel_mean,rel_median,rel_std,rel_max,rel_min,"
+       "norm_mean,norm_median,norm_std,norm_max,norm_min\n";
+  for (std::size_t i = 0; i < methods.size(); ++i) {
+    const auto& r = raw[i];
+    const auto rel = r.scaled(diagonal);
+    const auto& n = norm[i];
+    o << detail::csv_field(methods[i]) << ',' << r.count;
+    for (const auto* s : {&r, &rel, &n}) o << ',' << s->mean << ',' << s->median << ',' << s->std << ',' << s->max << ',' << s->min;
+    o << '\n';
+  }
+  detail::write_file(path, o.str());
+}
+
+/// A line plot of the series against the frame index as a standalone SVG (opens in any browser).
+inline void write_svg_plot(const std::filesystem::path& path, const std::vector<Series>& series, const std::string& title,
+                           const std::string& y_label) {
+  if (series.empty()) throw ArgumentError("write_svg_plot: no series");
+  const double W = 900, H = 480, left = 80, right = 200, top = 40, bottom = 50;
+  std::size_t n = 0;
+  double ymax = 0;
+  for (const auto& s : series) {
+    n = std::max(n, s.values.size());
+    for (double v : s.values)
+      if (std::isfinite(v)) ymax = std::max(ymax, v);
+  }
+  if (ymax <= 0) ymax = 1;
+  const double xs = (W - left - right) / double(std::max<std::size_t>(n - (n > 0), 1)), ys = (H - top - bottom) / ymax;
+  static const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+  std::ostringstream o;
+  o.imbue(std::locale::classic());
+  o << std::setprecision(6);
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" << detail::xml_text(title) << "</text>\n"
+    << "<line x1=\"" << left << "\" y1=\"" << H - bottom << "\" x2=\"" << W - right << "\" y2=\"" << H - bottom << "\" stroke=\"black\"/>\n"
+    << "<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left << "\" y2=\"" << H - bottom << "\" stroke=\"black\"/>\n";
+  for (int t = 0; t <= 4; ++t) {  // y ticks
+    const double v = ymax * t / 4, y = H - bottom - v * ys;
+    o << "<line x1=\"" << left - 4 << "\" y1=\"" << y << "\" x2=\"" << W - right << "\" y2=\"" << y << "\" stroke=\"#ddd\"/>"
+      << "<text x=\"" << left - 6 << "\" y=\"" << y + 4 << "\" text-anchor=\"end\">" << v << "</text>\n";
+  }
+  for (int t = 0; t <= 4 && n > 1; ++t) {  // x ticks
+    const double f = std::round(double(n - 1) * t / 4), x = left + f * xs;
+    o << "<text x=\"" << x << "\" y=\"" << H - bottom + 18 << "\" text-anchor=\"middle\">" << f << "</text>\n";
+  }
+  o << "<text x=\"" << (left + W - right) / 2 << "\" y=\"" << H - 10 << "\" text-anchor=\"middle\">frame</text>\n"
+    << "<text x=\"18\" y=\"" << (top + H - bottom) / 2 << "\" transform=\"rotate(-90 18 " << (top + H - bottom) / 2
+    << ")\" text-anchor=\"middle\">" << detail::xml_text(y_label) << "</text>\n";
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    const char* c = colors[i % 8];
+    o << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\" points=\"";
+    for (std::size_t f = 0; f < series[i].values.size(); ++f)
+      o << left + double(f) * xs << ',' << H - bottom - series[i].values[f] * ys << ' ';
+    o << "\"/>\n<rect x=\"" << W - right + 15 << "\" y=\"" << top + 20.0 * double(i) << "\" width=\"12\" height=\"12\" fill=\"" << c
+      << "\"/><text x=\"" << W - right + 32 << "\" y=\"" << top + 20.0 * double(i) + 11 << "\">" << detail::xml_text(series[i].name) << "</text>\n";
+  }
+  o << "</svg>\n";
+  detail::write_file(path, o.str());
+}
+
+}  // namespace simsr::eval
