@@ -36,7 +36,8 @@ struct TetLocatorOptions {
   double inside_tolerance = 1e-10;
   /// A tet is degenerate when |volume| ≤ tol·ℓ³ (ℓ its longest edge), as in ValidateOptions.
   double degenerate_tolerance = 1e-10;
-  /// Grid cell edge as a multiple of the mean tet bounding-box edge (> 0).
+  /// Grid cell edge as a multiple of the mean tet bounding-box edge (> 0). 1 lists each tet in
+  /// ~8 cells; on a 73k-tet lattice 0.75–1 is fastest (0.5 or 2 are 1.3–1.7× slower).
   double cell_scale = 1.0;
 };
 
@@ -56,8 +57,8 @@ struct NearestTet {
 /// tree descent; building is two linear passes (count, fill). For strongly graded meshes a BVH
 /// would adapt better; `cell_scale` trades memory against candidates per cell.
 ///
-/// Per tet the four corners, the inverse edge matrix and the bounding box are stored contiguously,
-/// so a candidate test is 9 multiply-adds without touching the mesh.
+/// Per tet the four corners and the inverse edge matrix are stored contiguously (a candidate test
+/// is 9 multiply-adds without touching the mesh), the bounding boxes in a separate compact array.
 template <class S = Scalar>
 class TetLocator {
  public:
@@ -119,7 +120,7 @@ class TetLocator {
     const Index c = cell_index(cell_of(p, 0), cell_of(p, 1), cell_of(p, 2));
     for (Index i = start_[std::size_t(c)]; i < start_[std::size_t(c) + 1]; ++i) {
       const Index t = items_[std::size_t(i)];
-      if (contains(t, p, w)) return t;
+      if (in_box(t, p) && contains(t, p, w)) return t;
     }
     return -1;
   }
@@ -141,8 +142,8 @@ class TetLocator {
       for (Index e = start_[std::size_t(cell)]; e < start_[std::size_t(cell) + 1]; ++e) {
         const Index t = items_[std::size_t(e)];
         if (t == best_t) continue;
-        const S* r = rec(t);
-        const S bd = detail::point_box_sqdist<S>(p, Eigen::Map<const Vec3<S>>(r + kBox), Eigen::Map<const Vec3<S>>(r + kBox + 3));
+        const S* bx = box(t);
+        const S bd = detail::point_box_sqdist<S>(p, Eigen::Map<const Vec3<S>>(bx), Eigen::Map<const Vec3<S>>(bx + 3));
         if (bd > best) continue;
         const S d2 = detail::point_tet_sqdist(p, corners(t), barycentric(t, p));
         if (d2 < best || (d2 == best && t < best_t)) {
@@ -191,9 +192,16 @@ class TetLocator {
   }
 
  private:
-  static constexpr int kInv = 12, kBox = 21, kStride = 27;  // corners 0..11, inverse 12..20, box 21..26
+  static constexpr int kInv = 12, kStride = 21;  // corners 0..11, inverse edge matrix 12..20
 
   const S* rec(Index t) const { return data_.data() + std::size_t(t) * kStride; }
+  /// Padded bounding box of tet t: lo xyz, hi xyz (kept apart from the records: the cheap reject
+  /// of most candidates touches 48 bytes instead of a 168-byte record).
+  const S* box(Index t) const { return boxes_.data() + std::size_t(t) * 6; }
+  bool in_box(Index t, const Vec3<S>& p) const {
+    const S* b = box(t);
+    return p[0] >= b[0] && p[1] >= b[1] && p[2] >= b[2] && p[0] <= b[3] && p[1] <= b[4] && p[2] <= b[5];
+  }
   std::array<Vec3<S>, 4> corners(Index t) const {
     const S* r = rec(t);
     return {Vec3<S>(r[0], r[1], r[2]), Vec3<S>(r[3], r[4], r[5]), Vec3<S>(r[6], r[7], r[8]), Vec3<S>(r[9], r[10], r[11])};
@@ -225,6 +233,7 @@ class TetLocator {
   void build(const TetMesh<S>& mesh) {
     num_tets_ = mesh.T.rows();
     data_.assign(std::size_t(num_tets_) * kStride, S(0));
+    boxes_.assign(std::size_t(num_tets_) * 6, S(0));
     lo_.setConstant(std::numeric_limits<S>::infinity());
     hi_.setConstant(-std::numeric_limits<S>::infinity());
     Vec3<S> mean_extent = Vec3<S>::Zero();
@@ -251,9 +260,10 @@ class TetLocator {
       const S pad = tol * (bhi - blo).norm() * S(2) + std::numeric_limits<S>::epsilon() * bhi.cwiseAbs().maxCoeff();
       blo.array() -= pad;
       bhi.array() += pad;
+      S* bx = boxes_.data() + std::size_t(t) * 6;
       for (int d = 0; d < 3; ++d) {
-        r[kBox + d] = blo[d];
-        r[kBox + 3 + d] = bhi[d];
+        bx[d] = blo[d];
+        bx[3 + d] = bhi[d];
       }
       lo_ = lo_.cwiseMin(blo);
       hi_ = hi_.cwiseMax(bhi);
@@ -274,8 +284,8 @@ class TetLocator {
     const std::size_t cells = std::size_t(n_[0] * n_[1] * n_[2]);
     start_.assign(cells + 1, 0);
     auto for_cells = [&](Index t, auto&& f) {
-      const S* r = rec(t);
-      const Vec3<S> blo(r[kBox], r[kBox + 1], r[kBox + 2]), bhi(r[kBox + 3], r[kBox + 4], r[kBox + 5]);
+      const S* bx = box(t);
+      const Vec3<S> blo(bx[0], bx[1], bx[2]), bhi(bx[3], bx[4], bx[5]);
       const Index i0 = cell_of(blo, 0), i1 = cell_of(bhi, 0), j0 = cell_of(blo, 1), j1 = cell_of(bhi, 1),
                   k0 = cell_of(blo, 2), k1 = cell_of(bhi, 2);
       for (Index k = k0; k <= k1; ++k)
@@ -293,6 +303,7 @@ class TetLocator {
   TetLocatorOptions options_{};
   Index num_tets_ = 0;
   std::vector<S> data_;
+  std::vector<S> boxes_;
   Vec3<S> lo_ = Vec3<S>::Zero(), hi_ = Vec3<S>::Zero();
   S h_ = S(1);
   std::array<Index, 3> n_{1, 1, 1};
