@@ -3,11 +3,13 @@
 //   simsr convert IN OUT       convert between mesh formats by extension
 //   simsr knn ...              Euclidean kNN (KD-tree), .npy in, .npz out
 //   simsr neighbors ...        §3.2 upsampling neighbourhoods + LR geodesic graph
+//   simsr upsample ...         LR frames → HR frames with a baseline interpolator
 // Errors: a message on stderr naming the file, and an exit code in 1..125 (errors.hpp).
 #include "cmd_convert.hpp"
 #include "cmd_info.hpp"
 #include "cmd_knn.hpp"
 #include "cmd_neighbors.hpp"
+#include "cmd_upsample.hpp"
 #include "errors.hpp"
 
 #include <CLI/CLI.hpp>
@@ -20,6 +22,7 @@ int main(int argc, char** argv) {
   simsr::cli::add_convert(app, action);
   simsr::cli::add_knn(app, action);
   simsr::cli::add_neighbors(app, action);
+  simsr::cli::add_upsample(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
