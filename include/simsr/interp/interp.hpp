@@ -13,3 +13,4 @@
 #include "mls.hpp"
 #include "problem.hpp"
 #include "rbf.hpp"
+#include "ridge.hpp"
