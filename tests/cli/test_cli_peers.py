@@ -173,6 +173,20 @@ if os.path.exists(bunny):
     check(np.array_equal(z["indices"][mapped, 0], np.arange(1747)) and np.all(z["distances"][mapped, 0] == 0),
           "each mapped HR vertex has its own LR vertex first at distance 0")
 
+    # baselines: ridge (the data-driven linear baseline) must beat Embedded on held-out bunny frames
+    bdir = os.path.join(WORK, "baselines")
+    p = simsr("baselines", "--lr-rest", bunny, "--hr-rest", os.path.join(DATA, "bunny", "hrestshape.obj"), "--frames",
+              os.path.join(DATA, "bunny", "train_frames.npz"), "--methods", "embedded", "ridge", "--holdout-every", "8",
+              "--out-dir", bdir)
+    res = json.loads(p.stdout) if p.returncode == 0 else {"methods": {}}
+    check(res.get("test_frames") == 32 and res.get("train_frames") == 224, f"baselines split: {p.stdout}")
+    m = res["methods"]
+    check("ridge" in m and "embedded" in m and m["ridge"]["relative_mean"] < m["embedded"]["relative_mean"], f"ridge vs embedded: {m}")
+    for f in ("statistics.csv", "frame_errors.csv", "frame_errors.svg", "heatmaps.pvd"):
+        check(os.path.exists(os.path.join(bdir, f)), f"baselines did not write {f}")
+    hm = meshio.read(os.path.join(bdir, "heatmaps", "heatmaps_000000.vtu"))
+    check(set(hm.point_data) == {"error_embedded", "error_ridge"} and len(hm.points) == 2503, "heatmap arrays")
+
 # --- 6. Errors: message names the file, exit code by error class.
 bad = os.path.join(WORK, "bad.msh")
 with open(bad, "w") as f:

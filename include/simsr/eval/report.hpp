@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <locale>
 #include <sstream>
 #include <string>
@@ -87,20 +88,29 @@ inline void write_statistics_csv(const std::filesystem::path& path, const std::v
   detail::write_file(path, o.str());
 }
 
-/// A line plot of the series against the frame index as a standalone SVG (opens in any browser).
+/// A line plot of the series against their index as a standalone SVG (opens in any browser).
+/// `log_y` plots log10 of the values (non-positive values are drawn at the bottom), for methods
+/// whose errors differ by orders of magnitude.
 inline void write_svg_plot(const std::filesystem::path& path, const std::vector<Series>& series, const std::string& title,
-                           const std::string& y_label) {
+                           const std::string& y_label, bool log_y = false, const std::string& x_label = "frame") {
   if (series.empty()) throw ArgumentError("write_svg_plot: no series");
-  const double W = 900, H = 480, left = 80, right = 200, top = 40, bottom = 50;
+  const double W = 900, H = 480, left = 90, right = 200, top = 40, bottom = 50;
   std::size_t n = 0;
-  double ymax = 0;
+  double ymax = 0, ymin_pos = std::numeric_limits<double>::infinity();
   for (const auto& s : series) {
     n = std::max(n, s.values.size());
     for (double v : s.values)
-      if (std::isfinite(v)) ymax = std::max(ymax, v);
+      if (std::isfinite(v)) ymax = std::max(ymax, v), ymin_pos = v > 0 ? std::min(ymin_pos, v) : ymin_pos;
   }
   if (ymax <= 0) ymax = 1;
-  const double xs = (W - left - right) / double(std::max<std::size_t>(n - (n > 0), 1)), ys = (H - top - bottom) / ymax;
+  // Vertical axis: [0, ymax] linear, or whole decades [10^lo, 10^hi] on a log scale.
+  const double lo = log_y ? std::floor(std::log10(std::isfinite(ymin_pos) ? ymin_pos : ymax)) : 0.0;
+  const double hi = log_y ? std::max(lo + 1, std::ceil(std::log10(ymax))) : ymax;
+  auto ypos = [&](double v) {
+    const double t = log_y ? (v > 0 ? (std::log10(v) - lo) / (hi - lo) : 0.0) : v / hi;
+    return H - bottom - std::clamp(t, 0.0, 1.0) * (H - top - bottom);
+  };
+  const double xs = (W - left - right) / double(std::max<std::size_t>(n - (n > 0), 1));
   static const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"};
   std::ostringstream o;
   o.imbue(std::locale::classic());
@@ -110,23 +120,25 @@ inline void write_svg_plot(const std::filesystem::path& path, const std::vector<
     << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" << detail::xml_text(title) << "</text>\n"
     << "<line x1=\"" << left << "\" y1=\"" << H - bottom << "\" x2=\"" << W - right << "\" y2=\"" << H - bottom << "\" stroke=\"black\"/>\n"
     << "<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left << "\" y2=\"" << H - bottom << "\" stroke=\"black\"/>\n";
-  for (int t = 0; t <= 4; ++t) {  // y ticks
-    const double v = ymax * t / 4, y = H - bottom - v * ys;
-    o << "<line x1=\"" << left - 4 << "\" y1=\"" << y << "\" x2=\"" << W - right << "\" y2=\"" << y << "\" stroke=\"#ddd\"/>"
+  const int yticks = log_y ? int(hi - lo) : 4;
+  for (int t = 0; t <= yticks; ++t) {  // y ticks
+    const double v = log_y ? std::pow(10.0, lo + t) : hi * t / 4, y = ypos(v);
+    o << std::setprecision(3) << "<line x1=\"" << left - 4 << "\" y1=\"" << y << "\" x2=\"" << W - right << "\" y2=\"" << y << "\" stroke=\"#ddd\"/>"
       << "<text x=\"" << left - 6 << "\" y=\"" << y + 4 << "\" text-anchor=\"end\">" << v << "</text>\n";
   }
   for (int t = 0; t <= 4 && n > 1; ++t) {  // x ticks
     const double f = std::round(double(n - 1) * t / 4), x = left + f * xs;
     o << "<text x=\"" << x << "\" y=\"" << H - bottom + 18 << "\" text-anchor=\"middle\">" << f << "</text>\n";
   }
-  o << "<text x=\"" << (left + W - right) / 2 << "\" y=\"" << H - 10 << "\" text-anchor=\"middle\">frame</text>\n"
-    << "<text x=\"18\" y=\"" << (top + H - bottom) / 2 << "\" transform=\"rotate(-90 18 " << (top + H - bottom) / 2
+  o << std::setprecision(6) << "<text x=\"" << (left + W - right) / 2 << "\" y=\"" << H - 10 << "\" text-anchor=\"middle\">"
+    << detail::xml_text(x_label) << "</text>\n"
+    << "<text x=\"16\" y=\"" << (top + H - bottom) / 2 << "\" transform=\"rotate(-90 16 " << (top + H - bottom) / 2
     << ")\" text-anchor=\"middle\">" << detail::xml_text(y_label) << "</text>\n";
   for (std::size_t i = 0; i < series.size(); ++i) {
     const char* c = colors[i % 8];
     o << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\" points=\"";
     for (std::size_t f = 0; f < series[i].values.size(); ++f)
-      o << left + double(f) * xs << ',' << H - bottom - series[i].values[f] * ys << ' ';
+      o << left + double(f) * xs << ',' << ypos(series[i].values[f]) << ' ';
     o << "\"/>\n<rect x=\"" << W - right + 15 << "\" y=\"" << top + 20.0 * double(i) << "\" width=\"12\" height=\"12\" fill=\"" << c
       << "\"/><text x=\"" << W - right + 32 << "\" y=\"" << top + 20.0 * double(i) + 11 << "\">" << detail::xml_text(series[i].name) << "</text>\n";
   }
