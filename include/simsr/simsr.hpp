@@ -1,6 +1,13 @@
 #pragma once
 /// \file
-/// Umbrella header: every area of simsr. Include single areas (simsr/core/core.hpp, ...) to keep
-/// compile times short.
+/// Umbrella header: every area of simsr, in the order data flows through them
+/// (core → mesh/io → discretize → neighbors → interp → eval). Include single areas
+/// (simsr/mesh/mesh.hpp, simsr/interp/interp.hpp, ...) to keep compile times short.
 
 #include "core/core.hpp"
+#include "discretize/discretize.hpp"
+#include "eval/eval.hpp"
+#include "interp/interp.hpp"
+#include "io/io.hpp"
+#include "mesh/mesh.hpp"
+#include "neighbors/neighbors.hpp"
