@@ -93,6 +93,54 @@ UpsamplingProblem<> make_problem(TetMesh<> lr, Points<> H, Index k) {
 
 double max_abs(const Points<>& a, const Points<>& b) { return (a - b).cwiseAbs().maxCoeff(); }
 
+/// Closed torus (major radius R, minor r) around `centre`, nu×nv vertices, 2·nu·nv triangles.
+TriMesh<> torus(int nu, int nv, double R, double r, const Eigen::RowVector3d& centre) {
+  TriMesh<> t;
+  t.V.resize(nu * nv, 3);
+  t.F.resize(2 * nu * nv, 3);
+  const double tau = 2 * std::acos(-1.0);
+  const auto id = [&](int a, int b) { return VIndex((a % nu) * nv + (b % nv)); };
+  for (int a = 0; a < nu; ++a)
+    for (int b = 0; b < nv; ++b) {
+      const double u = tau * a / nu, v = tau * b / nv;
+      t.V.row(id(a, b)) = centre + Eigen::RowVector3d((R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u),
+                                                      r * std::sin(v));
+      t.F.row(2 * id(a, b)) << id(a, b), id(a + 1, b), id(a + 1, b + 1);
+      t.F.row(2 * id(a, b) + 1) << id(a, b), id(a + 1, b + 1), id(a, b + 1);
+    }
+  return t;
+}
+
+/// LR lattice (5×5×3, spacing 1) and an HR torus around it, with the §3.2 neighbourhoods (mapping
+/// by assignment, k = 20): what RbfDistance::geodesic is fitted on.
+UpsamplingProblem<> surface_problem(std::mt19937& rng, int nu = 30, int nv = 14) {
+  UpsamplingProblem<> p;
+  p.lr = lattice_tets(5, 5, 3, 1.0, 0.2, rng);
+  p.hr = torus(nu, nv, 2.0, 1.2, Eigen::RowVector3d(2, 2, 1));
+  p.ensure_neighborhoods(20);
+  return p;
+}
+
+/// All-pairs shortest paths over the HR triangles' edges (Floyd–Warshall): the truth for the
+/// geodesic (surface) distances.
+Eigen::MatrixXd surface_floyd_warshall(const TriMesh<>& t) {
+  const Index n = t.V.rows();
+  Eigen::MatrixXd D = Eigen::MatrixXd::Constant(n, n, std::numeric_limits<double>::infinity());
+  for (Index i = 0; i < n; ++i) D(i, i) = 0;
+  for (Index f = 0; f < t.F.rows(); ++f)
+    for (int a = 0; a < 3; ++a) {
+      const Index u = t.F(f, a), v = t.F(f, (a + 1) % 3);
+      D(u, v) = D(v, u) = (t.V.row(u) - t.V.row(v)).norm();
+    }
+  for (Index k = 0; k < n; ++k)
+    for (Index j = 0; j < n; ++j) {
+      const double djk = D(j, k);
+      if (djk == std::numeric_limits<double>::infinity()) continue;
+      for (Index i = 0; i < n; ++i) D(i, j) = std::min(D(i, j), D(i, k) + djk);  // column-major inner loop
+    }
+  return D;
+}
+
 }  // namespace
 
 TEST_CASE("RBF (Euclidean) matches scipy.interpolate.RBFInterpolator to 1e-8") {
@@ -154,15 +202,18 @@ TEST_CASE("RBF reproduces constants (degree 0) and linear fields (degree 1), and
   for (const Index i : {0, 7, 33}) p.hr.V.row(i) = p.lr.V.row(i);
   const Index n = p.num_lr(), m = p.num_hr();
   Points<> dX(n, 3), dx(m, 3);
-  for (const auto dist : {RbfDistance::geodesic, RbfDistance::euclidean}) {
+  auto ps = surface_problem(rng);
+  for (const auto dist : {RbfDistance::geodesic, RbfDistance::lr_mesh_geodesic, RbfDistance::euclidean}) {
+    auto& q = dist == RbfDistance::geodesic ? ps : p;
     RBFOptions o;
     o.distance = dist;
     o.degree = 0;
     RBF<> rbf(o);
-    rbf.fit(p);
-    dX.rowwise() = Eigen::RowVector3d(0.4, -2.0, 1.5);
-    rbf.apply(dX, dx);
-    for (Index j = 0; j < m; ++j) CHECK((dx.row(j) - Eigen::RowVector3d(0.4, -2.0, 1.5)).norm() < 1e-9);
+    rbf.fit(q);
+    Points<> cX(q.num_lr(), 3), cx(q.num_hr(), 3);
+    cX.rowwise() = Eigen::RowVector3d(0.4, -2.0, 1.5);
+    rbf.apply(cX, cx);
+    CHECK(max_abs(cx.rowwise() - Eigen::RowVector3d(0.4, -2.0, 1.5), Points<>::Zero(q.num_hr(), 3)) < 1e-9);
   }
   Eigen::Matrix3d G;
   G << 0.2, -0.1, 0.4, 0.0, 0.3, -0.2, 0.5, 0.1, 0.1;
@@ -192,7 +243,7 @@ TEST_CASE("RBF reproduces constants (degree 0) and linear fields (degree 1), and
   }
 }
 
-TEST_CASE("RBF geodesic equals the direct solve with Floyd-Warshall distances, on every path") {
+TEST_CASE("RBF lr_mesh_geodesic equals the direct solve with Floyd-Warshall LR distances, on every path") {
   std::mt19937 rng(23);
   auto p = make_problem(lattice_tets(5, 4, 4, 1.0, 0.3, rng), random_points(70, 0.2, 3.2, rng), 20);
   const Index n = p.num_lr(), m = p.num_hr(), k = 20;
@@ -214,6 +265,7 @@ TEST_CASE("RBF geodesic equals the direct solve with Floyd-Warshall distances, o
     const Points<> ref = Phi_hl * W;
     Points<> dx(m, 3);
     RBFOptions o;
+    o.distance = RbfDistance::lr_mesh_geodesic;
     o.sigma = sigma;
     RBF<> dense(o);  // precomputed M×N operator
     dense.fit(p);
@@ -237,12 +289,150 @@ TEST_CASE("RBF geodesic equals the direct solve with Floyd-Warshall distances, o
   }
 }
 
+TEST_CASE("RBF geodesic: one surface metric - the dense solve with Floyd-Warshall surface distances, exact at mapped vertices") {
+  std::mt19937 rng(25);
+  auto p = surface_problem(rng);
+  const Index n = p.num_lr(), m = p.num_hr();
+  const auto& map = p.neighborhoods->lr_to_hr;
+  const Eigen::MatrixXd D = surface_floyd_warshall(p.hr);
+  // default σ: the mean distance from each mapped vertex to the nearest other one
+  double spacing = 0;
+  for (Index i = 0; i < n; ++i) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (Index k = 0; k < n; ++k)
+      if (k != i) nearest = std::min(nearest, D(map[i], map[k]));
+    spacing += nearest / double(n);
+  }
+  RBF<> def;
+  def.fit(p);
+  CHECK(def.info().sigma == doctest::Approx(spacing).epsilon(1e-12));
+  const double truncation = 1e-12;
+  for (const double sigma : {spacing, 1.3 * spacing}) {
+    const double radius = sigma * std::sqrt(std::log(1 / truncation));
+    const auto phi = [&](double d) { return d <= radius ? std::exp(-d * d / (sigma * sigma)) : 0.0; };
+    for (const int degree : {-1, 0, 1}) {
+      // reference: Eq. 10–11 with surface distances between mapped positions, truncated alike,
+      // the tail's monomials at the mapped positions
+      const Index q = degree < 0 ? 0 : degree == 0 ? 1 : 4;
+      Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n + q, n + q), E = Eigen::MatrixXd::Zero(m, n + q);
+      const auto mono = [&](Index v) {
+        Eigen::RowVectorXd r(q);
+        if (q > 0) r(0) = 1;
+        if (q > 1) r.tail(3) = p.hr.V.row(v);
+        return r;
+      };
+      for (Index i = 0; i < n; ++i) {
+        for (Index k = 0; k < n; ++k) K(i, k) = phi(D(map[i], map[k]));
+        K.block(i, n, 1, q) = mono(map[i]);
+        K.block(n, i, q, 1) = mono(map[i]).transpose();
+      }
+      for (Index j = 0; j < m; ++j) {
+        for (Index k = 0; k < n; ++k) E(j, k) = phi(D(j, map[k]));
+        E.block(j, n, 1, q) = mono(j);
+      }
+      const auto lu = K.fullPivLu();
+      const Points<> dX = random_points(n, -1, 1, rng);
+      Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n + q, 3);
+      rhs.topRows(n) = dX;
+      const Points<> ref = E * lu.solve(rhs);
+      for (const int path : {0, 1, 2}) {
+        RBFOptions o;
+        o.sigma = sigma;
+        o.degree = degree;
+        o.truncation = truncation;
+        if (path == 1) o.max_operator_bytes = 0;
+        if (path == 2) o.solver = RbfSolver::sparse;
+        RBF<> rbf(o);
+        rbf.fit(exec::omp, p);
+        CHECK(rbf.info().cutoff_radius == doctest::Approx(radius));
+        Points<> dx(m, 3);
+        rbf.apply(exec::omp, dX, dx);
+        INFO("sigma ", sigma, ", degree ", degree, ", path ", path, ", rcond ", rbf.info().rcond);
+        CHECK(max_abs(dx, ref) < 1e-8 * (1 + ref.cwiseAbs().maxCoeff()));
+        double at_centres = 0;
+        for (Index i = 0; i < n; ++i) at_centres = std::max(at_centres, (dx.row(map[i]) - dX.row(i)).norm());
+        CHECK(at_centres < 1e-9);
+      }
+    }
+  }
+  // the inconsistent metric does not reproduce the centres at their mapped vertices
+  RBFOptions o;
+  o.distance = RbfDistance::lr_mesh_geodesic;
+  RBF<> lr_mesh(o);
+  lr_mesh.fit(p);
+  const Points<> dX = random_points(n, -1, 1, rng);
+  Points<> dx(m, 3);
+  lr_mesh.apply(dX, dx);
+  double at_centres = 0;
+  for (Index i = 0; i < n; ++i) at_centres = std::max(at_centres, (dx.row(map[i]) - dX.row(i)).norm());
+  CHECK(at_centres > 0.1);
+}
+
+TEST_CASE("RBF surface distances are the 20-neighbourhood distances bit for bit, under seq and omp") {
+  std::mt19937 rng(26);
+  auto p = surface_problem(rng);
+  const auto& nb = *p.neighborhoods;
+  const auto g = neighbors::detail::surface_edge_graph(p.hr.V, p.hr.F);
+  const std::span<const VIndex> map(nb.lr_to_hr.data(), std::size_t(nb.lr_to_hr.size()));
+  const double radius = 1.5;  // a limit that cuts rows short
+  std::vector<interp::detail::DistanceRow> seq_rows(std::size_t(p.num_lr())), omp_rows(seq_rows.size());
+  interp::detail::surface_rows(exec::seq, g, map, radius, [&](Index s, const interp::detail::DistanceRow& r) { seq_rows[std::size_t(s)] = r; });
+  interp::detail::surface_rows(exec::omp, g, map, radius, [&](Index s, const interp::detail::DistanceRow& r) { omp_rows[std::size_t(s)] = r; });
+  CHECK(seq_rows == omp_rows);
+  Index found = 0, inside = 0;
+  for (Index j = 0; j < p.num_hr(); ++j)
+    for (Index c = 0; c < nb.k(); ++c) {
+      if (nb.distances(j, c) > radius) continue;
+      ++inside;
+      const auto& row = seq_rows[std::size_t(nb.indices(j, c))];
+      const auto it = std::lower_bound(row.begin(), row.end(), std::pair<VIndex, double>(VIndex(j), -1.0));
+      found += it != row.end() && it->first == j && it->second == nb.distances(j, c);
+    }
+  CHECK(inside > 0);
+  CHECK(found == inside);
+  // and nothing beyond the radius
+  for (const auto& row : seq_rows)
+    for (const auto& e : row) CHECK_UNARY(e.second <= radius);
+}
+
 TEST_CASE("RBF: singular systems, shapes, options; seq and omp give identical bits") {
   std::mt19937 rng(24);
   auto p = make_problem(lattice_tets(5, 5, 5, 1.0, 0.25, rng), random_points(300, 0.0, 4.0, rng), 20);
-  Points<> dX = random_points(p.num_lr(), -1, 1, rng), a(p.num_hr(), 3), b(p.num_hr(), 3);
+  auto ps = surface_problem(rng);
+  Points<> dX = random_points(ps.num_lr(), -1, 1, rng), a(ps.num_hr(), 3), b(ps.num_hr(), 3);
   for (const auto solver : {RbfSolver::dense, RbfSolver::sparse}) {
     RBFOptions o;
+    o.solver = solver;
+    o.degree = 1;
+    RBF<> s(o), t(o);
+    s.fit(exec::seq, ps);
+    t.fit(exec::omp, ps);
+    s.apply(exec::seq, dX, a);
+    t.apply(exec::omp, dX, b);
+    CHECK((a.array() == b.array()).all());
+    s.apply(exec::omp, dX, b);
+    CHECK((a.array() == b.array()).all());
+  }
+  // geodesic mode: what it needs, as typed errors
+  {
+    auto no_map = ps;
+    no_map.neighborhoods->lr_to_hr.resize(0);
+    CHECK_THROWS_WITH_AS(RBF<>().fit(no_map), doctest::Contains("lr_to_hr"), ArgumentError);
+    auto two = ps;
+    two.neighborhoods->lr_to_hr[3] = two.neighborhoods->lr_to_hr[4];
+    CHECK_THROWS_WITH_AS(RBF<>().fit(two), doctest::Contains("one-to-one"), ArgumentError);
+    auto flat = ps;
+    flat.hr.F.resize(0, 3);
+    CHECK_THROWS_WITH_AS(RBF<>().fit(flat), doctest::Contains("no triangles"), ArgumentError);
+    auto none = ps;
+    none.neighborhoods.reset();
+    CHECK_THROWS_AS(RBF<>().fit(none), ArgumentError);
+  }
+  dX = random_points(p.num_lr(), -1, 1, rng);
+  a.resize(p.num_hr(), 3), b.resize(p.num_hr(), 3);
+  for (const auto solver : {RbfSolver::dense, RbfSolver::sparse}) {
+    RBFOptions o;
+    o.distance = RbfDistance::lr_mesh_geodesic;
     o.solver = solver;
     o.degree = 1;
     RBF<> s(o), t(o);
@@ -255,8 +445,9 @@ TEST_CASE("RBF: singular systems, shapes, options; seq and omp give identical bi
     CHECK((a.array() == b.array()).all());
   }
   RBF<> r;
-  r.fit(p);
-  Points<> wrong(p.num_lr() + 1, 3);
+  r.fit(ps);
+  Points<> wrong(ps.num_lr() + 1, 3);
+  a.resize(ps.num_hr(), 3);
   CHECK_THROWS_AS(r.apply(wrong, a), ShapeError);
   CHECK_THROWS_AS(RBF<>(RBFOptions{.degree = 2}).fit(p), ArgumentError);
   // a duplicated LR vertex makes two rows of Φ_LL equal (Euclidean: the duplicate is at distance 0)
@@ -289,6 +480,11 @@ bool load_bunny(Bunny& b, std::vector<Index> frames) {
   neighbors::UpsamplingNeighborhoods nb;
   nb.indices = io::read_npy(dir / "geo_dist_surf2tet_idx.npy").to_matrix<VIndex>().leftCols(20);
   nb.distances = io::read_npy(dir / "geo_dist_surf2tet.npy").to_matrix<double>().leftCols(20);
+  // the authors' LR→HR mapping: the HR vertex at distance 0 of each LR vertex
+  nb.lr_to_hr = IndexVector::Constant(b.problem.num_lr(), -1);
+  for (Index j = 0; j < nb.indices.rows(); ++j)
+    if (nb.distances(j, 0) == 0.0) nb.lr_to_hr[nb.indices(j, 0)] = VIndex(j);
+  if ((nb.lr_to_hr.array() < 0).any()) return false;
   b.problem.neighborhoods = std::move(nb);
   io::NpzReader z(dir / "train_frames.npz");
   const auto lo = z.read("lowres").to_vector<double>(), hi = z.read("highres").to_vector<double>();
@@ -306,35 +502,45 @@ bool load_bunny(Bunny& b, std::vector<Index> frames) {
 
 }  // namespace
 
-TEST_CASE("RBF on the bunny: Euclidean beats the rest shape; the paper's geodesic form is reported") {
+/// lr_mesh_geodesic on the bunny (mean error 0.15 vs 0.0049 at rest) is left out for time (a dense
+/// 1747² LU); its inconsistency is checked on the torus above.
+TEST_CASE("RBF on the bunny: geodesic (one surface metric) and Euclidean beat the rest shape") {
   Bunny b;
   if (!load_bunny(b, {10, 100, 200, 250})) {
     MESSAGE("bunny data not found: skipped");
     return;
   }
-  for (const auto dist : {RbfDistance::euclidean, RbfDistance::geodesic})
-    for (const int degree : {-1, 0}) {
-      RBFOptions o;
-      o.distance = dist;
-      o.degree = degree;
-      RBF<> rbf(o);
-      rbf.fit(exec::omp, b.problem);
-      Points<> dx(b.problem.num_hr(), 3);
-      double mean = 0, worst = 0, rest = 0;
-      for (std::size_t f = 0; f < b.lr_frames.size(); ++f) {
-        rbf.apply(exec::omp, b.lr_frames[f], dx);
-        const Eigen::VectorXd e = (dx - b.hr_frames[f]).rowwise().norm();
-        mean += e.mean() / double(b.lr_frames.size());
-        worst = std::max(worst, e.maxCoeff());
-        rest += b.hr_frames[f].rowwise().norm().mean() / double(b.lr_frames.size());
-        CHECK(e.allFinite());
-        // Euclidean: Φ_HL and Φ_LL measure alike, so the interpolant must beat "HR stays at rest".
-        // Geodesic (A.2 as written) mixes LR-edge paths (Φ_LL) with HR-surface paths (Φ_HL, the
-        // §3.2 neighbourhoods): no such guarantee, and on the bunny it does not.
-        if (dist == RbfDistance::euclidean) CHECK(e.mean() < b.hr_frames[f].rowwise().norm().mean());
-      }
-      MESSAGE("bunny RBF ", std::string(dist == RbfDistance::geodesic ? "geodesic" : "euclidean"), " degree ", degree,
-              ": mean error ", mean, ", max ", worst, " (rest shape: mean ", rest, "), sigma ", rbf.info().sigma, ", rcond ",
-              rbf.info().rcond);
+  const auto& map = b.problem.neighborhoods->lr_to_hr;
+  const std::pair<RbfDistance, int> cases[] = {{RbfDistance::geodesic, -1}, {RbfDistance::geodesic, 0},
+                                               {RbfDistance::euclidean, -1}};
+  for (const auto& [dist, degree] : cases) {
+    RBFOptions o;
+    o.distance = dist;
+    o.degree = degree;
+    o.max_operator_bytes = 0;  // LU solves per frame: a quicker fit for four frames
+    // geodesic Φ_LL has ~30 entries a row within the truncation radius: the sparse LDLᵀ is quick
+    // (the dense path agrees, see the Floyd-Warshall case); Euclidean and LR-mesh rows are dense
+    if (dist == RbfDistance::geodesic) o.solver = RbfSolver::sparse;
+    RBF<> rbf(o);
+    rbf.fit(exec::omp, b.problem);
+    Points<> dx(b.problem.num_hr(), 3);
+    double mean = 0, worst = 0, rest = 0, at_centres = 0;
+    for (std::size_t f = 0; f < b.lr_frames.size(); ++f) {
+      rbf.apply(exec::omp, b.lr_frames[f], dx);
+      const Eigen::VectorXd e = (dx - b.hr_frames[f]).rowwise().norm();
+      const double rest_f = b.hr_frames[f].rowwise().norm().mean();
+      mean += e.mean() / double(b.lr_frames.size());
+      worst = std::max(worst, e.maxCoeff());
+      rest += rest_f / double(b.lr_frames.size());
+      CHECK(e.allFinite());
+      for (Index i = 0; i < b.problem.num_lr(); ++i)
+        at_centres = std::max(at_centres, (dx.row(map[i]) - b.lr_frames[f].row(i)).norm());
+      // one metric for Φ_LL and Φ_HL: the interpolant beats "HR stays at rest" in every frame
+      CHECK(e.mean() < 0.6 * rest_f);
     }
+    const std::string name = dist == RbfDistance::geodesic ? "geodesic" : "euclidean";
+    MESSAGE("bunny RBF ", name, " degree ", degree, ": mean error ", mean, ", max ", worst, " (rest shape: mean ", rest,
+            "), sigma ", rbf.info().sigma, ", rcond ", rbf.info().rcond, ", max |dx - dX| at mapped vertices ", at_centres);
+    if (dist == RbfDistance::geodesic) CHECK(at_centres < 1e-9);  // Δx^H at lr_to_hr[i] is ΔX^L_i
+  }
 }
