@@ -63,7 +63,8 @@ enum class RbfDistance {
   /// The literal but inconsistent reading: Φ_LL along the LR tet-mesh edges, Φ_HL from the §3.2
   /// neighbourhoods (HR surface paths to mapped vertices, first k only). The two metrics disagree,
   /// and the ill-conditioned solve amplifies it: on the bunny (frames 10/100/200/250, σ = mean LR
-  /// edge) mean error 0.14 vs 0.0049 for "HR stays at rest". Kept for comparison only.
+  /// edge) mean error 0.14 with our mapping, 0.15 with the authors', vs 0.0049 for "HR stays at
+  /// rest". Kept for comparison only.
   lr_mesh_geodesic,
   euclidean,  ///< straight-line distance for both (the scipy-comparable form)
 };
