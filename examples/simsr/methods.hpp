@@ -28,7 +28,7 @@ struct MethodArgs {
     cmd->add_option("--sigma", sigma, "rbf/mls: Gaussian width (0: from the data)");
     cmd->add_option("--degree", degree, "rbf: polynomial tail degree (-1 none, 0, 1)");
     cmd->add_option("--mls-basis", mls_basis, "mls: paper (Eq. 12-16, per coordinate, degree 2) or linear (3-D linear)");
-    cmd->add_option("--rbf-distance", rbf_distance, "rbf: geodesic (paper) or euclidean");
+    cmd->add_option("--rbf-distance", rbf_distance, "rbf: geodesic (HR-surface distances between mapped vertices, consistent), lr-mesh (the literal, inconsistent reading) or euclidean");
   }
 };
 
@@ -51,8 +51,10 @@ inline AnyMethod make_method(const std::string& name, const MethodArgs& a) {
     o.degree = a.degree;
     if (a.rbf_distance == "euclidean")
       o.distance = interp::RbfDistance::euclidean;
+    else if (a.rbf_distance == "lr-mesh")
+      o.distance = interp::RbfDistance::lr_mesh_geodesic;
     else if (a.rbf_distance != "geodesic")
-      throw ArgumentError("--rbf-distance: expected geodesic or euclidean, got '" + a.rbf_distance + "'");
+      throw ArgumentError("--rbf-distance: expected geodesic, lr-mesh or euclidean, got '" + a.rbf_distance + "'");
     return interp::RBF<double>(o);
   }
   if (name == "mls") {

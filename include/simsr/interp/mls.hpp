@@ -142,6 +142,12 @@ class MLS {
   using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 4, 4>;
   using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1>;
 
+#if defined(__GNUC__) && !defined(__clang__)
+// GCC 12 reports a false -Warray-bounds inside Eigen's SSE loads for these fixed-max (≤ 4)
+// dynamic vectors; the sizes are r + 1 ≤ 4 by construction (MLSOptions::degree is checked).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Warray-bounds"
+#endif
   /// Eq. 15–16 for one component: α_n = w_n e₀ᵀ M⁻¹ b(τ_n), τ = t / max|t| (the scaling leaves c₀
   /// unchanged). Lowers the degree while M is singular; returns the degree used.
   int fit_1d(const Eigen::VectorXd& w, const Eigen::VectorXd& t, Index j, int c) {
@@ -175,6 +181,10 @@ class MLS {
     for (int p = 1; p <= r; ++p) b(p) = b(p - 1) * tau;
     return b;
   }
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
   /// The 3-D linear MLS: α_n = w_n e₀ᵀ M⁺ [1, τ_n], τ = t / max‖t‖. Returns 1 when M was rank deficient.
   int fit_linear_3d(const Eigen::VectorXd& w, const Eigen::MatrixXd& t, Index j) {
