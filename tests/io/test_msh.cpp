@@ -1,5 +1,7 @@
 #include <doctest/doctest.h>
 
+#include "io_test_support.hpp"
+
 #include <Eigen/Geometry>
 #include <cstdlib>
 #include <filesystem>
@@ -13,36 +15,12 @@ namespace {
 namespace fs = std::filesystem;
 using simsr::io::MshVersion;
 
-const fs::path data_dir = fs::path(SIMSR_TEST_DATA_DIR) / "io";
+const fs::path data_dir = simsr::test::io_data_dir;
+using simsr::test::expected;
 
-/// A number recorded by tests/data/io/make_expected.py (meshio) for `file`: `key` of its object,
-/// or element `index` of the array `key`.
-double expected(const std::string& file, const std::string& key, int index = -1) {
-  static const std::string json = simsr::io::detail::read_text_file(data_dir / "expected.json");
-  const auto obj = json.find("\"" + file + "\": {");
-  REQUIRE(obj != std::string::npos);
-  const auto end = json.find("\n }", obj);
-  const auto at = json.find("\"" + key + "\":", obj);
-  REQUIRE(at < end);
-  const char* p = json.c_str() + at + key.size() + 3;
-  if (index >= 0) {
-    p = std::strchr(p, '[') + 1;
-    for (int i = 0; i < index; ++i) p = std::strchr(p, ',') + 1;
-  }
-  return std::strtod(p, nullptr);
-}
-
+/// expect_parse_error for the in-memory reader, whose source is named "any file".
 void expect_parse_error(const std::function<void()>& f, std::int64_t line, const std::string& part) {
-  bool thrown = false;
-  try {
-    f();
-  } catch (const simsr::ParseError& e) {
-    thrown = true;
-    INFO(std::string(e.what()));
-    CHECK(e.line() == line);
-    CHECK(std::string(e.what()).find(part) != std::string::npos);
-  }
-  CHECK_MESSAGE(thrown, "no ParseError for: ", part);
+  simsr::test::expect_parse_error(f, "", line, part);
 }
 
 template <class S>
@@ -119,11 +97,11 @@ TEST_CASE("msh: other element types are skipped and counted, parametric nodes re
   const std::string f = "cube_msh41_all.msh";
   for (const auto* m : {&all41, &all22}) {
     CHECK(m->V.rows() == expected(f, "nodes"));
-    CHECK(m->T.rows() == expected(f, "4"));
-    CHECK(m->F.rows() == expected(f, "2"));
+    CHECK(m->T.rows() == expected(f, "element_types/4"));
+    CHECK(m->F.rows() == expected(f, "element_types/2"));
     CHECK(m->skipped.size() == 2);
-    CHECK(m->skipped.at(1) == expected(f, "1"));
-    CHECK(m->skipped.at(15) == expected(f, "15"));
+    CHECK(m->skipped.at(1) == expected(f, "element_types/1"));
+    CHECK(m->skipped.at(15) == expected(f, "element_types/15"));
   }
   check_against_peer("cube_msh22_all.msh", all22.V, all22.T, all22.F.rows());
   CHECK(all41.T == all22.T);
@@ -138,8 +116,8 @@ TEST_CASE("msh: other element types are skipped and counted, parametric nodes re
   const auto o2 = simsr::io::read_msh(data_dir / "cube_o2_msh41.msh");
   CHECK(o2.V.rows() == expected("cube_o2_msh41.msh", "nodes"));
   CHECK(o2.T.rows() == 0);
-  CHECK(o2.skipped.at(11) == expected("cube_o2_msh41.msh", "tetra10"));
-  CHECK(o2.skipped.at(9) == expected("cube_o2_msh41.msh", "triangle6"));
+  CHECK(o2.skipped.at(11) == expected("cube_o2_msh41.msh", "element_types/tetra10"));
+  CHECK(o2.skipped.at(9) == expected("cube_o2_msh41.msh", "element_types/triangle6"));
 
   expect_parse_error([] { simsr::io::read_msh(data_dir / "cube_bin.msh"); }, 2, "binary .msh is not supported");
 }

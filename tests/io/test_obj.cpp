@@ -1,5 +1,7 @@
 #include <doctest/doctest.h>
 
+#include "io_test_support.hpp"
+
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <functional>
@@ -10,19 +12,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Runs `f`, which must throw simsr::ParseError at `line` with `part` in its message.
+/// expect_parse_error for the in-memory reader, whose source is named "mem.obj".
 void expect_parse_error(const std::function<void()>& f, std::int64_t line, const std::string& part) {
-  bool thrown = false;
-  try {
-    f();
-  } catch (const simsr::ParseError& e) {
-    thrown = true;
-    INFO(std::string(e.what()));
-    CHECK(e.line() == line);
-    CHECK(e.file() == "mem.obj");
-    CHECK(std::string(e.what()).find(part) != std::string::npos);
-  }
-  CHECK_MESSAGE(thrown, "no ParseError for: ", part);
+  simsr::test::expect_parse_error(f, "mem.obj", line, part);
 }
 
 template <class S>

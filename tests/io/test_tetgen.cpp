@@ -1,5 +1,7 @@
 #include <doctest/doctest.h>
 
+#include "io_test_support.hpp"
+
 #include <Eigen/Geometry>
 #include <cstdlib>
 #include <filesystem>
@@ -11,36 +13,10 @@
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path data_dir = fs::path(SIMSR_TEST_DATA_DIR) / "io";
+const fs::path data_dir = simsr::test::io_data_dir;
+using simsr::test::expected;
 
-/// A number recorded by tests/data/io/make_expected.py (meshio/numpy) for `file`.
-double expected(const std::string& file, const std::string& key, int index = -1) {
-  static const std::string json = simsr::io::detail::read_text_file(data_dir / "expected.json");
-  const auto obj = json.find("\"" + file + "\": {");
-  REQUIRE(obj != std::string::npos);
-  const auto at = json.find("\"" + key + "\":", obj);
-  REQUIRE(at < json.find("\n }", obj));
-  const char* p = json.c_str() + at + key.size() + 3;
-  if (index >= 0) {
-    p = std::strchr(p, '[') + 1;
-    for (int i = 0; i < index; ++i) p = std::strchr(p, ',') + 1;
-  }
-  return std::strtod(p, nullptr);
-}
-
-void expect_parse_error(const std::function<void()>& f, const std::string& file, std::int64_t line, const std::string& part) {
-  bool thrown = false;
-  try {
-    f();
-  } catch (const simsr::ParseError& e) {
-    thrown = true;
-    INFO(std::string(e.what()));
-    CHECK(e.file() == file);
-    CHECK(e.line() == line);
-    CHECK(std::string(e.what()).find(part) != std::string::npos);
-  }
-  CHECK_MESSAGE(thrown, "no ParseError for: ", part);
-}
+using simsr::test::expect_parse_error;
 
 double signed_volume(const simsr::Points<>& V, const Eigen::RowVector4i& t) {
   const Eigen::RowVector3d a = V.row(t[0]), b = V.row(t[1]), c = V.row(t[2]), d = V.row(t[3]);
