@@ -1,0 +1,112 @@
+#pragma once
+/// \file
+/// Elementwise activations (no parameters): LeakyReLU (slope 0.2 in the feature embedding, SPEC §7)
+/// and Sine, sin(ω₀·x), of SIREN (the upsampling weight network and the decoder), with the SIREN
+/// initialization of the Linear layer before a Sine.
+///
+///     nn::Linear<float> l0(store, "net_decoder.decoder.layers.0.fc", 227, 256, rng);
+///     nn::siren_init(l0, rng, 30.0, true);   // first layer: U(±1/fan_in)
+///     nn::Sine<float> s0(30.0f);
+
+#include <cmath>
+
+#include "detail/chunks.hpp"
+#include "layer.hpp"
+#include "linear.hpp"
+
+namespace simsr::nn {
+
+namespace detail {
+/// out = f(in) elementwise over fixed row chunks.
+template <class S, class Policy, class F>
+void map_rows(Policy policy, const ConstView<S>& in, Matrix<S>& out, F&& f) {
+  const Index R = in.rows(), C = in.cols();
+  ensure_shape(out, R, C);
+  const Index nc = chunk_count(R, product_chunks), workers = worker_count(policy, nc);
+  for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    for (Index r = b; r < e; ++r)
+      for (Index c = 0; c < C; ++c) out(r, c) = f(in(r, c));
+  });
+}
+/// d_in = d_out ⊙ f'(in) elementwise over fixed row chunks.
+template <class S, class Policy, class F>
+void map_rows_backward(Policy policy, const ConstView<S>& in, const ConstView<S>& d_out, Matrix<S>& d_in, const char* layer, F&& df) {
+  check_shape(layer, "output gradient", d_out, in.rows(), in.cols());
+  const Index R = in.rows(), C = in.cols();
+  ensure_shape(d_in, R, C);
+  const Index nc = chunk_count(R, product_chunks), workers = worker_count(policy, nc);
+  for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    for (Index r = b; r < e; ++r)
+      for (Index c = 0; c < C; ++c) d_in(r, c) = d_out(r, c) * df(in(r, c));
+  });
+}
+}  // namespace detail
+
+/// LeakyReLU: x for x > 0, slope·x otherwise (PyTorch: the gradient at 0 is `slope`).
+/// `out` must not alias `in` (backward reads `in`).
+template <class S = float>
+class LeakyReLU {
+ public:
+  using scalar_type = S;
+  explicit LeakyReLU(S slope = S(0.2)) : slope_(slope) {}
+  S slope() const { return slope_; }
+  Index out_features(Index in_cols) const { return in_cols; }
+
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+    const S a = slope_;
+    detail::map_rows<S>(policy, in, out, [a](S x) { return x > S(0) ? x : a * x; });
+  }
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+    if (!d_in) return;
+    const S a = slope_;
+    detail::map_rows_backward<S>(policy, in, d_out, *d_in, "nn::LeakyReLU", [a](S x) { return x > S(0) ? S(1) : a; });
+  }
+
+ private:
+  S slope_;
+};
+
+/// Sine activation sin(ω₀·x) (SIREN, Sitzmann et al. 2020; the reference's `Sine(w0)`).
+/// `out` must not alias `in`.
+template <class S = float>
+class Sine {
+ public:
+  using scalar_type = S;
+  explicit Sine(S omega0 = S(1)) : w0_(omega0) {}
+  S omega0() const { return w0_; }
+  Index out_features(Index in_cols) const { return in_cols; }
+
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+    const S w0 = w0_;
+    detail::map_rows<S>(policy, in, out, [w0](S x) { return std::sin(w0 * x); });
+  }
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+    if (!d_in) return;
+    const S w0 = w0_;
+    detail::map_rows_backward<S>(policy, in, d_out, *d_in, "nn::Sine", [w0](S x) { return w0 * std::cos(w0 * x); });
+  }
+
+ private:
+  S w0_;
+};
+
+/// Bound of the SIREN uniform initialization of a Linear with `fan_in` inputs followed by
+/// sin(ω₀·): 1/fan_in for the first layer, √(c/fan_in)/ω₀ after (c = 6; SPEC §7, the
+/// reference's `Siren.init_`).
+inline double siren_bound(Index fan_in, double omega0, bool first, double c = 6.0) {
+  if (fan_in < 1 || !(omega0 > 0)) throw ArgumentError("nn::siren_bound: fan_in must be >= 1 and omega0 > 0");
+  return first ? 1.0 / double(fan_in) : std::sqrt(c / double(fan_in)) / omega0;
+}
+
+/// Draws `layer`'s weight, then bias, U(±siren_bound(in_features, omega0, first, c)).
+template <class S>
+void siren_init(Linear<S>& layer, Rng& rng, double omega0, bool first, double c = 6.0) {
+  const double bound = siren_bound(layer.in_features(), omega0, first, c);
+  layer.init_uniform(rng, bound, bound);
+}
+
+}  // namespace simsr::nn

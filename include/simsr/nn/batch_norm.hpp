@@ -1,0 +1,191 @@
+#pragma once
+/// \file
+/// BatchNorm over channels (PyTorch's BatchNorm1d on B×C×N, and BatchNorm2d on B×C×N×K: in the
+/// points × channels layout both normalize each column over all rows). SPEC §7: between the 1×1
+/// convolutions of the edge MLP, of `fc_out` and of the upsampling weight network.
+///
+///     nn::BatchNorm1d<float> bn(store, "fc_out.1", 384);
+///     bn.forward(nn::Mode::train, y, z);  // batch statistics, running averages updated
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "detail/chunks.hpp"
+#include "layer.hpp"
+#include "parameters.hpp"
+
+namespace simsr::nn {
+
+/// y = (x − μ_c)/√(σ²_c + eps)·γ_c + β_c per channel c.
+/// - train: μ, σ² are the batch mean and *biased* variance over all rows (two passes, summed in
+///   double over fixed row chunks); running_mean/var ← (1 − momentum)·running + momentum·batch
+///   with the *unbiased* variance σ²·R/(R − 1); num_batches_tracked += 1 (all as PyTorch).
+/// - eval: μ, σ² are running_mean, running_var (unless track_running_stats is off).
+/// Tensors: `<name>.weight` γ (1s), `<name>.bias` β (0s) when affine; buffers `<name>.running_mean`
+/// (0s), `<name>.running_var` (1s), `<name>.num_batches_tracked` (shape {}) when tracking.
+template <class S = float>
+class BatchNorm1d {
+ public:
+  using scalar_type = S;
+
+  struct Options {
+    double eps = 1e-5;
+    double momentum = 0.1;
+    bool affine = true;
+    bool track_running_stats = true;
+  };
+
+  BatchNorm1d(ParameterStore<S>& store, std::string name, Index channels, Options options = {})
+      : store_(&store), name_(std::move(name)), c_(channels), opt_(options) {
+    if (channels < 1) throw ArgumentError(where() + ": channels must be >= 1");
+    if (!(options.eps > 0)) throw ArgumentError(where() + ": eps must be > 0");
+    if (!(options.momentum >= 0 && options.momentum <= 1)) throw ArgumentError(where() + ": momentum must be in [0, 1]");
+    if (options.affine) {
+      w_off_ = store.add_parameter(name_ + ".weight", {channels});
+      b_off_ = store.add_parameter(name_ + ".bias", {channels});
+      store.value(w_off_, 1, channels).setOnes();
+    }
+    if (options.track_running_stats) {
+      rm_off_ = store.add_buffer(name_ + ".running_mean", {channels}, S(0));
+      rv_off_ = store.add_buffer(name_ + ".running_var", {channels}, S(1));
+      nbt_off_ = store.add_buffer(name_ + ".num_batches_tracked", {}, S(0));
+    }
+  }
+
+  const std::string& name() const { return name_; }
+  Index channels() const { return c_; }
+  Index out_features(Index = -1) const { return c_; }
+  const Options& options() const { return opt_; }
+
+  /// γ, β and their gradients (ArgumentError when not affine).
+  VectorMap<S> weight() { return param(w_off_, false); }
+  VectorMap<S> bias() { return param(b_off_, false); }
+  VectorMap<S> weight_grad() { return param(w_off_, true); }
+  VectorMap<S> bias_grad() { return param(b_off_, true); }
+  /// Running statistics (ArgumentError when not tracked).
+  VectorMap<S> running_mean() { return buf(rm_off_, c_); }
+  VectorMap<S> running_var() { return buf(rv_off_, c_); }
+  S num_batches_tracked() { return buf(nbt_off_, 1)[0]; }
+
+  /// The normalized input x̂ of the last forward (rows×C); kept for backward.
+  const Matrix<S>& normalized() const { return xhat_; }
+
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+    detail::check_shape(where(), "input", in, -1, c_);
+    const Index R = in.rows();
+    batch_stats_ = mode == Mode::train || !opt_.track_running_stats;
+    ensure_shape(xhat_, R, c_);
+    ensure_shape(out, R, c_);
+    ensure_size(mean_, c_);
+    ensure_size(inv_std_, c_);
+    if (batch_stats_) {
+      if (R < 2) throw ArgumentError(where() + ": batch statistics need more than 1 row per channel, got " + std::to_string(R));
+      column_sums(policy, R, [&](Index r, auto acc) { acc += in.row(r).template cast<double>(); });
+      mean_ = total_ / double(R);
+      column_sums(policy, R, [&](Index r, auto acc) { acc += (in.row(r).template cast<double>() - mean_.transpose()).cwiseAbs2(); });
+      const Vector<double> var = total_ / double(R);
+      inv_std_ = (var.array() + opt_.eps).rsqrt();
+      if (mode == Mode::train && opt_.track_running_stats) {
+        const double m = opt_.momentum, unbias = double(R) / double(R - 1);
+        auto rm = running_mean(), rv = running_var();
+        for (Index c = 0; c < c_; ++c) {
+          rm[c] = static_cast<S>((1 - m) * double(rm[c]) + m * mean_[c]);
+          rv[c] = static_cast<S>((1 - m) * double(rv[c]) + m * var[c] * unbias);
+        }
+        buf(nbt_off_, 1)[0] += S(1);
+      }
+    } else {
+      mean_ = running_mean().template cast<double>();
+      inv_std_ = (running_var().template cast<double>().array() + opt_.eps).rsqrt();
+    }
+    shift_ = mean_.template cast<S>();
+    scale_ = inv_std_.template cast<S>();
+    ensure_size(gamma_, c_);
+    ensure_size(beta_, c_);
+    if (opt_.affine)
+      gamma_ = weight(), beta_ = bias();
+    else
+      gamma_.setOnes(), beta_.setZero();
+    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+      for (Index r = b; r < e; ++r) {
+        xhat_.row(r) = (in.row(r) - shift_.transpose()).cwiseProduct(scale_.transpose());
+        out.row(r) = xhat_.row(r).cwiseProduct(gamma_.transpose()) + beta_.transpose();
+      }
+    });
+  }
+
+  /// With batch statistics: d_in = γ/σ·(d_out − mean(d_out) − x̂·mean(d_out ⊙ x̂)) per channel
+  /// (every output depends on every row); with running statistics: d_in = γ/σ·d_out.
+  /// Adds ∂/∂γ = Σ d_out ⊙ x̂ and ∂/∂β = Σ d_out.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+    detail::check_shape(where(), "input", in, xhat_.rows(), c_);
+    detail::check_shape(where(), "output gradient", d_out, xhat_.rows(), c_);
+    const Index R = in.rows();
+    column_sums(policy, R, [&](Index r, auto acc) { acc += d_out.row(r).template cast<double>(); });
+    const Vector<double> dsum = total_;
+    column_sums(policy, R, [&](Index r, auto acc) { acc += d_out.row(r).template cast<double>().cwiseProduct(xhat_.row(r).template cast<double>()); });
+    const Vector<double> dxsum = total_;
+    if (opt_.affine) {
+      auto gw = weight_grad(), gb = bias_grad();
+      for (Index c = 0; c < c_; ++c) gw[c] += static_cast<S>(dxsum[c]), gb[c] += static_cast<S>(dsum[c]);
+    }
+    if (!d_in) return;
+    ensure_shape(*d_in, R, c_);
+    for (Index c = 0; c < c_; ++c) scale_[c] = static_cast<S>(double(gamma_[c]) * inv_std_[c]);
+    ensure_size(dmean_, c_);
+    ensure_size(dxmean_, c_);
+    if (batch_stats_) {
+      dmean_ = (dsum / double(R)).template cast<S>();
+      dxmean_ = (dxsum / double(R)).template cast<S>();
+    } else {
+      dmean_.setZero(), dxmean_.setZero();
+    }
+    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+      for (Index r = b; r < e; ++r)
+        d_in->row(r) = (d_out.row(r) - dmean_.transpose() - xhat_.row(r).cwiseProduct(dxmean_.transpose())).cwiseProduct(scale_.transpose());
+    });
+  }
+
+ private:
+  std::string where() const { return "nn::BatchNorm1d '" + name_ + "'"; }
+  VectorMap<S> param(Index off, bool grad) {
+    if (off < 0) throw ArgumentError(where() + " is not affine: it has no weight or bias");
+    return VectorMap<S>((grad ? store_->gradients() : store_->values()).data() + off, c_);
+  }
+  VectorMap<S> buf(Index off, Index n) {
+    if (off < 0) throw ArgumentError(where() + " does not track running statistics");
+    return store_->buffer(off, n);
+  }
+  /// total_ (C) = Σ_rows of the per-row contributions, in double, summed per fixed row chunk and
+  /// then over chunks in order (so seq and omp agree bit for bit).
+  template <class Policy, class Add>
+  void column_sums(Policy policy, Index R, Add&& add) {
+    const Index nr = detail::chunk_count(R, detail::reduction_chunks), workers = detail::worker_count(policy, nr);
+    ensure_shape(parts_, nr, c_);
+    detail::for_chunks(policy, R, nr, workers, [&](Index, Index c, Index b, Index e) {
+      parts_.row(c).setZero();
+      for (Index r = b; r < e; ++r) add(r, parts_.row(c));
+    });
+    ensure_size(total_, c_);
+    total_.setZero();
+    for (Index c = 0; c < nr; ++c) total_ += parts_.row(c).transpose();
+  }
+
+  ParameterStore<S>* store_;
+  std::string name_;
+  Index c_;
+  Options opt_;
+  Index w_off_ = -1, b_off_ = -1, rm_off_ = -1, rv_off_ = -1, nbt_off_ = -1;
+  bool batch_stats_ = true;
+  Matrix<S> xhat_;
+  Matrix<double> parts_;
+  Vector<double> total_, mean_, inv_std_;
+  Vector<S> shift_, scale_, gamma_, beta_, dmean_, dxmean_;
+};
+
+}  // namespace simsr::nn

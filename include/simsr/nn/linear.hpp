@@ -1,0 +1,155 @@
+#pragma once
+/// \file
+/// Linear layer = 1×1 convolution over points: out = in·Wᵀ + b (SPEC §7: every `1×1 conv` and
+/// `nn.Linear` of the network).
+///
+///     nn::Linear<float> fc(store, "fc_out.0", 323, 384, rng, {.bias = false, .kernel_dims = 1});
+///     fc.forward(nn::Mode::train, h, y);  // h: rows×323 → y: rows×384
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "detail/chunks.hpp"
+#include "detail/gemm.hpp"
+#include "layer.hpp"
+#include "parameters.hpp"
+
+namespace simsr::nn {
+
+/// Per-row affine map of rows×in activations to rows×out. Parameters `<name>.weight` (out×in,
+/// row-major like PyTorch's) and, with `bias`, `<name>.bias` (out).
+template <class S = float>
+class Linear {
+ public:
+  using scalar_type = S;
+
+  struct Options {
+    bool bias = true;     ///< PyTorch's bias=…
+    int kernel_dims = 0;  ///< trailing 1s of the state-dict weight shape: 0 nn.Linear, 1 Conv1d, 2 Conv2d
+  };
+
+  /// Registers the parameters in `store` (which must outlive the layer) and draws PyTorch's
+  /// default initialization: weight and bias U(±1/√in).
+  Linear(ParameterStore<S>& store, std::string name, Index in, Index out, Rng& rng, Options options = {})
+      : store_(&store), name_(std::move(name)), in_(in), out_(out) {
+    if (in < 1 || out < 1) throw ArgumentError("nn::Linear '" + name_ + "': in and out features must be >= 1");
+    if (options.kernel_dims < 0 || options.kernel_dims > 3) throw ArgumentError("nn::Linear '" + name_ + "': kernel_dims must be 0..3");
+    std::vector<Index> shape{out, in};
+    shape.insert(shape.end(), static_cast<std::size_t>(options.kernel_dims), Index(1));
+    w_off_ = store.add_parameter(name_ + ".weight", shape);
+    if (options.bias) b_off_ = store.add_parameter(name_ + ".bias", {out});
+    init_default(rng);
+  }
+
+  const std::string& name() const { return name_; }
+  Index in_features() const { return in_; }
+  Index out_features(Index = -1) const { return out_; }
+  bool has_bias() const { return b_off_ >= 0; }
+
+  /// out×in weight and its gradient; bias (out) and its gradient (ArgumentError without bias).
+  MatrixMap<S> weight() { return store_->value(w_off_, out_, in_); }
+  ConstMatrixMap<S> weight() const { return std::as_const(*store_).value(w_off_, out_, in_); }
+  MatrixMap<S> weight_grad() { return store_->gradient(w_off_, out_, in_); }
+  VectorMap<S> bias() { return VectorMap<S>(store_->value(bias_offset(), out_, 1).data(), out_); }
+  VectorMap<S> bias_grad() { return VectorMap<S>(store_->gradient(bias_offset(), out_, 1).data(), out_); }
+
+  /// PyTorch's reset_parameters(): weight and bias U(±1/√in).
+  void init_default(Rng& rng) {
+    const double bound = 1.0 / std::sqrt(static_cast<double>(in_));
+    init_uniform(rng, bound, bound);
+  }
+  /// Weight U(±w_bound), then bias U(±b_bound).
+  void init_uniform(Rng& rng, double w_bound, double b_bound) {
+    auto W = weight();
+    for (Index i = 0; i < W.size(); ++i) W.data()[i] = static_cast<S>(uniform(rng, -w_bound, w_bound));
+    if (has_bias()) {
+      auto b = bias();
+      for (Index i = 0; i < out_; ++i) b[i] = static_cast<S>(uniform(rng, -b_bound, b_bound));
+    }
+  }
+  template <class D>
+  void set_weight(const Eigen::MatrixBase<D>& W) {
+    detail::check_shape(where(), "weight", W, out_, in_);
+    weight() = W.template cast<S>();
+  }
+  template <class D>
+  void set_bias(const Eigen::MatrixBase<D>& b) {
+    if (b.size() != out_) throw ShapeError(where() + ": bias", {out_}, {b.size()});
+    bias() = b.template cast<S>();
+  }
+
+  /// out (rows×out) = in (rows×in)·Wᵀ + b. The mode does not matter here.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+    detail::check_shape(where(), "input", in, -1, in_);
+    const Index R = in.rows();
+    ensure_shape(out, R, out_);
+    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+    reserve(gemm_fwd_, workers, detail::max_chunk_rows(R, nc), out_, in_);
+    const auto W = std::as_const(*store_).value(w_off_, out_, in_);
+    const S* bias_data = has_bias() ? std::as_const(*store_).values().data() + b_off_ : nullptr;
+    detail::for_chunks(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+      gemm_fwd_[std::size_t(w)].run(e - b, out_, in_, in.data() + b * in.outerStride(), in.outerStride(), false, W.data(), in_, true,
+                                    out.data() + b * out_, out_, false);
+      if (bias_data) out.middleRows(b, e - b).rowwise() += ConstMatrixMap<S>(bias_data, 1, out_).row(0);
+    });
+  }
+
+  /// Adds ∂/∂W = d_outᵀ·in and ∂/∂b = column sums of d_out into the store; d_in = d_out·W.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+    detail::check_shape(where(), "input", in, -1, in_);
+    detail::check_shape(where(), "output gradient", d_out, in.rows(), out_);
+    const Index R = in.rows();
+    const auto W = std::as_const(*store_).value(w_off_, out_, in_);
+    if (d_in) {
+      ensure_shape(*d_in, R, in_);
+      const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+      reserve(gemm_din_, workers, detail::max_chunk_rows(R, nc), in_, out_);
+      detail::for_chunks(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+        gemm_din_[std::size_t(w)].run(e - b, in_, out_, d_out.data() + b * d_out.outerStride(), d_out.outerStride(), false, W.data(),
+                                      in_, false, d_in->data() + b * in_, in_, false);
+      });
+    }
+    if (R == 0) return;
+    // Weight gradient: one partial product per fixed row chunk, summed in chunk order.
+    const Index nr = detail::chunk_count(R, detail::reduction_chunks), workers = detail::worker_count(policy, nr);
+    reserve(gemm_dw_, workers, out_, in_, detail::max_chunk_rows(R, nr));
+    if (dw_parts_.size() < std::size_t(nr)) dw_parts_.resize(std::size_t(nr));
+    for (Index c = 0; c < nr; ++c) ensure_shape(dw_parts_[std::size_t(c)], out_, in_);
+    if (has_bias()) ensure_shape(db_parts_, nr, out_);
+    detail::for_chunks(policy, R, nr, workers, [&](Index w, Index c, Index b, Index e) {
+      gemm_dw_[std::size_t(w)].run(out_, in_, e - b, d_out.data() + b * d_out.outerStride(), d_out.outerStride(), true,
+                                   in.data() + b * in.outerStride(), in.outerStride(), false, dw_parts_[std::size_t(c)].data(), in_, false);
+      if (has_bias()) db_parts_.row(c) = d_out.middleRows(b, e - b).colwise().sum();
+    });
+    auto gW = weight_grad();
+    for (Index c = 0; c < nr; ++c) gW += dw_parts_[std::size_t(c)];
+    if (has_bias()) {
+      auto gb = store_->gradient(b_off_, 1, out_);
+      for (Index c = 0; c < nr; ++c) gb += db_parts_.row(c);
+    }
+  }
+
+ private:
+  std::string where() const { return "nn::Linear '" + name_ + "'"; }
+  Index bias_offset() const {
+    if (!has_bias()) throw ArgumentError(where() + " has no bias");
+    return b_off_;
+  }
+  static void reserve(std::vector<detail::SerialGemm<S>>& g, Index workers, Index rows, Index cols, Index depth) {
+    if (g.size() < std::size_t(workers)) g.resize(std::size_t(workers));
+    for (Index w = 0; w < workers; ++w) g[std::size_t(w)].reserve(rows, cols, depth);
+  }
+
+  ParameterStore<S>* store_;
+  std::string name_;
+  Index in_, out_;
+  Index w_off_ = -1, b_off_ = -1;
+  std::vector<detail::SerialGemm<S>> gemm_fwd_, gemm_din_, gemm_dw_;
+  std::vector<Matrix<S>> dw_parts_;
+  Matrix<S> db_parts_;
+};
+
+}  // namespace simsr::nn
