@@ -37,7 +37,7 @@ class BatchNorm1d {
   };
 
   BatchNorm1d(ParameterStore<S>& store, std::string name, Index channels, Options options = {})
-      : store_(&store), name_(std::move(name)), c_(channels), opt_(options) {
+      : store_(&store), name_(std::move(name)), where_("nn::BatchNorm1d '" + name_ + "'"), c_(channels), opt_(options) {
     if (channels < 1) throw ArgumentError(where() + ": channels must be >= 1");
     if (!(options.eps > 0)) throw ArgumentError(where() + ": eps must be > 0");
     if (!(options.momentum >= 0 && options.momentum <= 1)) throw ArgumentError(where() + ": momentum must be in [0, 1]");
@@ -73,7 +73,7 @@ class BatchNorm1d {
 
   template <exec::HostPolicy Policy = exec::seq_t>
   void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
-    detail::check_shape(where(), "input", in, -1, c_);
+    detail::check_shape(where_, "input", in, -1, c_);
     const Index R = in.rows();
     batch_stats_ = mode == Mode::train || !opt_.track_running_stats;
     ensure_shape(xhat_, R, c_);
@@ -85,14 +85,15 @@ class BatchNorm1d {
       column_sums(policy, R, [&](Index r, auto acc) { acc += in.row(r).template cast<double>(); });
       mean_ = total_ / double(R);
       column_sums(policy, R, [&](Index r, auto acc) { acc += (in.row(r).template cast<double>() - mean_.transpose()).cwiseAbs2(); });
-      const Vector<double> var = total_ / double(R);
-      inv_std_ = (var.array() + opt_.eps).rsqrt();
+      ensure_size(var_, c_);
+      var_ = total_ / double(R);
+      inv_std_ = (var_.array() + opt_.eps).rsqrt();
       if (mode == Mode::train && opt_.track_running_stats) {
         const double m = opt_.momentum, unbias = double(R) / double(R - 1);
         auto rm = running_mean(), rv = running_var();
         for (Index c = 0; c < c_; ++c) {
           rm[c] = static_cast<S>((1 - m) * double(rm[c]) + m * mean_[c]);
-          rv[c] = static_cast<S>((1 - m) * double(rv[c]) + m * var[c] * unbias);
+          rv[c] = static_cast<S>((1 - m) * double(rv[c]) + m * var_[c] * unbias);
         }
         buf(nbt_off_, 1)[0] += S(1);
       }
@@ -122,16 +123,18 @@ class BatchNorm1d {
   /// Adds ∂/∂γ = Σ d_out ⊙ x̂ and ∂/∂β = Σ d_out.
   template <exec::HostPolicy Policy = exec::seq_t>
   void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
-    detail::check_shape(where(), "input", in, xhat_.rows(), c_);
-    detail::check_shape(where(), "output gradient", d_out, xhat_.rows(), c_);
+    detail::check_shape(where_, "input", in, xhat_.rows(), c_);
+    detail::check_shape(where_, "output gradient", d_out, xhat_.rows(), c_);
     const Index R = in.rows();
     column_sums(policy, R, [&](Index r, auto acc) { acc += d_out.row(r).template cast<double>(); });
-    const Vector<double> dsum = total_;
+    ensure_size(dsum_, c_);
+    dsum_ = total_;
     column_sums(policy, R, [&](Index r, auto acc) { acc += d_out.row(r).template cast<double>().cwiseProduct(xhat_.row(r).template cast<double>()); });
-    const Vector<double> dxsum = total_;
+    ensure_size(dxsum_, c_);
+    dxsum_ = total_;
     if (opt_.affine) {
       auto gw = weight_grad(), gb = bias_grad();
-      for (Index c = 0; c < c_; ++c) gw[c] += static_cast<S>(dxsum[c]), gb[c] += static_cast<S>(dsum[c]);
+      for (Index c = 0; c < c_; ++c) gw[c] += static_cast<S>(dxsum_[c]), gb[c] += static_cast<S>(dsum_[c]);
     }
     if (!d_in) return;
     ensure_shape(*d_in, R, c_);
@@ -139,8 +142,8 @@ class BatchNorm1d {
     ensure_size(dmean_, c_);
     ensure_size(dxmean_, c_);
     if (batch_stats_) {
-      dmean_ = (dsum / double(R)).template cast<S>();
-      dxmean_ = (dxsum / double(R)).template cast<S>();
+      dmean_ = (dsum_ / double(R)).template cast<S>();
+      dxmean_ = (dxsum_ / double(R)).template cast<S>();
     } else {
       dmean_.setZero(), dxmean_.setZero();
     }
@@ -152,7 +155,7 @@ class BatchNorm1d {
   }
 
  private:
-  std::string where() const { return "nn::BatchNorm1d '" + name_ + "'"; }
+  const std::string& where() const { return where_; }
   VectorMap<S> param(Index off, bool grad) {
     if (off < 0) throw ArgumentError(where() + " is not affine: it has no weight or bias");
     return VectorMap<S>((grad ? store_->gradients() : store_->values()).data() + off, c_);
@@ -177,14 +180,14 @@ class BatchNorm1d {
   }
 
   ParameterStore<S>* store_;
-  std::string name_;
+  std::string name_, where_;
   Index c_;
   Options opt_;
   Index w_off_ = -1, b_off_ = -1, rm_off_ = -1, rv_off_ = -1, nbt_off_ = -1;
   bool batch_stats_ = true;
   Matrix<S> xhat_;
   Matrix<double> parts_;
-  Vector<double> total_, mean_, inv_std_;
+  Vector<double> total_, mean_, inv_std_, var_, dsum_, dxsum_;
   Vector<S> shift_, scale_, gamma_, beta_, dmean_, dxmean_;
 };
 

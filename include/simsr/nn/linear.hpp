@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "detail/chunks.hpp"
@@ -32,7 +33,7 @@ class Linear {
   /// Registers the parameters in `store` (which must outlive the layer) and draws PyTorch's
   /// default initialization: weight and bias U(±1/√in).
   Linear(ParameterStore<S>& store, std::string name, Index in, Index out, Rng& rng, Options options = {})
-      : store_(&store), name_(std::move(name)), in_(in), out_(out) {
+      : store_(&store), name_(std::move(name)), where_("nn::Linear '" + name_ + "'"), in_(in), out_(out) {
     if (in < 1 || out < 1) throw ArgumentError("nn::Linear '" + name_ + "': in and out features must be >= 1");
     if (options.kernel_dims < 0 || options.kernel_dims > 3) throw ArgumentError("nn::Linear '" + name_ + "': kernel_dims must be 0..3");
     std::vector<Index> shape{out, in};
@@ -70,7 +71,7 @@ class Linear {
   }
   template <class D>
   void set_weight(const Eigen::MatrixBase<D>& W) {
-    detail::check_shape(where(), "weight", W, out_, in_);
+    detail::check_shape(where_, "weight", W, out_, in_);
     weight() = W.template cast<S>();
   }
   template <class D>
@@ -82,7 +83,7 @@ class Linear {
   /// out (rows×out) = in (rows×in)·Wᵀ + b. The mode does not matter here.
   template <exec::HostPolicy Policy = exec::seq_t>
   void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
-    detail::check_shape(where(), "input", in, -1, in_);
+    detail::check_shape(where_, "input", in, -1, in_);
     const Index R = in.rows();
     ensure_shape(out, R, out_);
     const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
@@ -99,8 +100,8 @@ class Linear {
   /// Adds ∂/∂W = d_outᵀ·in and ∂/∂b = column sums of d_out into the store; d_in = d_out·W.
   template <exec::HostPolicy Policy = exec::seq_t>
   void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
-    detail::check_shape(where(), "input", in, -1, in_);
-    detail::check_shape(where(), "output gradient", d_out, in.rows(), out_);
+    detail::check_shape(where_, "input", in, -1, in_);
+    detail::check_shape(where_, "output gradient", d_out, in.rows(), out_);
     const Index R = in.rows();
     const auto W = std::as_const(*store_).value(w_off_, out_, in_);
     if (d_in) {
@@ -133,7 +134,7 @@ class Linear {
   }
 
  private:
-  std::string where() const { return "nn::Linear '" + name_ + "'"; }
+  const std::string& where() const { return where_; }
   Index bias_offset() const {
     if (!has_bias()) throw ArgumentError(where() + " has no bias");
     return b_off_;
@@ -144,7 +145,7 @@ class Linear {
   }
 
   ParameterStore<S>* store_;
-  std::string name_;
+  std::string name_, where_;
   Index in_, out_;
   Index w_off_ = -1, b_off_ = -1;
   std::vector<detail::SerialGemm<S>> gemm_fwd_, gemm_din_, gemm_dw_;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <string_view>
 
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
@@ -68,10 +69,11 @@ namespace detail {
 
 /// ShapeError "`layer`: `what`: expected shape (rows, cols), got (…)" unless m is rows×cols
 /// (a negative expected size matches any size).
+/// (string_view: no string is built unless it throws.)
 template <class M>
-void check_shape(const std::string& layer, const char* what, const M& m, Index rows, Index cols) {
+void check_shape(std::string_view layer, std::string_view what, const M& m, Index rows, Index cols) {
   if ((rows >= 0 && m.rows() != rows) || (cols >= 0 && m.cols() != cols))
-    throw ShapeError(layer + ": " + what, {rows, cols}, {m.rows(), m.cols()});
+    throw ShapeError(std::string(layer) + ": " + std::string(what), {rows, cols}, {m.rows(), m.cols()});
 }
 
 }  // namespace detail

@@ -1,0 +1,86 @@
+#include "gradient_check.hpp"
+
+using namespace simsr;
+using nn::Matrix;
+using test::random_matrix;
+
+TEST_CASE("nn::LeakyReLU: values and gradients (slope 0.2 default)") {
+  std::mt19937_64 rng(31);
+  nn::LeakyReLU<double> act;
+  CHECK(act.slope() == 0.2);
+  Matrix<double> x(1, 4), y, d;
+  x << -2, 0, 3, -0.5;
+  act.forward(nn::Mode::train, x, y);
+  CHECK(y(0, 0) == doctest::Approx(-0.4));
+  CHECK(y(0, 1) == 0.0);
+  CHECK(y(0, 2) == 3.0);
+  CHECK(y(0, 3) == doctest::Approx(-0.1));
+  act.backward(x, y, Matrix<double>::Ones(1, 4), &d);
+  CHECK(d(0, 1) == doctest::Approx(0.2));  // PyTorch: slope at 0
+  for (double slope : {0.2, 0.01, 1.5}) {
+    nn::LeakyReLU<double> a(slope);
+    test::check_gradients(test::layer_gradient_check(a, nullptr, test::random_away_from_zero(rng, 13, 5), nn::Mode::train, rng));
+  }
+}
+
+TEST_CASE("nn::Sine: sin(ω₀x) and its gradient") {
+  std::mt19937_64 rng(32);
+  for (double w0 : {1.0, 30.0}) {
+    nn::Sine<double> s(w0);
+    const Matrix<double> x = random_matrix(rng, 11, 6, -0.2, 0.2);
+    Matrix<double> y;
+    s.forward(nn::Mode::eval, x, y);
+    for (Index i = 0; i < x.size(); ++i) CHECK(y.data()[i] == std::sin(w0 * x.data()[i]));
+    test::check_gradients(test::layer_gradient_check(s, nullptr, x, nn::Mode::train, rng));
+  }
+}
+
+TEST_CASE("nn::siren_init: first layer U(±1/fan_in), later U(±√(6/fan_in)/ω₀), biases likewise") {
+  nn::Rng rng(33);
+  nn::ParameterStore<float> store;
+  nn::Linear<float> first(store, "layers.0.fc", 227, 256, rng), later(store, "layers.1.fc", 256, 128, rng);
+  nn::siren_init(first, rng, 30.0, true);
+  nn::siren_init(later, rng, 1.0, false);
+  const double b0 = 1.0 / 227, b1 = std::sqrt(6.0 / 256);
+  CHECK(first.weight().cwiseAbs().maxCoeff() <= b0);
+  CHECK(first.weight().cwiseAbs().maxCoeff() > 0.99 * b0);
+  CHECK(first.bias().cwiseAbs().maxCoeff() <= b0);
+  CHECK(first.bias().cwiseAbs().maxCoeff() > 0.9 * b0);
+  CHECK(later.weight().cwiseAbs().maxCoeff() <= b1);
+  CHECK(later.weight().cwiseAbs().maxCoeff() > 0.99 * b1);
+  CHECK(nn::siren_bound(16, 30.0, false) == doctest::Approx(std::sqrt(6.0 / 16) / 30));
+  CHECK_THROWS_AS(nn::siren_bound(0, 1.0, true), ArgumentError);
+}
+
+TEST_CASE("nn activations: a Linear → Sine chain matches finite differences (SIREN layer)") {
+  std::mt19937_64 rng(34);
+  nn::Rng init(35);
+  nn::ParameterStore<double> store;
+  nn::Linear<double> l(store, "l", 7, 5, init);
+  nn::siren_init(l, init, 30.0, true);
+  nn::Sine<double> s(30.0);
+  Matrix<double> h;
+  test::check_gradients(test::gradient_check(
+      random_matrix(rng, 9, 7), &store,
+      [&](const Matrix<double>& x, Matrix<double>& y) {
+        l.forward(nn::Mode::train, x, h);
+        s.forward(nn::Mode::train, h, y);
+      },
+      [&](const Matrix<double>& x, const Matrix<double>& y, const Matrix<double>& d, Matrix<double>* dx) {
+        Matrix<double> dh;
+        s.backward(h, y, d, &dh);
+        l.backward(x, h, dh, dx);
+      },
+      rng));
+}
+
+TEST_CASE("nn activations: seq == omp bitwise; warm calls allocate nothing") {
+  std::mt19937_64 rng(36);
+  const Matrix<float> x = random_matrix(rng, 3000, 40).cast<float>();
+  nn::LeakyReLU<float> a;
+  nn::Sine<float> s(30.0f);
+  test::check_seq_equals_omp(a, (nn::ParameterStore<float>*)nullptr, x, nn::Mode::train, rng);
+  test::check_seq_equals_omp(s, (nn::ParameterStore<float>*)nullptr, x, nn::Mode::train, rng);
+  test::check_warm_no_allocation(a, x, nn::Mode::train, exec::omp);
+  test::check_warm_no_allocation(s, x, nn::Mode::train, exec::seq);
+}
