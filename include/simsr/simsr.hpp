@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Umbrella header: every area of simsr, in the order data flows through them
-/// (core → mesh/io → discretize → neighbors → interp → eval). Include single areas
+/// (core → mesh/io → discretize → neighbors → interp | nn → eval). Include single areas
 /// (simsr/mesh/mesh.hpp, simsr/interp/interp.hpp, ...) to keep compile times short.
 
 #include "core/core.hpp"
@@ -11,3 +11,4 @@
 #include "io/io.hpp"
 #include "mesh/mesh.hpp"
 #include "neighbors/neighbors.hpp"
+#include "nn/nn.hpp"
