@@ -70,7 +70,7 @@ TEST_CASE("nn::ParameterStore: registering more tensors later keeps earlier laye
   nn::Rng rng(1);
   nn::Linear<double> a(store, "a", 3, 4, rng);
   const Matrix<double> Wa = a.weight();
-  for (int i = 0; i < 50; ++i) nn::Linear<double>(store, "b" + std::to_string(i), 30, 30, rng);
+  for (int i = 0; i < 50; ++i) nn::Linear<double>(store, std::string("b").append(std::to_string(i)), 30, 30, rng);  // (GCC 12 false -Wrestrict on "b" + string)
   CHECK(Matrix<double>(a.weight()) == Wa);
   Matrix<double> x = Matrix<double>::Ones(2, 3), y;
   a.forward(nn::Mode::eval, x, y);
