@@ -1,0 +1,101 @@
+#include <simsr/nn/neighbor_upsample.hpp>
+
+#include "gradient_check.hpp"
+
+using namespace simsr;
+using nn::GraphIndices;
+using nn::Matrix;
+using test::random_matrix;
+
+namespace {
+GraphIndices random_indices(std::mt19937_64& rng, Index M, Index N, Index K) {
+  std::uniform_int_distribution<int> pick(0, int(N) - 1);
+  GraphIndices g(M, K);
+  for (Index i = 0; i < g.size(); ++i) g.data()[i] = pick(rng);
+  return g;
+}
+}  // namespace
+
+TEST_CASE("nn::NeighborUpsample: softmax weights and the weighted gather against plain loops") {
+  std::mt19937_64 rng(91);
+  const Index B = 3, N = 8, M = 11, K = 4, C = 5;
+  nn::NeighborUpsample<double> up(random_indices(rng, M, N, K), N);
+  const Matrix<double> z = random_matrix(rng, B * N, C);
+  for (bool shared : {true, false}) {
+    const Matrix<double> logits = random_matrix(rng, shared ? M : B * M, K, -3, 3);
+    Matrix<double> out, out2;
+    up.forward(logits, z, out);
+    REQUIRE(out.rows() == B * M);
+    for (Index r = 0; r < logits.rows(); ++r) {
+      double s = 0;
+      for (Index i = 0; i < K; ++i) s += std::exp(logits(r, i));
+      for (Index i = 0; i < K; ++i) CHECK(std::abs(up.weights()(r, i) - std::exp(logits(r, i)) / s) < 1e-15);
+    }
+    for (Index b = 0; b < B; ++b)
+      for (Index j = 0; j < M; ++j)
+        for (Index c = 0; c < C; ++c) {
+          double v = 0;
+          for (Index i = 0; i < K; ++i) v += up.weights()(shared ? j : b * M + j, i) * z(b * N + up.indices()(j, i), c);
+          CHECK(std::abs(out(b * M + j, c) - v) < 1e-14);
+        }
+    // inference path with precomputed weights: the same bits
+    Matrix<double> w;
+    nn::NeighborUpsample<double>::softmax_rows(logits, w);
+    up.apply(w, z, out2);
+    CHECK(test::bitwise_equal(out, out2));
+  }
+  // large logits do not overflow
+  Matrix<double> big = Matrix<double>::Constant(M, K, 1000.0), w;
+  nn::NeighborUpsample<double>::softmax_rows(big, w);
+  CHECK((w.array() - 0.25).abs().maxCoeff() < 1e-15);
+  GraphIndices bad = GraphIndices::Constant(M, K, VIndex(N));
+  CHECK_THROWS_AS(nn::NeighborUpsample<double>(bad, N), ArgumentError);
+  Matrix<double> out;
+  CHECK_THROWS_AS(up.forward(Matrix<double>(M + 1, K), z, out), ShapeError);
+  CHECK_THROWS_AS(up.forward(Matrix<double>(M, K), Matrix<double>(N + 1, C), out), ShapeError);
+}
+
+TEST_CASE("nn::NeighborUpsample: gradients to logits and LR codes match finite differences") {
+  std::mt19937_64 rng(92);
+  const Index B = 2, N = 6, M = 9, K = 3, C = 4;
+  nn::NeighborUpsample<double> up(random_indices(rng, M, N, K), N);
+  for (bool shared : {true, false}) {
+    INFO("shared logits " << shared);
+    const Matrix<double> logits = random_matrix(rng, shared ? M : B * M, K, -2, 2);
+    const Matrix<double> z = random_matrix(rng, B * N, C);
+    // w.r.t. z (logits fixed)
+    test::check_gradients(test::gradient_check(
+        z, (nn::ParameterStore<double>*)nullptr, [&](const Matrix<double>& x, Matrix<double>& o) { up.forward(logits, x, o); },
+        [&](const Matrix<double>& x, const Matrix<double>&, const Matrix<double>& d, Matrix<double>* dx) { up.backward(x, d, nullptr, dx); },
+        rng));
+    // w.r.t. the logits (z fixed)
+    test::check_gradients(test::gradient_check(
+        logits, (nn::ParameterStore<double>*)nullptr, [&](const Matrix<double>& l, Matrix<double>& o) { up.forward(l, z, o); },
+        [&](const Matrix<double>&, const Matrix<double>&, const Matrix<double>& d, Matrix<double>* dl) { up.backward(z, d, dl, nullptr); },
+        rng));
+  }
+}
+
+TEST_CASE("nn::NeighborUpsample: seq == omp bitwise; warm calls allocate nothing") {
+  std::mt19937_64 rng(93);
+  const Index B = 4, N = 300, M = 1200, K = 10, C = 64;
+  nn::NeighborUpsample<float> up(random_indices(rng, M, N, K), N);
+  const Matrix<float> z = random_matrix(rng, B * N, C).cast<float>();
+  const Matrix<float> logits = random_matrix(rng, M, K, -2, 2).cast<float>();
+  Matrix<float> o1, o2, dl1, dl2, dz1, dz2;
+  up.forward(logits, z, o1, exec::seq);
+  const Matrix<float> r = random_matrix(rng, o1.rows(), o1.cols()).cast<float>();
+  up.backward(z, r, &dl1, &dz1, exec::seq);
+  up.forward(logits, z, o2, exec::omp);
+  up.backward(z, r, &dl2, &dz2, exec::omp);
+  CHECK(test::bitwise_equal(o1, o2));
+  CHECK(test::bitwise_equal(dl1, dl2));
+  CHECK(test::bitwise_equal(dz1, dz2));
+  const float* p = o1.data();
+  const long before = simsr_test_nn_malloc_count();
+  up.forward(logits, z, o1, exec::omp);
+  up.backward(z, r, &dl1, &dz1, exec::omp);
+  up.apply(up.weights(), z, o1, exec::seq);
+  CHECK(simsr_test_nn_malloc_count() - before == 0);
+  CHECK(o1.data() == p);
+}
