@@ -5,4 +5,5 @@
 #include "error.hpp"
 #include "host_device.hpp"
 #include "parallel.hpp"
+#include "serial_gemm.hpp"
 #include "types.hpp"

@@ -17,55 +17,10 @@
 #include <vector>
 
 #include "../core/parallel.hpp"
+#include "../core/serial_gemm.hpp"
 #include "knn_result.hpp"
 
 namespace simsr::neighbors {
-
-namespace detail {
-
-/// C = A·Bᵀ on the calling thread: A m×d and B n×d row-major (leading dimensions lda, ldb), C
-/// m×n row-major (ldc). Eigen's own product would start OpenMP threads of its own when called
-/// outside a parallel region (exec::seq), which oversubscribes the cores and makes the rounding
-/// depend on where it runs; this calls Eigen's packed GEMM kernel directly, single-threaded, with
-/// packing buffers allocated once in reserve(). Eigen 3.4 internals; other versions fall back to
-/// the public product.
-template <class S>
-class SerialGemmABt {
- public:
-  /// Sizes the packing buffers for products up to rows×cols×depth.
-  void reserve(Index rows, Index cols, Index depth) {
-#if EIGEN_VERSION_AT_LEAST(3, 4, 0) && !EIGEN_VERSION_AT_LEAST(3, 5, 0)
-    if (blocking_ && rows == rows_ && cols == cols_ && depth == depth_) return;
-    blocking_ = std::make_unique<Blocking>(rows, cols, depth, 1, true);
-    blocking_->allocateAll();
-    rows_ = rows, cols_ = cols, depth_ = depth;
-#else
-    (void)rows, (void)cols, (void)depth;
-#endif
-  }
-
-  void run(Index m, Index n, Index d, const S* A, Index lda, const S* B, Index ldb, S* C, Index ldc) {
-    using RowMat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-    Eigen::Map<RowMat, 0, Eigen::OuterStride<>> Cm(C, m, n, Eigen::OuterStride<>(ldc));
-#if EIGEN_VERSION_AT_LEAST(3, 4, 0) && !EIGEN_VERSION_AT_LEAST(3, 5, 0)
-    Cm.setZero();
-    Eigen::internal::general_matrix_matrix_product<Index, S, Eigen::RowMajor, false, S, Eigen::ColMajor, false, Eigen::RowMajor, 1>::run(
-        m, n, d, A, lda, B, ldb, C, 1, ldc, S(1), *blocking_, nullptr);
-#else
-    Eigen::Map<const RowMat, 0, Eigen::OuterStride<>> Am(A, m, d, Eigen::OuterStride<>(lda)), Bm(B, n, d, Eigen::OuterStride<>(ldb));
-    Cm.noalias() = Am * Bm.transpose();
-#endif
-  }
-
- private:
-#if EIGEN_VERSION_AT_LEAST(3, 4, 0) && !EIGEN_VERSION_AT_LEAST(3, 5, 0)
-  using Blocking = Eigen::internal::gemm_blocking_space<Eigen::RowMajor, S, S, Eigen::Dynamic, Eigen::Dynamic, Eigen::Dynamic>;
-  std::unique_ptr<Blocking> blocking_;
-  Index rows_ = 0, cols_ = 0, depth_ = 0;
-#endif
-};
-
-}  // namespace detail
 
 /// Exact brute-force kNN over N points of dimension D (row-major N×D, float by default).
 ///
@@ -156,7 +111,7 @@ class BruteForceKnn {
     std::vector<Index> count;
     std::vector<S> exact;        // re-ranking scratch: direct distances
     std::vector<VIndex> order;
-    detail::SerialGemmABt<S> gemm;
+    SerialGemm<S> gemm;
 
     void reserve(Index qb, Index pb, Index d, Index cap) {
       gemm.reserve(qb, pb, d);
@@ -218,7 +173,7 @@ class BruteForceKnn {
     const S inf = std::numeric_limits<S>::infinity();
     for (Index p0 = 0; p0 < n_; p0 += params_.point_block) {
       const Index pn = std::min(params_.point_block, n_ - p0);
-      ws.gemm.run(m, pn, d_, ws.Qb.data(), d_, P.data() + p0 * d_, d_, ws.G.data(), ws.G.cols());
+      ws.gemm.run(m, pn, d_, ws.Qb.data(), d_, false, P.data() + p0 * d_, d_, true, ws.G.data(), ws.G.cols(), false);
       for (Index r = 0; r < m; ++r) {
         S* cd = ws.cand_d2.data() + r * cap;
         VIndex* ci = ws.cand_i.data() + r * cap;

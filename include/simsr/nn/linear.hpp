@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "detail/chunks.hpp"
-#include "detail/gemm.hpp"
+#include "../core/serial_gemm.hpp"
 #include "layer.hpp"
 #include "parameters.hpp"
 
@@ -139,7 +139,7 @@ class Linear {
     if (!has_bias()) throw ArgumentError(where() + " has no bias");
     return b_off_;
   }
-  static void reserve(std::vector<detail::SerialGemm<S>>& g, Index workers, Index rows, Index cols, Index depth) {
+  static void reserve(std::vector<SerialGemm<S>>& g, Index workers, Index rows, Index cols, Index depth) {
     if (g.size() < std::size_t(workers)) g.resize(std::size_t(workers));
     for (Index w = 0; w < workers; ++w) g[std::size_t(w)].reserve(rows, cols, depth);
   }
@@ -148,7 +148,7 @@ class Linear {
   std::string name_, where_;
   Index in_, out_;
   Index w_off_ = -1, b_off_ = -1;
-  std::vector<detail::SerialGemm<S>> gemm_fwd_, gemm_din_, gemm_dw_;
+  std::vector<SerialGemm<S>> gemm_fwd_, gemm_din_, gemm_dw_;
   std::vector<Matrix<S>> dw_parts_;
   Matrix<S> db_parts_;
 };

@@ -1,24 +1,29 @@
 #pragma once
 /// \file
-/// Single-threaded GEMM on raw row-major buffers for the layers' block products.
+/// Single-threaded GEMM on raw row-major buffers: the block products of the feature kNN
+/// (neighbors::BruteForceKnn) and of the network layers (nn::Linear).
 
+#include <Eigen/Core>
 #include <memory>
 
-#include "../tensor.hpp"
+#include "types.hpp"
 
-namespace simsr::nn::detail {
+namespace simsr {
 
 /// C (+)= op(A)·op(B) on the calling thread. C is m×n row-major (leading dimension ldc); op(A) is
 /// m×k: A row-major m×k (lda), or with `a_t` A row-major k×m read transposed; op(B) is k×n: B
 /// row-major k×n (ldb), or with `b_t` B row-major n×k read transposed. `accumulate` adds to C.
 ///
 /// Why not Eigen's product: called outside a parallel region (exec::seq) it starts its own OpenMP
-/// threads, which oversubscribes the cores and makes rounding depend on where it runs. As in
-/// neighbors::BruteForceKnn, this calls Eigen 3.4's packed kernel directly with one thread and
-/// packing buffers sized once in reserve(); other Eigen versions fall back to the public product.
+/// threads, which oversubscribes the cores and makes rounding depend on where it runs (it made the
+/// feature kNN 5× slower on a loaded machine). This calls Eigen 3.4's packed kernel directly with
+/// one thread and packing buffers sized once in reserve(); other Eigen versions fall back to the
+/// public product.
 /// Rounding depends on (m, n, k) and the reserved sizes only, never on the thread.
 template <class S>
 class SerialGemm {
+  using Matrix = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
  public:
   /// Sizes the packing buffers for products up to rows×cols with depth `depth`.
   void reserve(Index rows, Index cols, Index depth) {
@@ -34,7 +39,7 @@ class SerialGemm {
 
   void run(Index m, Index n, Index k, const S* A, Index lda, bool a_t, const S* B, Index ldb, bool b_t, S* C, Index ldc,
            bool accumulate) {
-    Eigen::Map<Matrix<S>, 0, Eigen::OuterStride<>> Cm(C, m, n, Eigen::OuterStride<>(ldc));
+    Eigen::Map<Matrix, 0, Eigen::OuterStride<>> Cm(C, m, n, Eigen::OuterStride<>(ldc));
     if (!accumulate) Cm.setZero();
     if (m == 0 || n == 0 || k == 0) return;
 #if EIGEN_VERSION_AT_LEAST(3, 4, 0) && !EIGEN_VERSION_AT_LEAST(3, 5, 0)
@@ -49,13 +54,13 @@ class SerialGemm {
 #else
     using Stride = Eigen::OuterStride<>;
     using CM = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor>;
-    auto opA = [&]() -> Matrix<S> {
+    auto opA = [&]() -> Matrix {
       if (a_t) return Eigen::Map<const CM, 0, Stride>(A, m, k, Stride(lda));
-      return Eigen::Map<const Matrix<S>, 0, Stride>(A, m, k, Stride(lda));
+      return Eigen::Map<const Matrix, 0, Stride>(A, m, k, Stride(lda));
     };
-    auto opB = [&]() -> Matrix<S> {
+    auto opB = [&]() -> Matrix {
       if (b_t) return Eigen::Map<const CM, 0, Stride>(B, k, n, Stride(ldb));
-      return Eigen::Map<const Matrix<S>, 0, Stride>(B, k, n, Stride(ldb));
+      return Eigen::Map<const Matrix, 0, Stride>(B, k, n, Stride(ldb));
     };
     Cm.noalias() += opA() * opB();
 #endif
@@ -78,4 +83,4 @@ class SerialGemm {
 #endif
 };
 
-}  // namespace simsr::nn::detail
+}  // namespace simsr
