@@ -1,5 +1,7 @@
 #include <doctest/doctest.h>
 
+#include "bunny_fixture.hpp"
+
 #include <simsr/interp/idw.hpp>
 #include <simsr/interp/mls.hpp>
 #include <simsr/io/npy.hpp>
@@ -222,40 +224,8 @@ TEST_CASE("MLS: seq and omp give identical bits; shapes and options are checked"
   CHECK_THROWS_WITH_AS(MLS<>().fit(bare), doctest::Contains("ensure_neighborhoods"), ArgumentError);
 }
 
-namespace {
-
-struct Bunny {
-  UpsamplingProblem<> problem;
-  std::vector<Points<>> lr_frames, hr_frames;  // displacements from the rest shapes
-};
-
-/// The bunny example with the authors' precomputed surface-to-tet geodesic neighbourhoods (first
-/// 20 of 100 columns) and a few training frames; false when the data are absent.
-bool load_bunny(Bunny& b, std::vector<Index> frames) {
-#ifdef SIMSR_DATA_DIR
-  const std::filesystem::path dir = std::filesystem::path(SIMSR_DATA_DIR) / "bunny";
-  if (!std::filesystem::exists(dir / "train_frames.npz")) return false;
-  b.problem.lr = io::read_obj_tets(dir / "lrestshape.obj");
-  b.problem.hr = io::read_obj_triangles(dir / "hrestshape.obj");
-  neighbors::UpsamplingNeighborhoods nb;
-  nb.indices = io::read_npy(dir / "geo_dist_surf2tet_idx.npy").to_matrix<VIndex>().leftCols(20);
-  nb.distances = io::read_npy(dir / "geo_dist_surf2tet.npy").to_matrix<double>().leftCols(20);
-  b.problem.neighborhoods = std::move(nb);
-  io::NpzReader z(dir / "train_frames.npz");
-  const auto lo = z.read("lowres").to_vector<double>(), hi = z.read("highres").to_vector<double>();
-  const Index n = b.problem.num_lr(), m = b.problem.num_hr();
-  for (Index f : frames) {
-    b.lr_frames.push_back(Eigen::Map<const Points<>>(lo.data() + f * n * 3, n, 3) - b.problem.lr.V);
-    b.hr_frames.push_back(Eigen::Map<const Points<>>(hi.data() + f * m * 3, m, 3) - b.problem.hr.V);
-  }
-  return true;
-#else
-  (void)b, (void)frames;
-  return false;
-#endif
-}
-
-}  // namespace
+using simsr::test::Bunny;
+using simsr::test::load_bunny;
 
 TEST_CASE("MLS on the bunny: both variants beat the rest shape") {
   Bunny b;

@@ -1,5 +1,7 @@
 #include <doctest/doctest.h>
 
+#include "bunny_fixture.hpp"
+
 #include <simsr/interp/rbf.hpp>
 #include <simsr/io/npy.hpp>
 #include <simsr/io/npz.hpp>
@@ -464,43 +466,8 @@ TEST_CASE("RBF: singular systems, shapes, options; seq and omp give identical bi
   CHECK_THROWS_WITH_AS(RBF<>(e).fit(p), doctest::Contains("numerically singular"), ArgumentError);
 }
 
-namespace {
-
-struct Bunny {
-  UpsamplingProblem<> problem;
-  std::vector<Points<>> lr_frames, hr_frames;
-};
-
-bool load_bunny(Bunny& b, std::vector<Index> frames) {
-#ifdef SIMSR_DATA_DIR
-  const std::filesystem::path dir = std::filesystem::path(SIMSR_DATA_DIR) / "bunny";
-  if (!std::filesystem::exists(dir / "train_frames.npz")) return false;
-  b.problem.lr = io::read_obj_tets(dir / "lrestshape.obj");
-  b.problem.hr = io::read_obj_triangles(dir / "hrestshape.obj");
-  neighbors::UpsamplingNeighborhoods nb;
-  nb.indices = io::read_npy(dir / "geo_dist_surf2tet_idx.npy").to_matrix<VIndex>().leftCols(20);
-  nb.distances = io::read_npy(dir / "geo_dist_surf2tet.npy").to_matrix<double>().leftCols(20);
-  // the authors' LR→HR mapping: the HR vertex at distance 0 of each LR vertex
-  nb.lr_to_hr = IndexVector::Constant(b.problem.num_lr(), -1);
-  for (Index j = 0; j < nb.indices.rows(); ++j)
-    if (nb.distances(j, 0) == 0.0) nb.lr_to_hr[nb.indices(j, 0)] = VIndex(j);
-  if ((nb.lr_to_hr.array() < 0).any()) return false;
-  b.problem.neighborhoods = std::move(nb);
-  io::NpzReader z(dir / "train_frames.npz");
-  const auto lo = z.read("lowres").to_vector<double>(), hi = z.read("highres").to_vector<double>();
-  const Index n = b.problem.num_lr(), m = b.problem.num_hr();
-  for (Index f : frames) {
-    b.lr_frames.push_back(Eigen::Map<const Points<>>(lo.data() + f * n * 3, n, 3) - b.problem.lr.V);
-    b.hr_frames.push_back(Eigen::Map<const Points<>>(hi.data() + f * m * 3, m, 3) - b.problem.hr.V);
-  }
-  return true;
-#else
-  (void)b, (void)frames;
-  return false;
-#endif
-}
-
-}  // namespace
+using simsr::test::Bunny;
+using simsr::test::load_bunny;
 
 /// lr_mesh_geodesic on the bunny (mean error 0.15 vs 0.0049 at rest) is left out for time (a dense
 /// 1747² LU); its inconsistency is checked on the torus above.
