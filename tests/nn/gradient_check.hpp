@@ -16,7 +16,7 @@
 #include <vector>
 
 /// Number of malloc/calloc/realloc calls so far in this process (all threads).
-long simsr_test_nn_malloc_count();
+long simsr_test_malloc_count();
 
 namespace simsr::test {
 
@@ -163,10 +163,10 @@ void check_warm_no_allocation(L& layer, const Matrix<S>& x, nn::Mode mode, Polic
   layer.backward(x, out, r, &dx, policy);
   const S* out_ptr = out.data();
   const S* dx_ptr = dx.data();
-  const long before = simsr_test_nn_malloc_count();
+  const long before = simsr_test_malloc_count();
   layer.forward(mode, x, out, policy);
   layer.backward(x, out, r, &dx, policy);
-  const long after = simsr_test_nn_malloc_count();
+  const long after = simsr_test_malloc_count();
   CHECK(after - before == 0);
   CHECK(out.data() == out_ptr);
   CHECK(dx.data() == dx_ptr);

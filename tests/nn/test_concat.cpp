@@ -84,9 +84,9 @@ TEST_CASE("nn::Concat: seq == omp bitwise; warm calls allocate nothing") {
   CHECK(test::bitwise_equal(da2, a));
   CHECK(test::bitwise_equal(db2, b));
   const float* p = y1.data();
-  const long before = simsr_test_nn_malloc_count();
+  const long before = simsr_test_malloc_count();
   cat.forward({a, b}, y1, exec::omp);
   cat.backward(y1, {&da1, &db1}, true, exec::omp);
-  CHECK(simsr_test_nn_malloc_count() - before == 0);
+  CHECK(simsr_test_malloc_count() - before == 0);
   CHECK(y1.data() == p);
 }

@@ -92,10 +92,10 @@ TEST_CASE("nn::NeighborUpsample: seq == omp bitwise; warm calls allocate nothing
   CHECK(test::bitwise_equal(dl1, dl2));
   CHECK(test::bitwise_equal(dz1, dz2));
   const float* p = o1.data();
-  const long before = simsr_test_nn_malloc_count();
+  const long before = simsr_test_malloc_count();
   up.forward(logits, z, o1, exec::omp);
   up.backward(z, r, &dl1, &dz1, exec::omp);
   up.apply(up.weights(), z, o1, exec::seq);
-  CHECK(simsr_test_nn_malloc_count() - before == 0);
+  CHECK(simsr_test_malloc_count() - before == 0);
   CHECK(o1.data() == p);
 }

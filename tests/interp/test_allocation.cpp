@@ -1,0 +1,88 @@
+// Interpolator::apply allocates nothing once warm (the Interpolator contract): the malloc calls of
+// repeated applies are counted on the bunny problem, under seq and omp, for every method and each
+// RBF solve path. tests/support/malloc_counter.hpp is included here, once for test_interp.
+#include <doctest/doctest.h>
+
+#include <simsr/interp/interp.hpp>
+
+#include "../support/malloc_counter.hpp"
+#include "bunny_fixture.hpp"
+
+using namespace simsr;
+using namespace simsr::interp;
+
+namespace {
+
+/// Mallocs of 3 applies after 2 warm-up applies, under `policy`.
+template <class Method, class Policy>
+long warm_apply_mallocs(const Method& method, Policy policy, const Points<>& lr, Points<>& hr) {
+  for (int i = 0; i < 2; ++i) method.apply(policy, lr, hr);
+  const long before = simsr_test_malloc_count();
+  for (int i = 0; i < 3; ++i) method.apply(policy, lr, hr);
+  return simsr_test_malloc_count() - before;
+}
+
+template <class Method>
+void check_no_allocation(const char* name, const Method& method, const Points<>& lr, Points<>& hr) {
+  INFO(name);
+  CHECK(warm_apply_mallocs(method, exec::seq, lr, hr) == 0);
+  CHECK(warm_apply_mallocs(method, exec::omp, lr, hr) == 0);
+}
+
+}  // namespace
+
+TEST_CASE("every interpolator's warm apply allocates nothing (bunny, seq and omp)") {
+#if !defined(__GLIBC__)
+  MESSAGE("malloc counting needs glibc: skipped");
+  return;
+#endif
+  {  // the counter itself must see allocations, or every check below would pass vacuously
+    const long before = simsr_test_malloc_count();
+    Points<> tmp(100, 3);
+    CHECK(simsr_test_malloc_count() - before >= 1);
+    CHECK(tmp.rows() == 100);
+  }
+  simsr::test::Bunny b;
+  if (!simsr::test::load_bunny(b, {10, 50, 100, 150, 200, 250})) {
+    MESSAGE("bunny data not found: skipped");
+    return;
+  }
+  const Points<>& lr = b.lr_frames[0];
+  Points<> hr(b.problem.num_hr(), 3);
+
+  Embedded<> embedded;
+  embedded.fit(b.problem);
+  check_no_allocation("Embedded", embedded, lr, hr);
+  IDW<> idw;
+  idw.fit(b.problem);
+  check_no_allocation("IDW", idw, lr, hr);
+  for (const auto basis : {MlsBasis::per_coordinate, MlsBasis::linear_3d}) {
+    MLS<> mls(MLSOptions{.basis = basis});
+    mls.fit(b.problem);
+    check_no_allocation(basis == MlsBasis::per_coordinate ? "MLS as written" : "MLS 3-D linear", mls, lr, hr);
+  }
+  for (const auto solver : {RbfSolver::dense, RbfSolver::sparse}) {
+    RBFOptions o;
+    o.solver = solver;
+    RBF<> rbf(o);
+    rbf.fit(b.problem);
+    check_no_allocation(solver == RbfSolver::dense ? "RBF dense" : "RBF sparse", rbf, lr, hr);
+  }
+  {  // dense LU kept and solved per frame (operator larger than the budget)
+    RBFOptions o;
+    o.solver = RbfSolver::dense;
+    o.max_operator_bytes = 0;
+    RBF<> rbf(o);
+    rbf.fit(b.problem);
+    check_no_allocation("RBF dense, per-frame LU solves", rbf, lr, hr);
+  }
+  std::vector<double> train_lr, train_hr;
+  for (std::size_t f = 0; f < b.lr_frames.size(); ++f) {
+    train_lr.insert(train_lr.end(), b.lr_frames[f].data(), b.lr_frames[f].data() + b.lr_frames[f].size());
+    train_hr.insert(train_hr.end(), b.hr_frames[f].data(), b.hr_frames[f].data() + b.hr_frames[f].size());
+  }
+  Ridge<> ridge;
+  ridge.fit(b.problem);
+  ridge.train(train_lr, train_hr, Index(b.lr_frames.size()));
+  check_no_allocation("Ridge", ridge, lr, hr);
+}
