@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds every reader's libFuzzer harness with clang (ASan+UBSan) and fuzzes each for N seconds
 # (default 60), starting from its committed corpus. New crashing inputs land in build-fuzz/crashes/.
-#   bash scripts/fuzz.sh [SECONDS]
+#   bash scripts/fuzz.sh [SECONDS]        (SIMSR_FUZZ_SEED=N picks the mutation seed; default 1, so
+#                                         a short run in CI explores the same inputs every time)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -24,7 +25,7 @@ for t in $targets; do
   name=${t#fuzz_}
   work=$(mktemp -d)
   cp -r "tests/fuzz/corpus/$name/." "$work/" 2>/dev/null || true
-  if "$build/tests/fuzz/$t" "$work" -max_total_time="$seconds" -max_len=8192 -timeout=5 -rss_limit_mb=2048 \
+  if "$build/tests/fuzz/$t" "$work" -max_total_time="$seconds" -seed="${SIMSR_FUZZ_SEED:-1}" -max_len=8192 -timeout=5 -rss_limit_mb=2048 \
        -artifact_prefix="$build/crashes/$name-" -print_final_stats=1 >"$build/$t.log" 2>&1; then
     runs=$(grep -m1 'stat::number_of_executed_units' "$build/$t.log" | awk '{print $2}')
     echo "simsr: fuzz $name: ${seconds} s, ${runs:-?} inputs, no crash"
