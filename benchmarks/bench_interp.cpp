@@ -77,9 +77,9 @@ UpsamplingProblem<>& paper_problem() {
   return *p;
 }
 
+/// Times method.apply on one random LR displacement of problem `p` (warmed up once).
 template <class I, class Policy>
-void run_apply(benchmark::State& state, I& method, Policy policy) {
-  auto& p = paper_problem();
+void run_apply(benchmark::State& state, I& method, Policy policy, const UpsamplingProblem<>& p) {
   std::mt19937 rng(2);
   std::normal_distribution<double> g;
   Points<> dX(p.num_lr(), 3), dx(p.num_hr(), 3);
@@ -123,28 +123,15 @@ RBF<>& rbf() {
   }();
   return *m;
 }
-template <class I, class Policy>
-void run_rbf_apply(benchmark::State& state, I& method, Policy policy) {
-  auto& p = rbf_problem();
-  std::mt19937 rng(2);
-  std::normal_distribution<double> g;
-  Points<> dX(p.num_lr(), 3), dx(p.num_hr(), 3);
-  for (Index i = 0; i < dX.size(); ++i) dX.data()[i] = g(rng);
-  method.apply(policy, dX, dx);
-  for (auto _ : state) {
-    method.apply(policy, dX, dx);
-    benchmark::DoNotOptimize(dx.data());
-  }
-}
 
-void BM_IDW_apply_seq(benchmark::State& s) { run_apply(s, idw(), exec::seq); }
-void BM_IDW_apply_omp(benchmark::State& s) { run_apply(s, idw(), exec::omp); }
-void BM_MLS_as_written_apply_seq(benchmark::State& s) { run_apply(s, mls(MlsBasis::per_coordinate), exec::seq); }
-void BM_MLS_as_written_apply_omp(benchmark::State& s) { run_apply(s, mls(MlsBasis::per_coordinate), exec::omp); }
-void BM_MLS_linear3d_apply_seq(benchmark::State& s) { run_apply(s, mls(MlsBasis::linear_3d), exec::seq); }
-void BM_MLS_linear3d_apply_omp(benchmark::State& s) { run_apply(s, mls(MlsBasis::linear_3d), exec::omp); }
-void BM_RBF_geodesic_sparse_apply_seq(benchmark::State& s) { run_rbf_apply(s, rbf(), exec::seq); }
-void BM_RBF_geodesic_sparse_apply_omp(benchmark::State& s) { run_rbf_apply(s, rbf(), exec::omp); }
+void BM_IDW_apply_seq(benchmark::State& s) { run_apply(s, idw(), exec::seq, paper_problem()); }
+void BM_IDW_apply_omp(benchmark::State& s) { run_apply(s, idw(), exec::omp, paper_problem()); }
+void BM_MLS_as_written_apply_seq(benchmark::State& s) { run_apply(s, mls(MlsBasis::per_coordinate), exec::seq, paper_problem()); }
+void BM_MLS_as_written_apply_omp(benchmark::State& s) { run_apply(s, mls(MlsBasis::per_coordinate), exec::omp, paper_problem()); }
+void BM_MLS_linear3d_apply_seq(benchmark::State& s) { run_apply(s, mls(MlsBasis::linear_3d), exec::seq, paper_problem()); }
+void BM_MLS_linear3d_apply_omp(benchmark::State& s) { run_apply(s, mls(MlsBasis::linear_3d), exec::omp, paper_problem()); }
+void BM_RBF_geodesic_sparse_apply_seq(benchmark::State& s) { run_apply(s, rbf(), exec::seq, rbf_problem()); }
+void BM_RBF_geodesic_sparse_apply_omp(benchmark::State& s) { run_apply(s, rbf(), exec::omp, rbf_problem()); }
 
 void BM_MLS_as_written_fit_omp(benchmark::State& s) {
   for (auto _ : s) {

@@ -1,5 +1,5 @@
 #pragma once
-// The bunny example for the interpolator tests: rest shapes, the authors' precomputed
+// Fixtures of the interpolator tests: brute-force stand-in neighbourhoods, and the bunny example: rest shapes, the authors' precomputed
 // surface-to-tet geodesic neighbourhoods (first 20 of 100 columns) with their LR→HR mapping, and
 // the displacements of a few training frames.
 #include <simsr/interp/problem.hpp>
@@ -7,12 +7,29 @@
 #include <simsr/io/npz.hpp>
 #include <simsr/io/obj.hpp>
 
+#include <algorithm>
 #include <filesystem>
+#include <utility>
 #include <vector>
 
 namespace simsr::test {
 
 using interp::UpsamplingProblem;
+
+/// Stand-in neighbourhoods: the k Euclidean-nearest LR vertices (L) of each HR vertex (H), by brute
+/// force (sorted by distance, then id), as the interpolators only read ids and distances.
+inline neighbors::UpsamplingNeighborhoods brute_neighborhoods(const Points<>& L, const Points<>& H, Index k) {
+  neighbors::UpsamplingNeighborhoods nb;
+  nb.indices.resize(H.rows(), k);
+  nb.distances.resize(H.rows(), k);
+  for (Index j = 0; j < H.rows(); ++j) {
+    std::vector<std::pair<double, Index>> d;
+    for (Index i = 0; i < L.rows(); ++i) d.emplace_back((L.row(i) - H.row(j)).norm(), i);
+    std::partial_sort(d.begin(), d.begin() + k, d.end());
+    for (Index n = 0; n < k; ++n) nb.indices(j, n) = VIndex(d[n].second), nb.distances(j, n) = d[n].first;
+  }
+  return nb;
+}
 
 /// Displacements from the rest shapes of the frames asked for.
 struct Bunny {

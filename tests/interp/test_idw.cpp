@@ -1,5 +1,7 @@
 #include <doctest/doctest.h>
 
+#include "bunny_fixture.hpp"
+
 #include <simsr/interp/idw.hpp>
 #include <simsr/io/npy.hpp>
 #include <simsr/io/npz.hpp>
@@ -29,16 +31,7 @@ UpsamplingProblem<> make_problem(Points<> L, Points<> H, Index k) {
   UpsamplingProblem<> p;
   p.lr.V = std::move(L);
   p.hr.V = std::move(H);
-  neighbors::UpsamplingNeighborhoods nb;
-  nb.indices.resize(p.num_hr(), k);
-  nb.distances.resize(p.num_hr(), k);
-  for (Index j = 0; j < p.num_hr(); ++j) {
-    std::vector<std::pair<double, Index>> d;
-    for (Index i = 0; i < p.num_lr(); ++i) d.emplace_back((p.lr.V.row(i) - p.hr.V.row(j)).norm(), i);
-    std::partial_sort(d.begin(), d.begin() + k, d.end());
-    for (Index n = 0; n < k; ++n) nb.indices(j, n) = VIndex(d[n].second), nb.distances(j, n) = d[n].first;
-  }
-  p.neighborhoods = std::move(nb);
+  p.neighborhoods = simsr::test::brute_neighborhoods(p.lr.V, p.hr.V, k);
   return p;
 }
 

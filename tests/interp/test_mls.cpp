@@ -42,20 +42,7 @@ Points<> random_points(Index n, double lo, double hi, std::mt19937& rng) {
   return P;
 }
 
-/// Stand-in neighbourhoods: the k Euclidean-nearest LR vertices of each HR vertex, by brute force
-/// (sorted by distance, then id), as the interpolators only read ids and distances.
-neighbors::UpsamplingNeighborhoods brute_neighborhoods(const Points<>& L, const Points<>& H, Index k) {
-  neighbors::UpsamplingNeighborhoods nb;
-  nb.indices.resize(H.rows(), k);
-  nb.distances.resize(H.rows(), k);
-  for (Index j = 0; j < H.rows(); ++j) {
-    std::vector<std::pair<double, Index>> d;
-    for (Index i = 0; i < L.rows(); ++i) d.emplace_back((L.row(i) - H.row(j)).norm(), i);
-    std::partial_sort(d.begin(), d.begin() + k, d.end());
-    for (Index n = 0; n < k; ++n) nb.indices(j, n) = VIndex(d[n].second), nb.distances(j, n) = d[n].first;
-  }
-  return nb;
-}
+using simsr::test::brute_neighborhoods;
 
 UpsamplingProblem<> point_problem(Points<> L, Points<> H, Index k) {
   UpsamplingProblem<> p;

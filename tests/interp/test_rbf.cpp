@@ -80,16 +80,7 @@ UpsamplingProblem<> make_problem(TetMesh<> lr, Points<> H, Index k) {
   UpsamplingProblem<> p;
   p.lr = std::move(lr);
   p.hr.V = std::move(H);
-  neighbors::UpsamplingNeighborhoods nb;
-  nb.indices.resize(p.num_hr(), k);
-  nb.distances.resize(p.num_hr(), k);
-  for (Index j = 0; j < p.num_hr(); ++j) {
-    std::vector<std::pair<double, Index>> d;
-    for (Index i = 0; i < p.num_lr(); ++i) d.emplace_back((p.lr.V.row(i) - p.hr.V.row(j)).norm(), i);
-    std::partial_sort(d.begin(), d.begin() + k, d.end());
-    for (Index n = 0; n < k; ++n) nb.indices(j, n) = VIndex(d[n].second), nb.distances(j, n) = d[n].first;
-  }
-  p.neighborhoods = std::move(nb);
+  p.neighborhoods = simsr::test::brute_neighborhoods(p.lr.V, p.hr.V, k);
   return p;
 }
 
