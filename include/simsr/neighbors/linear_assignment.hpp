@@ -33,6 +33,15 @@ struct Assignment {
   double total_cost = 0;   ///< Σ_i C(i, row_to_col[i]), summed in row order from the input costs
   VecX<double> row_dual;   ///< N: u
   VecX<double> col_dual;   ///< M: v
+
+  /// Sizes for `rows` × `cols`: nothing assigned, zero duals (the solvers' starting point).
+  void reset(Index rows, Index cols) {
+    row_to_col = IndexVector::Constant(rows, -1);
+    col_to_row = IndexVector::Constant(cols, -1);
+    row_dual = VecX<double>::Zero(rows);
+    col_dual = VecX<double>::Zero(cols);
+    total_cost = 0;
+  }
 };
 
 /// Minimum-cost assignment of every row of the N×M cost matrix C (N ≤ M) to a distinct column.
@@ -59,10 +68,7 @@ Assignment linear_assignment(const Eigen::MatrixBase<Derived>& C) {
 
   constexpr double inf = std::numeric_limits<double>::infinity();
   Assignment a;
-  a.row_dual = VecX<double>::Zero(nr);
-  a.col_dual = VecX<double>::Zero(nc);
-  a.row_to_col = IndexVector::Constant(nr, -1);
-  a.col_to_row = IndexVector::Constant(nc, -1);
+  a.reset(nr, nc);
   auto& u = a.row_dual;
   auto& v = a.col_dual;
   auto& col4row = a.row_to_col;

@@ -26,6 +26,7 @@
 
 #include "../core/error.hpp"
 #include "../core/types.hpp"
+#include "linear_assignment.hpp"
 
 namespace simsr::neighbors {
 
@@ -57,13 +58,8 @@ struct SparseCostGraph {
 /// that covers every row: `hall_rows` (sorted) is the union of row sets with fewer distinct
 /// candidate columns than rows, one per row that could not be placed (Hall's condition fails
 /// there; give those rows more candidates), and the other fields are left empty.
-struct SparseAssignment {
+struct SparseAssignment : Assignment {  // row_to_col, col_to_row (−1 free), total_cost, duals
   bool feasible = false;
-  IndexVector row_to_col;  ///< N
-  IndexVector col_to_row;  ///< M, −1 for free columns
-  double total_cost = 0;   ///< Σ_i cost of row i's edge, in row order
-  VecX<double> row_dual;   ///< N: u
-  VecX<double> col_dual;   ///< M: v
   std::vector<VIndex> hall_rows;
   Index greedy_rows = 0;           ///< rows placed by the row-minimum start
   Index augmentations = 0;         ///< shortest-path searches run
@@ -102,10 +98,7 @@ inline SparseAssignment sparse_assignment(const SparseCostGraph& g) {
 
   constexpr double inf = std::numeric_limits<double>::infinity();
   SparseAssignment a;
-  a.row_dual = VecX<double>::Zero(nr);
-  a.col_dual = VecX<double>::Zero(nc);
-  a.row_to_col = IndexVector::Constant(nr, -1);
-  a.col_to_row = IndexVector::Constant(nc, -1);
+  a.reset(nr, nc);
   auto& u = a.row_dual;
   auto& v = a.col_dual;
   auto& col4row = a.row_to_col;
