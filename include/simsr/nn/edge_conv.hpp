@@ -12,13 +12,13 @@
 /// State-dict names (official_model.py): `<prefix>.edge_conv.0.weight` (2out×2C×1×1),
 /// `<prefix>.edge_conv.1.{weight,bias,running_mean,running_var,num_batches_tracked}`,
 /// `<prefix>.edge_conv.3.weight` (out×2out×1×1).
+/// The `paper` profile's edge function (SPEC §7: "EdgeConv as one linear layer, no BatchNorm")
+/// is `EdgeMlp::single_linear`: Conv2d 2C→out with bias, LeakyReLU, `<prefix>.edge_conv.0.*`.
 
 #include <string>
 
-#include "activations.hpp"
-#include "batch_norm.hpp"
 #include "graph_features.hpp"
-#include "linear.hpp"
+#include "mlp.hpp"
 #include "pooling.hpp"
 
 namespace simsr::nn {
@@ -32,19 +32,29 @@ class EdgeConv {
  public:
   using scalar_type = S;
 
+  /// The edge function h(e): official (two 1×1 convs with BatchNorm) or the paper's single layer.
+  enum class EdgeMlp { official, single_linear };
+
   struct Options {
     S slope = S(0.2);                       ///< LeakyReLU negative slope
     typename BatchNorm1d<S>::Options bn{};  ///< eps, momentum of the BatchNorm2d
+    EdgeMlp edge_mlp = EdgeMlp::official;
   };
 
   EdgeConv(ParameterStore<S>& store, const std::string& prefix, Index in, Index out, Index k, Rng& rng, Options options = {})
-      : in_(in), out_(out), k_(k),
-        conv0_(store, prefix + ".edge_conv.0", 2 * in, 2 * out, rng, {.bias = false, .kernel_dims = 2}),
-        bn_(store, prefix + ".edge_conv.1", 2 * out, options.bn),
-        act_(options.slope),
-        conv3_(store, prefix + ".edge_conv.3", 2 * out, out, rng, {.bias = false, .kernel_dims = 2}),
+      : in_(in), out_(out), k_(k), kind_(options.edge_mlp),
+        mlp_(store, prefix + ".edge_conv", stages(in, out, options), rng),
         pool_(PoolKind::max, k, false) {
     if (k < 1) throw ArgumentError("nn::EdgeConv '" + prefix + "': k must be >= 1");
+  }
+
+  /// The stages of the edge function for `options.edge_mlp`.
+  static std::vector<MlpStage> stages(Index in, Index out, const Options& o) {
+    const typename BatchNorm1d<float>::Options bn{.eps = o.bn.eps, .momentum = o.bn.momentum, .affine = o.bn.affine,
+                                                  .track_running_stats = o.bn.track_running_stats};
+    if (o.edge_mlp == EdgeMlp::single_linear) return {MlpStage::linear(2 * in, out, "0").dims(2).then(Act::leaky_relu, double(o.slope))};
+    return {MlpStage::linear(2 * in, 2 * out, "0").no_bias().dims(2).norm("1", bn).then(Act::leaky_relu, double(o.slope)),
+            MlpStage::linear(2 * out, out, "3").no_bias().dims(2)};
   }
 
   Index in_features() const { return in_; }
@@ -67,9 +77,15 @@ class EdgeConv {
   /// The graph of the last forward (or the fixed one).
   const GraphIndices& graph() const { return features_.graph(); }
 
-  Linear<S>& conv0() { return conv0_; }
-  BatchNorm1d<S>& batch_norm() { return bn_; }
-  Linear<S>& conv3() { return conv3_; }
+  EdgeMlp edge_mlp() const { return kind_; }
+  /// The official edge MLP's layers (conv3 and batch_norm: ArgumentError for single_linear).
+  Linear<S>& conv0() { return mlp_.linear(0); }
+  BatchNorm1d<S>& batch_norm() { return mlp_.batch_norm(0); }
+  Linear<S>& conv3() {
+    if (kind_ != EdgeMlp::official) throw ArgumentError("nn::EdgeConv: the single-linear edge function has no conv3");
+    return mlp_.linear(1);
+  }
+  Mlp<S>& edge_function() { return mlp_; }
 
   template <exec::HostPolicy Policy = exec::seq_t>
   void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
@@ -79,10 +95,7 @@ class EdgeConv {
       features_.set_graph(dyn_graph_, n_);
     }
     features_.forward(mode, in, e0_, policy);
-    conv0_.forward(mode, e0_, e1_, policy);
-    bn_.forward(mode, e1_, e2_, policy);
-    act_.forward(mode, e2_, e3_, policy);
-    conv3_.forward(mode, e3_, e4_, policy);
+    mlp_.forward(mode, e0_, e4_, policy);
     pool_.forward(mode, e4_, out, policy);
   }
 
@@ -90,25 +103,20 @@ class EdgeConv {
   void backward(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
     detail::check_shape("nn::EdgeConv", "input", in, e0_.rows() / k_, in_);
     pool_.backward(e4_, out, d_out, &g4_, policy);
-    conv3_.backward(e3_, e4_, g4_, &g3_, policy);
-    act_.backward(e2_, e3_, g3_, &g2_, policy);
-    bn_.backward(e1_, e2_, g2_, &g1_, policy);
-    conv0_.backward(e0_, e1_, g1_, d_in ? &g0_ : nullptr, policy);
+    mlp_.backward(e0_, e4_, g4_, d_in ? &g0_ : nullptr, policy);
     if (d_in) features_.backward(in, e0_, g0_, d_in, policy);
   }
 
  private:
   Index in_, out_, k_, n_ = 0;
+  EdgeMlp kind_;
   bool dynamic_ = false;
   GraphFeatures<S> features_;
   DynamicKnnGraph<S> knn_;
   GraphIndices dyn_graph_;
-  Linear<S> conv0_;
-  BatchNorm1d<S> bn_;
-  LeakyReLU<S> act_;
-  Linear<S> conv3_;
+  Mlp<S> mlp_;
   GroupPool<S> pool_;
-  Matrix<S> e0_, e1_, e2_, e3_, e4_, g0_, g1_, g2_, g3_, g4_;
+  Matrix<S> e0_, e4_, g0_, g4_;
 };
 
 }  // namespace simsr::nn

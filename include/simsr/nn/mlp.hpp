@@ -1,0 +1,218 @@
+#pragma once
+/// \file
+/// A stack of per-point (1×1 convolution) stages, each Linear → optional BatchNorm → activation:
+/// the shape of every MLP of the network (SPEC §7): the EdgeConv edge MLP, `fc_out` of each
+/// embedding block, the upsampling weight network, the SIREN decoder.
+///
+///     std::vector<nn::MlpStage> st = {
+///       nn::MlpStage::linear(7, 128, "conv_weights.0").no_bias().norm("conv_weights.1").then(nn::Act::sine),
+///       nn::MlpStage::linear(128, 1, "conv_weights.3")};
+///     nn::Mlp<float> mlp(store, "net_upscale", st, rng);
+///     mlp.forward(nn::Mode::train, q, logits);
+///
+/// Names are the caller's (PyTorch nn.Sequential indices differ by profile), prefixed by `prefix.`.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "activations.hpp"
+#include "batch_norm.hpp"
+#include "linear.hpp"
+
+namespace simsr::nn {
+
+/// Activation after a stage: none (identity), LeakyReLU(slope), sin(ω₀·x).
+enum class Act { none, leaky_relu, sine };
+
+/// Initialization of a stage's Linear: PyTorch's default U(±1/√in), or SIREN's (first layer
+/// U(±1/in), later U(±√(6/in)/ω₀); see siren_init).
+enum class Init { pytorch_default, siren_first, siren };
+
+/// One stage. `omega0` is the sine's ω₀ and the ω₀ of a SIREN init; `slope` LeakyReLU's.
+struct MlpStage {
+  Index in = 0, out = 0;
+  bool bias = true;
+  bool batch_norm = false;
+  Act act = Act::none;
+  double omega0 = 1.0;
+  double slope = 0.2;
+  Init init = Init::pytorch_default;
+  int kernel_dims = 1;  ///< trailing 1s of the weight's state-dict shape (Conv1d 1, Conv2d 2, Linear 0)
+  std::string linear_name, bn_name;
+  typename BatchNorm1d<float>::Options bn{};
+
+  /// A Linear in→out named `name` (with bias, Conv1d-shaped weight, no activation).
+  static MlpStage linear(Index in, Index out, std::string name) {
+    MlpStage s;
+    s.in = in;
+    s.out = out;
+    s.linear_name = std::move(name);
+    return s;
+  }
+  MlpStage& no_bias() { return bias = false, *this; }
+  MlpStage& dims(int trailing_ones) { return kernel_dims = trailing_ones, *this; }
+  /// BatchNorm after the Linear, named `name`.
+  MlpStage& norm(std::string name, typename BatchNorm1d<float>::Options options = {}) {
+    batch_norm = true;
+    bn_name = std::move(name);
+    bn = options;
+    return *this;
+  }
+  /// Activation after the stage: LeakyReLU(param) or sin(param·x).
+  MlpStage& then(Act a, double param) {
+    act = a;
+    (a == Act::sine ? omega0 : slope) = param;
+    return *this;
+  }
+  /// SIREN initialization of the Linear (first layer or later) for sin(ω₀·).
+  MlpStage& siren(bool first, double w0) {
+    init = first ? Init::siren_first : Init::siren;
+    omega0 = w0;
+    return *this;
+  }
+};
+
+/// The stages in order; forward keeps every intermediate for backward. Not copyable (layers
+/// point into the store); one object serves one place in the graph.
+template <class S = float>
+class Mlp {
+ public:
+  using scalar_type = S;
+
+  Mlp(ParameterStore<S>& store, const std::string& prefix, const std::vector<MlpStage>& stages, Rng& rng) {
+    if (stages.empty()) throw ArgumentError("nn::Mlp '" + prefix + "': needs at least one stage");
+    const std::string p = prefix.empty() ? "" : prefix + ".";
+    for (std::size_t i = 0; i < stages.size(); ++i) {
+      const MlpStage& s = stages[i];
+      if (i > 0 && s.in != stages[i - 1].out)
+        throw ArgumentError("nn::Mlp '" + prefix + "': stage " + std::to_string(i) + " takes " + std::to_string(s.in) +
+                            " features but the previous stage gives " + std::to_string(stages[i - 1].out));
+      if (s.linear_name.empty()) throw ArgumentError("nn::Mlp '" + prefix + "': stage " + std::to_string(i) + " needs a linear_name");
+      auto st = std::make_unique<Stage>();
+      st->spec = s;
+      st->linear.emplace(store, p + s.linear_name, s.in, s.out, rng, typename Linear<S>::Options{.bias = s.bias, .kernel_dims = s.kernel_dims});
+      if (s.init != Init::pytorch_default) siren_init(*st->linear, rng, s.omega0, s.init == Init::siren_first);
+      if (s.batch_norm) {
+        if (s.bn_name.empty()) throw ArgumentError("nn::Mlp '" + prefix + "': stage " + std::to_string(i) + " needs a bn_name");
+        st->bn.emplace(store, p + s.bn_name, s.out,
+                       typename BatchNorm1d<S>::Options{.eps = s.bn.eps, .momentum = s.bn.momentum, .affine = s.bn.affine,
+                                                        .track_running_stats = s.bn.track_running_stats});
+      }
+      st->leaky.emplace(static_cast<S>(s.slope));
+      st->sine.emplace(static_cast<S>(s.omega0));
+      stages_.push_back(std::move(st));
+    }
+  }
+
+  Index stages() const { return Index(stages_.size()); }
+  Index in_features() const { return stages_.front()->spec.in; }
+  Index out_features(Index = -1) const { return stages_.back()->spec.out; }
+  Linear<S>& linear(Index i) { return *stage(i).linear; }
+  /// The BatchNorm of stage i; ArgumentError when the stage has none.
+  BatchNorm1d<S>& batch_norm(Index i) {
+    if (!stage(i).bn) throw ArgumentError("nn::Mlp: stage " + std::to_string(i) + " has no BatchNorm");
+    return *stage(i).bn;
+  }
+  const MlpStage& spec(Index i) const { return stages_.at(std::size_t(i))->spec; }
+
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+    const ConstView<S>* x = &in;
+    std::optional<ConstView<S>> view;
+    const std::size_t last = stages_.size() - 1;
+    for (std::size_t i = 0; i <= last; ++i) {
+      Stage& s = *stages_[i];
+      // The last stage writes its final activation straight into `out`.
+      Matrix<S>& lin_out = (i == last && !s.bn && s.spec.act == Act::none) ? out : s.lin;
+      s.linear->forward(mode, *x, lin_out, policy);
+      const Matrix<S>* y = &lin_out;
+      if (s.bn) {
+        Matrix<S>& bn_out = (i == last && s.spec.act == Act::none) ? out : s.normed;
+        s.bn->forward(mode, *y, bn_out, policy);
+        y = &bn_out;
+      }
+      if (s.spec.act != Act::none) {
+        Matrix<S>& act_out = i == last ? out : s.activated;
+        activation_forward(s, mode, *y, act_out, policy);
+        y = &act_out;
+      }
+      view.emplace(*y);
+      x = &*view;
+    }
+  }
+
+  /// After forward(…, in, out): parameter gradients added, d_in written when not null.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+    const std::size_t last = stages_.size() - 1;
+    const ConstView<S>* g = &d_out;
+    std::optional<ConstView<S>> gview;
+    for (std::size_t ii = stages_.size(); ii-- > 0;) {
+      Stage& s = *stages_[ii];
+      const bool is_last = ii == last;
+      // the stage's tensors: lin (Linear output), normed (BN output), the activation output
+      const ConstView<S> lin_out = (is_last && !s.bn && s.spec.act == Act::none) ? ConstView<S>(out) : ConstView<S>(s.lin);
+      const ConstView<S> bn_out = !s.bn ? lin_out : (is_last && s.spec.act == Act::none) ? ConstView<S>(out) : ConstView<S>(s.normed);
+      if (s.spec.act != Act::none) {
+        const ConstView<S> act_out = is_last ? ConstView<S>(out) : ConstView<S>(s.activated);
+        activation_backward(s, bn_out, act_out, *g, s.g_act, policy);
+        gview.emplace(s.g_act);
+        g = &*gview;
+      }
+      if (s.bn) {
+        s.bn->backward(lin_out, bn_out, *g, &s.g_bn, policy);
+        gview.emplace(s.g_bn);
+        g = &*gview;
+      }
+      const ConstView<S> x = ii == 0 ? in : stage_output(ii - 1);
+      Matrix<S>* dx = ii == 0 ? d_in : &s.g_in;
+      s.linear->backward(x, lin_out, *g, dx, policy);
+      if (ii > 0) {
+        gview.emplace(s.g_in);
+        g = &*gview;
+      }
+    }
+  }
+
+ private:
+  struct Stage {
+    MlpStage spec;
+    std::optional<Linear<S>> linear;
+    std::optional<BatchNorm1d<S>> bn;
+    std::optional<LeakyReLU<S>> leaky;
+    std::optional<Sine<S>> sine;
+    Matrix<S> lin, normed, activated, g_act, g_bn, g_in;
+  };
+
+  Stage& stage(Index i) {
+    if (i < 0 || i >= stages()) throw ArgumentError("nn::Mlp: no stage " + std::to_string(i));
+    return *stages_[std::size_t(i)];
+  }
+  /// Output of a stage that is not the last one.
+  ConstView<S> stage_output(std::size_t i) const {
+    const Stage& s = *stages_[i];
+    if (s.spec.act != Act::none) return s.activated;
+    if (s.bn) return s.normed;
+    return s.lin;
+  }
+  template <class Policy>
+  void activation_forward(Stage& s, Mode mode, const ConstView<S>& x, Matrix<S>& y, Policy policy) {
+    if (s.spec.act == Act::leaky_relu)
+      s.leaky->forward(mode, x, y, policy);
+    else
+      s.sine->forward(mode, x, y, policy);
+  }
+  template <class Policy>
+  void activation_backward(Stage& s, const ConstView<S>& x, const ConstView<S>& y, const ConstView<S>& g, Matrix<S>& dx, Policy policy) {
+    if (s.spec.act == Act::leaky_relu)
+      s.leaky->backward(x, y, g, &dx, policy);
+    else
+      s.sine->backward(x, y, g, &dx, policy);
+  }
+
+  std::vector<std::unique_ptr<Stage>> stages_;
+};
+
+}  // namespace simsr::nn
