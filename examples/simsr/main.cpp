@@ -5,9 +5,11 @@
 //   simsr neighbors ...        §3.2 upsampling neighbourhoods + LR geodesic graph
 //   simsr upsample ...         LR frames → HR frames with a baseline interpolator
 //   simsr baselines ...        every baseline on held-out frames: statistics, plots, heatmaps
+//   simsr eval ...             error statistics of predicted HR frames against the truth
 // Errors: a message on stderr naming the file, and an exit code in 1..125 (errors.hpp).
 #include "cmd_baselines.hpp"
 #include "cmd_convert.hpp"
+#include "cmd_eval.hpp"
 #include "cmd_info.hpp"
 #include "cmd_knn.hpp"
 #include "cmd_neighbors.hpp"
@@ -26,6 +28,7 @@ int main(int argc, char** argv) {
   simsr::cli::add_neighbors(app, action);
   simsr::cli::add_upsample(app, action);
   simsr::cli::add_baselines(app, action);
+  simsr::cli::add_eval(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
