@@ -1,0 +1,197 @@
+#pragma once
+/// \file
+/// Coordinate-based upsampling (paper §3.2, Eq. 1–3; SPEC §7 `upsampling`): the weight network
+/// f_θ maps the query u_ij = [x_j^H, x_i^L (normalized), d_ij] of each HR vertex j and each of
+/// its upK LR neighbours i to a logit; a softmax over the neighbours gives w_ij and
+/// z_j^H = Σ_i w_ij z_i^L. The query depends on rest shapes only, so in inference the weights
+/// are computed once (precompute_weights) and every frame is a sparse M×N product (apply).
+///
+///     nn::CoordinateUpsampling<float> up(store, "net_upscale", cfg, query, up_indices, N, rng);
+///     up.forward(nn::Mode::train, z, zH);      // training: f_θ once per step, not per item
+///     up.precompute_weights(); up.apply(z, zH); // inference
+///
+/// Official names: `conv_weights.<3l>` (Conv2d, no bias), `conv_weights.<3l+1>` (BatchNorm2d),
+/// sin, …, `conv_weights.<3L>` (Conv2d →1 with bias); without BatchNorm the indices step by 2.
+/// The w/o-CU ablation (UpsamplingKind::table) replaces f_θ by one free logit per (j, i):
+/// `logits` (M×upK, initialized to 0 = equal weights).
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/SparseCore>
+
+#include "mlp.hpp"
+#include "neighbor_upsample.hpp"
+#include "network_config.hpp"
+
+namespace simsr::nn {
+
+/// Positions as the official dataset.py normalizes them: parsed to S first, then (x − μ)/σ in S.
+template <class S, class D>
+Matrix<S> normalize_positions(const Eigen::MatrixBase<D>& X, double mean, double std_dev) {
+  const S mu = static_cast<S>(mean), sigma = static_cast<S>(std_dev);
+  Matrix<S> out(X.rows(), X.cols());
+  for (Index r = 0; r < X.rows(); ++r)
+    for (Index c = 0; c < X.cols(); ++c) out(r, c) = (static_cast<S>(X(r, c)) - mu) / sigma;
+  return out;
+}
+
+/// The (M·upK)×7 query of Eq. 2, row j·upK + i = [hr_n(j), lr_n(idx(j,i)), dist(j,i)] where the
+/// positions are normalized (normalize_positions) and the distance is in raw mesh units (as
+/// the official code feeds its geodesic distances).
+template <class S, class DH, class DL, class DD>
+Matrix<S> upsampling_query(const Eigen::MatrixBase<DH>& hr_normalized, const Eigen::MatrixBase<DL>& lr_normalized,
+                           const GraphIndices& indices, const Eigen::MatrixBase<DD>& distances) {
+  const Index M = indices.rows(), K = indices.cols();
+  detail::check_shape("nn::upsampling_query", "HR positions", hr_normalized, M, 3);
+  detail::check_shape("nn::upsampling_query", "LR positions", lr_normalized, -1, 3);
+  detail::check_shape("nn::upsampling_query", "distances", distances, M, K);
+  Matrix<S> q(M * K, 7);
+  for (Index j = 0; j < M; ++j)
+    for (Index i = 0; i < K; ++i) {
+      const Index n = indices(j, i);
+      if (n < 0 || n >= lr_normalized.rows())
+        throw ArgumentError("nn::upsampling_query: neighbour " + std::to_string(n) + " of HR vertex " + std::to_string(j) + " is outside [0, " +
+                            std::to_string(lr_normalized.rows()) + ")");
+      const double d = double(distances(j, i));
+      if (!std::isfinite(d) || d < 0)
+        throw ArgumentError("nn::upsampling_query: distance of HR vertex " + std::to_string(j) + " to neighbour " + std::to_string(i) +
+                            " is not a finite non-negative number");
+      auto row = q.row(j * K + i);
+      for (int c = 0; c < 3; ++c) {
+        row[c] = static_cast<S>(hr_normalized(j, c));
+        row[3 + c] = static_cast<S>(lr_normalized(n, c));
+      }
+      row[6] = static_cast<S>(d);
+    }
+  return q;
+}
+
+template <class S = float>
+class CoordinateUpsampling {
+ public:
+  using scalar_type = S;
+  using SparseMatrix = Eigen::SparseMatrix<S, Eigen::RowMajor>;
+
+  /// query: (M·upK)×7 (upsampling_query); indices: M×upK into [0, n_lr).
+  CoordinateUpsampling(ParameterStore<S>& store, const std::string& prefix, const NetworkConfig& cfg, Matrix<S> query,
+                       const GraphIndices& indices, Index n_lr, Rng& rng)
+      : kind_(cfg.upsampling), query_(std::move(query)), up_(indices, n_lr), store_(&store) {
+    const Index M = indices.rows(), K = indices.cols();
+    if (kind_ == UpsamplingKind::table) {
+      logits_off_ = store.add_parameter(prefix + ".logits", {M, K});
+      return;
+    }
+    detail::check_shape("nn::CoordinateUpsampling", "query ((M·upK)×7)", query_, M * K, 7);
+    mlp_ = std::make_unique<Mlp<S>>(store, prefix + ".conv_weights", stages(cfg), rng);
+  }
+
+  /// f_θ: hidden layers (Conv2d [no bias + BatchNorm2d] then sin(ω₀·)), then Conv2d → 1 with bias.
+  static std::vector<MlpStage> stages(const NetworkConfig& cfg) {
+    std::vector<MlpStage> st;
+    const typename BatchNorm1d<float>::Options bno{.eps = cfg.batchnorm_eps, .momentum = cfg.batchnorm_momentum};
+    Index in = 7;
+    int idx = 0;
+    for (std::size_t l = 0; l < cfg.up_hidden.size(); ++l) {
+      const double w0 = l == 0 ? cfg.up_w0_initial : cfg.up_w0;
+      MlpStage s = MlpStage::linear(in, cfg.up_hidden[l], std::to_string(idx++)).dims(2);
+      if (cfg.up_siren_init) s.siren(l == 0, w0);
+      if (cfg.up_batch_norm) s.no_bias().norm(std::to_string(idx++), bno);
+      s.then(Act::sine, w0);
+      ++idx;
+      st.push_back(s);
+      in = cfg.up_hidden[l];
+    }
+    MlpStage last = MlpStage::linear(in, 1, std::to_string(idx)).dims(2);
+    if (cfg.up_siren_init && !cfg.up_hidden.empty()) last.siren(false, cfg.up_w0);
+    st.push_back(last);
+    return st;
+  }
+
+  Index hr_points() const { return up_.hr_points(); }
+  Index lr_points() const { return up_.lr_points(); }
+  Index neighbors() const { return up_.neighbors(); }
+  const GraphIndices& indices() const { return up_.indices(); }
+  const Matrix<S>& query() const { return query_; }
+  UpsamplingKind kind() const { return kind_; }
+  /// Softmax weights of the last forward / precompute_weights (M×upK).
+  const Matrix<S>& weights() const { return kind_ == UpsamplingKind::table || !precomputed_ ? up_.weights() : weights_; }
+
+  /// Training path: logits from f_θ (mode: BatchNorm statistics), softmax, gather. z: (B·N)×C.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode mode, const ConstView<S>& z, Matrix<S>& zH, Policy policy = {}) {
+    compute_logits(mode, policy);
+    up_.forward(logits_view(), z, zH, policy);
+  }
+
+  /// After forward: d_z written (overwritten), f_θ's (or the table's) gradients added.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& z, const ConstView<S>& d_zH, Matrix<S>* d_z, Policy policy = {}) {
+    up_.backward(z, d_zH, &d_logits_, d_z, policy);
+    if (kind_ == UpsamplingKind::table) {
+      auto g = store_->gradient(logits_off_, up_.hr_points(), up_.neighbors());
+      g += d_logits_;
+      return;
+    }
+    const Index MK = up_.hr_points() * up_.neighbors();
+    const ConstView<S> d_col(Eigen::Map<const Matrix<S>>(d_logits_.data(), MK, 1));
+    mlp_->backward(query_, logits_, d_col, nullptr, policy);
+  }
+
+  /// Inference: weights from f_θ in eval mode (running BatchNorm statistics), once.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void precompute_weights(Policy policy = {}) {
+    compute_logits(Mode::eval, policy);
+    NeighborUpsample<S>::softmax_rows(logits_view(), weights_, policy);
+    precomputed_ = true;
+  }
+  bool has_precomputed_weights() const { return precomputed_; }
+  /// Forgets the precomputed weights (call after the parameters change).
+  void invalidate() { precomputed_ = false; }
+
+  /// Inference gather with the precomputed weights: zH = W·z per batch item.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void apply(const ConstView<S>& z, Matrix<S>& zH, Policy policy = {}) const {
+    if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::apply: call precompute_weights() first");
+    up_.apply(weights_, z, zH, policy);
+  }
+
+  /// The precomputed upsampling as an M×N sparse matrix (duplicate neighbours summed).
+  SparseMatrix sparse_matrix() const {
+    if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::sparse_matrix: call precompute_weights() first");
+    std::vector<Eigen::Triplet<S>> t;
+    const Index M = up_.hr_points(), K = up_.neighbors();
+    t.reserve(std::size_t(M * K));
+    for (Index j = 0; j < M; ++j)
+      for (Index i = 0; i < K; ++i) t.emplace_back(j, up_.indices()(j, i), weights_(j, i));
+    SparseMatrix W(M, up_.lr_points());
+    W.setFromTriplets(t.begin(), t.end());
+    return W;
+  }
+
+ private:
+  template <class Policy>
+  void compute_logits(Mode mode, Policy policy) {
+    if (kind_ == UpsamplingKind::table) {
+      const Index M = up_.hr_points(), K = up_.neighbors();
+      ensure_shape(logits_, M * K, 1);
+      Eigen::Map<Matrix<S>>(logits_.data(), M, K) = std::as_const(*store_).value(logits_off_, M, K);
+      return;
+    }
+    mlp_->forward(mode, query_, logits_, policy);
+  }
+  /// The (M·upK)×1 logits seen as M×upK (row-major: the same memory).
+  ConstView<S> logits_view() const { return Eigen::Map<const Matrix<S>>(logits_.data(), up_.hr_points(), up_.neighbors()); }
+
+  UpsamplingKind kind_;
+  Matrix<S> query_;
+  NeighborUpsample<S> up_;
+  ParameterStore<S>* store_;
+  Index logits_off_ = -1;
+  std::unique_ptr<Mlp<S>> mlp_;
+  Matrix<S> logits_, d_logits_, weights_;
+  bool precomputed_ = false;
+};
+
+}  // namespace simsr::nn

@@ -1,0 +1,218 @@
+#pragma once
+/// \file
+/// The feature encoding network of §3.1 (SPEC §7, the official `FeatEmb`): S = 2 submodules,
+/// each an EdgeConv (graph of block 0 = geodesic kNN on the LR mesh, later blocks = dynamic kNN
+/// in feature space) whose output e is pooled to global max and mean features, then
+/// `fc_out`(cat(h, e, max, mean)); block s feeds block s+1, and the code is z = [h⁰, h¹, …, h^S].
+///
+///     nn::FeatureEmbedding<float> fe(store, "net_feat_emb", cfg, N, lr_graph, rng);
+///     fe.forward(nn::Mode::train, h0, z);   // (B·N)×35 → (B·N)×227
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "concat.hpp"
+#include "dropout.hpp"
+#include "edge_conv.hpp"
+#include "mlp.hpp"
+#include "network_config.hpp"
+#include "pooling.hpp"
+
+namespace simsr::nn {
+
+/// One submodule (`blocks.<b>`): (B·N)×in → (B·N)×out.
+template <class S = float>
+class EmbeddingBlock {
+ public:
+  using scalar_type = S;
+
+  /// `graph`: N×k fixed graph (block 0) or nullptr for a dynamic feature-space graph.
+  EmbeddingBlock(ParameterStore<S>& store, const std::string& prefix, const NetworkConfig& cfg, Index in, Index out, Index n_points,
+                 const GraphIndices* graph, Rng& rng)
+      : in_(in), out_(out), n_(n_points),
+        edge_(store, prefix, in, out, cfg.knn, rng, edge_options(cfg)),
+        gmax_(PoolKind::max, n_points), gmean_(PoolKind::mean, n_points), cat_({in, out, out, out}),
+        fc_out_(store, prefix + ".fc_out", fc_out_stages(cfg, in, out), rng) {
+    if (graph)
+      edge_.set_graph(*graph, n_points);
+    else
+      edge_.use_dynamic_graph(n_points);
+  }
+
+  Index out_features(Index = -1) const { return out_; }
+  EdgeConv<S>& edge_conv() { return edge_; }
+  Mlp<S>& fc_out() { return fc_out_; }
+
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode mode, const ConstView<S>& h, Matrix<S>& out, Policy policy = {}) {
+    edge_.forward(mode, h, e_, policy);
+    gmax_.forward(mode, e_, max_, policy);
+    gmean_.forward(mode, e_, mean_, policy);
+    cat_.forward({h, e_, max_, mean_}, cat_out_, policy);
+    fc_out_.forward(mode, cat_out_, out, policy);
+  }
+
+  /// d_h written when not null (the block's input gradient, all paths summed).
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& h, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_h, Policy policy = {}) {
+    fc_out_.backward(cat_out_, out, d_out, &d_cat_, policy);
+    cat_.backward(d_cat_, {&d_h_direct_, &d_e_, &d_max_, &d_mean_}, false, policy);
+    gmax_.backward(e_, max_, d_max_, &d_e_part_, policy);
+    d_e_ += d_e_part_;
+    gmean_.backward(e_, mean_, d_mean_, &d_e_part_, policy);
+    d_e_ += d_e_part_;
+    if (!d_h) {
+      edge_.backward(h, e_, d_e_, nullptr, policy);
+      return;
+    }
+    edge_.backward(h, e_, d_e_, d_h, policy);
+    *d_h += d_h_direct_;
+  }
+
+  static typename EdgeConv<S>::Options edge_options(const NetworkConfig& cfg) {
+    typename EdgeConv<S>::Options o;
+    o.slope = static_cast<S>(cfg.leaky_relu_slope);
+    o.bn.eps = cfg.batchnorm_eps;
+    o.bn.momentum = cfg.batchnorm_momentum;
+    o.edge_mlp = cfg.edge_batch_norm ? EdgeConv<S>::EdgeMlp::official : EdgeConv<S>::EdgeMlp::single_linear;
+    return o;
+  }
+
+  /// fc_out: in+3·out → 3·out → 2·out → out (each with LeakyReLU, BatchNorm before it in the
+  /// official profile, which has no biases) → out (linear). Official Sequential indices 0,1,3,4,6,7,9;
+  /// without BatchNorm 0,2,4,6.
+  static std::vector<MlpStage> fc_out_stages(const NetworkConfig& cfg, Index in, Index out) {
+    const Index dims[] = {in + 3 * out, 3 * out, 2 * out, out, out};
+    const bool bn = cfg.fc_out_batch_norm;
+    const typename BatchNorm1d<float>::Options bno{.eps = cfg.batchnorm_eps, .momentum = cfg.batchnorm_momentum};
+    std::vector<MlpStage> st;
+    int idx = 0;
+    for (int l = 0; l < 4; ++l) {
+      MlpStage s = MlpStage::linear(dims[l], dims[l + 1], std::to_string(idx++));
+      if (bn) s.no_bias();
+      if (l < 3) {
+        if (bn) s.norm(std::to_string(idx++), bno);
+        s.then(Act::leaky_relu, cfg.leaky_relu_slope);
+        ++idx;
+      }
+      st.push_back(s);
+    }
+    return st;
+  }
+
+ private:
+  Index in_, out_, n_;
+  EdgeConv<S> edge_;
+  GroupPool<S> gmax_, gmean_;
+  Concat<S> cat_;
+  Mlp<S> fc_out_;
+  Matrix<S> e_, max_, mean_, cat_out_, d_cat_, d_h_direct_, d_e_, d_max_, d_mean_, d_e_part_;
+};
+
+/// The blocks, their dropout and the code z = [h⁰, h¹, …] ((B·N)×latent_dim). The official module
+/// also builds `fc_initial` (Linear 3→D, LeakyReLU, Linear D→D) and never calls it; it is
+/// registered (cfg.profile == "official") so the state dict loads, and gets no gradient.
+template <class S = float>
+class FeatureEmbedding {
+ public:
+  using scalar_type = S;
+
+  FeatureEmbedding(ParameterStore<S>& store, const std::string& prefix, const NetworkConfig& cfg, Index n_points,
+                   const GraphIndices& lr_graph, Rng& rng)
+      : n_(n_points), dims_(cfg.emb_feat_dims) {
+    if (lr_graph.rows() != n_points || lr_graph.cols() < cfg.knn)
+      throw ShapeError("nn::FeatureEmbedding: LR graph (N×k, at least k = " + std::to_string(cfg.knn) + " columns)", {n_points, cfg.knn},
+                       {lr_graph.rows(), lr_graph.cols()});
+    graph_ = lr_graph.leftCols(cfg.knn);
+    const Index S_blocks = Index(dims_.size()) - 1;
+    for (Index b = 0; b < S_blocks; ++b) {
+      blocks_.push_back(std::make_unique<EmbeddingBlock<S>>(store, prefix + ".blocks." + std::to_string(b), cfg, dims_[std::size_t(b)],
+                                                            dims_[std::size_t(b + 1)], n_points, b == 0 ? &graph_ : nullptr, rng));
+      drops_.push_back(std::make_unique<Dropout<S>>(cfg.dropout, Rng(rng())));
+    }
+    if (cfg.profile == "official") {
+      const Index d = cfg.pos_feat_dim;
+      fc_initial_ = std::make_unique<Mlp<S>>(
+          store, prefix + ".fc_initial",
+          std::vector<MlpStage>{MlpStage::linear(3, d, "0").dims(0).then(Act::leaky_relu, cfg.leaky_relu_slope), MlpStage::linear(d, d, "2").dims(0)},
+          rng);
+    }
+    std::vector<Index> widths(dims_.begin(), dims_.end());
+    cat_ = std::make_unique<Concat<S>>(widths);
+    h_.resize(std::size_t(S_blocks));
+    pre_drop_.resize(std::size_t(S_blocks));
+    d_h_.resize(std::size_t(S_blocks));
+  }
+
+  Index blocks() const { return Index(blocks_.size()); }
+  EmbeddingBlock<S>& block(Index b) { return *blocks_.at(std::size_t(b)); }
+  Index out_features(Index = -1) const { return cat_->out_features(); }
+  /// h^{s+1}, the output of block s after its dropout, from the last forward.
+  const Matrix<S>& block_output(Index s) const { return h_.at(std::size_t(s)); }
+
+  /// h0: (B·N)×D₀ → z = [h0, h¹, …] (B·N)×Σ D.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode mode, const ConstView<S>& h0, Matrix<S>& z, Policy policy = {}) {
+    const ConstView<S>* x = &h0;
+    std::optional<ConstView<S>> xv;
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      blocks_[b]->forward(mode, *x, pre_drop_[b], policy);
+      drops_[b]->forward(mode, pre_drop_[b], h_[b], policy);
+      xv.emplace(h_[b]);
+      x = &*xv;
+    }
+    concat_forward(h0, z, policy);
+  }
+
+  /// d_z: gradient of z; parameter gradients added (h0 needs none: it is data).
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& h0, const ConstView<S>& d_z, Policy policy = {}) {
+    const std::size_t nb = blocks_.size();
+    split(d_z, policy);
+    for (std::size_t b = nb; b-- > 0;) {
+      drops_[b]->backward(pre_drop_[b], h_[b], d_h_[b], &d_pre_, policy);
+      const ConstView<S> in = b == 0 ? h0 : ConstView<S>(h_[b - 1]);
+      if (b == 0) {
+        blocks_[b]->backward(in, pre_drop_[b], d_pre_, nullptr, policy);
+      } else {
+        blocks_[b]->backward(in, pre_drop_[b], d_pre_, &d_in_, policy);
+        d_h_[b - 1] += d_in_;
+      }
+    }
+  }
+
+ private:
+  template <class Policy>
+  void concat_forward(const ConstView<S>& h0, Matrix<S>& z, Policy policy) {
+    switch (blocks_.size()) {
+      case 1: cat_->forward({h0, h_[0]}, z, policy); break;
+      case 2: cat_->forward({h0, h_[0], h_[1]}, z, policy); break;
+      case 3: cat_->forward({h0, h_[0], h_[1], h_[2]}, z, policy); break;
+      case 4: cat_->forward({h0, h_[0], h_[1], h_[2], h_[3]}, z, policy); break;
+      default: throw ArgumentError("nn::FeatureEmbedding: 1 to 4 blocks are supported");
+    }
+  }
+  template <class Policy>
+  void split(const ConstView<S>& d_z, Policy policy) {
+    switch (blocks_.size()) {
+      case 1: cat_->backward(d_z, {nullptr, &d_h_[0]}, false, policy); break;
+      case 2: cat_->backward(d_z, {nullptr, &d_h_[0], &d_h_[1]}, false, policy); break;
+      case 3: cat_->backward(d_z, {nullptr, &d_h_[0], &d_h_[1], &d_h_[2]}, false, policy); break;
+      case 4: cat_->backward(d_z, {nullptr, &d_h_[0], &d_h_[1], &d_h_[2], &d_h_[3]}, false, policy); break;
+      default: throw ArgumentError("nn::FeatureEmbedding: 1 to 4 blocks are supported");
+    }
+  }
+
+  Index n_;
+  std::vector<Index> dims_;
+  GraphIndices graph_;
+  std::vector<std::unique_ptr<EmbeddingBlock<S>>> blocks_;
+  std::vector<std::unique_ptr<Dropout<S>>> drops_;
+  std::unique_ptr<Mlp<S>> fc_initial_;
+  std::unique_ptr<Concat<S>> cat_;
+  std::vector<Matrix<S>> h_, pre_drop_, d_h_;
+  Matrix<S> d_pre_, d_in_;
+};
+
+}  // namespace simsr::nn

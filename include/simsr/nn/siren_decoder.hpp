@@ -1,0 +1,65 @@
+#pragma once
+/// \file
+/// The surface reconstruction network of §3.3 (SPEC §7 `decoder`): a SIREN over the upsampled
+/// code, dims[0] → … → dims[-2] with sin(ω₀·) (ω₀ = w0_initial on the first layer, w0 after),
+/// then a linear dims[-2] → 3 (`last_layer`). The official SirenNet also builds a sixth sine layer
+/// dims[-2] → dims[-1] that its forward never calls (zip over five ω₀ values): with
+/// `decoder_dead_layer` it is registered (and initialized) in its state-dict place so official
+/// weights load; it gets no gradient.
+///
+/// Names: `<prefix>.layers.<i>.fc.{weight,bias}` (nn.Linear), `<prefix>.last_layer.fc.*`.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mlp.hpp"
+#include "network_config.hpp"
+
+namespace simsr::nn {
+
+template <class S = float>
+class SirenDecoder {
+ public:
+  using scalar_type = S;
+
+  SirenDecoder(ParameterStore<S>& store, const std::string& prefix, const NetworkConfig& cfg, Rng& rng) {
+    const auto& d = cfg.decoder_dims;
+    if (d.size() < 3) throw ArgumentError("nn::SirenDecoder: decoder_dims needs at least one hidden width (in, hidden…, 3)");
+    const std::size_t hidden = d.size() - 2;
+    std::vector<MlpStage> st;
+    for (std::size_t i = 0; i < hidden; ++i) {
+      const double w0 = i == 0 ? cfg.w0_initial : cfg.w0;
+      st.push_back(MlpStage::linear(d[i], d[i + 1], "layers." + std::to_string(i) + ".fc").dims(0).siren(i == 0, w0).then(Act::sine, w0));
+    }
+    sines_ = std::make_unique<Mlp<S>>(store, prefix, st, rng);
+    if (cfg.decoder_dead_layer)
+      dead_ = std::make_unique<Mlp<S>>(
+          store, prefix,
+          std::vector<MlpStage>{MlpStage::linear(d[hidden], d[hidden + 1], "layers." + std::to_string(hidden) + ".fc").dims(0).siren(false, cfg.w0)},
+          rng);
+    last_ = std::make_unique<Mlp<S>>(
+        store, prefix, std::vector<MlpStage>{MlpStage::linear(d[hidden], d[hidden + 1], "last_layer.fc").dims(0).siren(false, cfg.w0)}, rng);
+  }
+
+  Index in_features() const { return sines_->in_features(); }
+  Index out_features(Index = -1) const { return last_->out_features(); }
+
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode mode, const ConstView<S>& zH, Matrix<S>& out, Policy policy = {}) {
+    sines_->forward(mode, zH, hidden_, policy);
+    last_->forward(mode, hidden_, out, policy);
+  }
+
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& zH, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_zH, Policy policy = {}) {
+    last_->backward(hidden_, out, d_out, &d_hidden_, policy);
+    sines_->backward(zH, hidden_, d_hidden_, d_zH, policy);
+  }
+
+ private:
+  std::unique_ptr<Mlp<S>> sines_, dead_, last_;
+  Matrix<S> hidden_, d_hidden_;
+};
+
+}  // namespace simsr::nn

@@ -1,0 +1,177 @@
+#pragma once
+/// \file
+/// The whole super-resolution network (paper §3, Fig. 2; SPEC §7): LR displacements →
+/// h⁰ = [Δx, PE] → feature encoding → z (N×Σ D) → coordinate-based upsampling → z^H (M×Σ D) →
+/// SIREN reconstruction → HR displacements, all in the official normalized units (Δx/σ).
+/// One class serves both profiles and the ablations: NetworkConfig says which parts exist.
+///
+///     nn::SuperResolutionNet<float> net(nn::NetworkConfig::official(), geometry, rng);
+///     net.forward(nn::Mode::train, ldx, pred, exec::omp);   // ldx (B·N)×3 → pred (B·M)×3
+///     net.backward(d_pred, &d_z_reg, exec::omp);            // gradients into net.store()
+///     net.prepare_inference(exec::omp);                      // upsampling weights, once
+///     net.infer(ldx, pred, exec::omp);                       // eval mode, sparse upsampling
+///
+/// State-dict names are the official ones (`net_feat_emb.*`, `net_upscale.*`, `net_decoder.*`),
+/// registered in PyTorch's order, so ParameterStore::entries() is the official state dict.
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <Eigen/SparseCore>
+
+#include "coordinate_upsampling.hpp"
+#include "feature_embedding.hpp"
+#include "positional_encoding.hpp"
+#include "siren_decoder.hpp"
+
+namespace simsr::nn {
+
+/// What the network needs of the two meshes (raw units; nothing normalized yet).
+struct NetworkGeometry {
+  Points<double> lr_rest;      ///< N×3 LR rest positions
+  Points<double> hr_rest;      ///< M×3 HR rest positions
+  GraphIndices lr_graph;       ///< N×(≥ knn) LR geodesic neighbours, self first (EdgeConv graph 1)
+  GraphIndices up_indices;     ///< M×(≥ upK) LR neighbours of each HR vertex, nearest first
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> up_distances;  ///< M×(≥ upK), raw units
+  /// M×N embedding (barycentric) matrix: needed only with cfg.residual.
+  Eigen::SparseMatrix<double, Eigen::RowMajor> embedding;
+};
+
+template <class S = float>
+class SuperResolutionNet {
+ public:
+  using scalar_type = S;
+
+  SuperResolutionNet(NetworkConfig cfg, const NetworkGeometry& geo, Rng& rng) : cfg_(std::move(cfg)) {
+    cfg_.validate();
+    const Index N = geo.lr_rest.rows(), M = geo.hr_rest.rows();
+    if (N < 2 || M < 1) throw ArgumentError("nn::SuperResolutionNet: needs N >= 2 LR and M >= 1 HR vertices");
+    if (geo.up_indices.rows() != M || geo.up_indices.cols() < cfg_.up_k)
+      throw ShapeError("nn::SuperResolutionNet: up_indices (M×≥upK)", {M, cfg_.up_k}, {geo.up_indices.rows(), geo.up_indices.cols()});
+    if (geo.up_distances.rows() != M || geo.up_distances.cols() < cfg_.up_k)
+      throw ShapeError("nn::SuperResolutionNet: up_distances (M×≥upK)", {M, cfg_.up_k}, {geo.up_distances.rows(), geo.up_distances.cols()});
+    if (cfg_.feature_embedding && cfg_.knn >= N) throw ArgumentError("nn::SuperResolutionNet: knn must be < N");
+    for (Index i = 0; i < geo.lr_rest.size(); ++i)
+      if (!std::isfinite(geo.lr_rest.data()[i])) throw ArgumentError("nn::SuperResolutionNet: LR rest position " + std::to_string(i / 3) + " is not finite");
+    for (Index i = 0; i < geo.hr_rest.size(); ++i)
+      if (!std::isfinite(geo.hr_rest.data()[i])) throw ArgumentError("nn::SuperResolutionNet: HR rest position " + std::to_string(i / 3) + " is not finite");
+    n_ = N;
+    m_ = M;
+    lr_n_ = normalize_positions<S>(geo.lr_rest, cfg_.norm_mean, cfg_.norm_std);
+    hr_n_ = normalize_positions<S>(geo.hr_rest, cfg_.norm_mean, cfg_.norm_std);
+    pe_ = std::make_unique<PositionalEncoding<S>>(N, cfg_.pos_feat_dim);
+    if (cfg_.feature_embedding) fe_ = std::make_unique<FeatureEmbedding<S>>(store_, "net_feat_emb", cfg_, N, geo.lr_graph, rng);
+    const GraphIndices idx = geo.up_indices.leftCols(cfg_.up_k);
+    up_ = std::make_unique<CoordinateUpsampling<S>>(store_, "net_upscale", cfg_,
+                                                    upsampling_query<S>(hr_n_, lr_n_, idx, geo.up_distances.leftCols(cfg_.up_k)), idx, N, rng);
+    decoder_ = std::make_unique<SirenDecoder<S>>(store_, "net_decoder.decoder", cfg_, rng);
+    if (cfg_.residual) {
+      if (geo.embedding.rows() != M || geo.embedding.cols() != N)
+        throw ShapeError("nn::SuperResolutionNet: residual needs the M×N embedding matrix", {M, N}, {geo.embedding.rows(), geo.embedding.cols()});
+      embedding_ = geo.embedding.template cast<S>();
+    }
+  }
+
+  SuperResolutionNet(const SuperResolutionNet&) = delete;
+  SuperResolutionNet& operator=(const SuperResolutionNet&) = delete;
+
+  const NetworkConfig& config() const { return cfg_; }
+  ParameterStore<S>& store() { return store_; }
+  const ParameterStore<S>& store() const { return store_; }
+  Index lr_points() const { return n_; }
+  Index hr_points() const { return m_; }
+  Index latent_dim() const { return cfg_.latent_dim(); }
+  const Matrix<S>& lr_rest_normalized() const { return lr_n_; }
+  const Matrix<S>& hr_rest_normalized() const { return hr_n_; }
+  CoordinateUpsampling<S>& upsampling() { return *up_; }
+  const CoordinateUpsampling<S>& upsampling() const { return *up_; }
+  /// The feature embedding (ArgumentError in the w/o-FE ablation).
+  FeatureEmbedding<S>& feature_embedding() {
+    if (!fe_) throw ArgumentError("nn::SuperResolutionNet: this network has no feature embedding (w/o FE)");
+    return *fe_;
+  }
+  bool has_feature_embedding() const { return bool(fe_); }
+  /// The LR code z = [h⁰, h¹, …] of the last forward ((B·N)×latent_dim) and its upsampling z^H.
+  const Matrix<S>& code() const { return fe_ ? z_ : h0_; }
+  const Matrix<S>& hr_code() const { return zh_; }
+
+  /// Training (or eval-mode) forward: ldx (B·N)×3 normalized LR displacements → pred (B·M)×3
+  /// normalized HR displacements. f_θ runs once per call, whatever B.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void forward(Mode mode, const ConstView<S>& ldx, Matrix<S>& pred, Policy policy = {}) {
+    encode(mode, ldx, policy);
+    up_->forward(mode, code(), zh_, policy);
+    decode(mode, ldx, pred, policy);
+  }
+
+  /// After forward: d_pred (B·M)×3 → parameter gradients (added to the store; zero_grad first).
+  /// `d_code`, when given, is an extra gradient on z (the latent regularizer's).
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& d_pred, const Matrix<S>* d_code = nullptr, Policy policy = {}) {
+    detail::check_shape("nn::SuperResolutionNet", "prediction gradient", d_pred, zh_.rows(), 3);
+    decoder_->backward(zh_, pred_ref(), d_pred, &d_zh_, policy);
+    up_->backward(code(), d_zh_, &d_z_, policy);
+    if (d_code) {
+      detail::check_shape("nn::SuperResolutionNet", "code gradient", *d_code, d_z_.rows(), d_z_.cols());
+      d_z_ += *d_code;
+    }
+    if (fe_) fe_->backward(h0_, d_z_, policy);
+    up_->invalidate();
+  }
+
+  /// Computes the upsampling weights from the rest shapes (eval mode) for infer().
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void prepare_inference(Policy policy = {}) {
+    up_->precompute_weights(policy);
+  }
+
+  /// Inference: eval mode with the precomputed upsampling (prepare_inference first).
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void infer(const ConstView<S>& ldx, Matrix<S>& pred, Policy policy = {}) {
+    if (!up_->has_precomputed_weights()) prepare_inference(policy);
+    encode(Mode::eval, ldx, policy);
+    up_->apply(code(), zh_, policy);
+    decode(Mode::eval, ldx, pred, policy);
+  }
+
+  /// Drops precomputed upsampling weights (after loading or changing parameters).
+  void parameters_changed() { up_->invalidate(); }
+
+ private:
+  template <class Policy>
+  void encode(Mode mode, const ConstView<S>& ldx, Policy policy) {
+    detail::check_shape("nn::SuperResolutionNet", "LR displacements ((B·N)×3)", ldx, -1, 3);
+    if (ldx.rows() == 0 || ldx.rows() % n_)
+      throw ShapeError("nn::SuperResolutionNet: LR displacements (B·" + std::to_string(n_) + " rows)", {-1, 3}, {ldx.rows(), ldx.cols()});
+    pe_->forward(mode, ldx, h0_, policy);
+    if (fe_) fe_->forward(mode, h0_, z_, policy);
+  }
+  template <class Policy>
+  void decode(Mode mode, const ConstView<S>& ldx, Matrix<S>& pred, Policy policy) {
+    decoder_->forward(mode, zh_, pred, policy);
+    pred_ = &pred;
+    if (cfg_.residual) {
+      const Index B = ldx.rows() / n_;
+      for (Index b = 0; b < B; ++b) pred.middleRows(b * m_, m_).noalias() += embedding_ * ldx.middleRows(b * n_, n_);
+    }
+  }
+  ConstView<S> pred_ref() const {
+    if (!pred_) throw ArgumentError("nn::SuperResolutionNet::backward: needs a forward first");
+    return *pred_;
+  }
+
+  NetworkConfig cfg_;
+  ParameterStore<S> store_;
+  Index n_ = 0, m_ = 0;
+  Matrix<S> lr_n_, hr_n_;
+  std::unique_ptr<PositionalEncoding<S>> pe_;
+  std::unique_ptr<FeatureEmbedding<S>> fe_;
+  std::unique_ptr<CoordinateUpsampling<S>> up_;
+  std::unique_ptr<SirenDecoder<S>> decoder_;
+  Eigen::SparseMatrix<S, Eigen::RowMajor> embedding_;
+  Matrix<S> h0_, z_, zh_, d_zh_, d_z_;
+  const Matrix<S>* pred_ = nullptr;
+};
+
+}  // namespace simsr::nn
