@@ -6,6 +6,7 @@
 #include "activations.hpp"
 #include "adam.hpp"
 #include "batch_norm.hpp"
+#include "beta_vae.hpp"
 #include "concat.hpp"
 #include "dropout.hpp"
 #include "edge_conv.hpp"
