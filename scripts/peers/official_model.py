@@ -11,7 +11,7 @@ official checkpoint (`net_feat_emb`, `net_upscale`, `net_decoder`) load with str
 Run with Debian's /usr/bin/python3 (python3-torch, numpy):
 
     official_model.py --count                       # 706871 parameters at the defaults
-    official_model.py --export DIR [--data-dir D]   # DIR/state_dict.npz, DIR/io.npz (fixtures)
+    official_model.py --export DIR [--data-dir D] [--checkpoint X.pth]   # DIR/state_dict.npz, DIR/io.npz
     official_model.py --make-checkpoint X.pth [--steps 1]   # a checkpoint saved as train.py does
 
 Facts (official file in brackets):
@@ -162,12 +162,36 @@ def load_bunny(data_dir, knn=5, upk=10):
     }
 
 
-def displacements(positions, rest):
+def displacements(positions, rest, dtype=np.float32):
     """Official inputs/targets: positions and rest parsed to float32, normalized in float32, then
-    subtracted (dataset.py). positions: (..., n, 3), rest: (n, 3)."""
-    p = torch.from_numpy(np.asarray(positions, dtype=np.float32))
-    r = torch.from_numpy(np.asarray(rest, dtype=np.float32))
+    subtracted (dataset.py). positions: (..., n, 3), rest: (n, 3). dtype=np.float64 gives the
+    same pipeline in double (the double-precision interop fixtures)."""
+    p = torch.from_numpy(np.asarray(positions, dtype=dtype))
+    r = torch.from_numpy(np.asarray(rest, dtype=dtype))
     return normalize(p) - normalize(r)
+
+
+def to_float64(model, data):
+    """The model in double precision: parameters and buffers, and the rest shapes, the upsampling
+    query and the positional encoding recomputed in float64."""
+    model.double()
+    cfg = model.cfg
+    model.lr_rest_n = normalize(torch.from_numpy(np.asarray(data["lr_rest"], dtype=np.float64)))
+    model.hr_rest_n = normalize(torch.from_numpy(np.asarray(data["hr_rest"], dtype=np.float64)))
+    idx = torch.as_tensor(data["up_indices"][:, : cfg["upK"]], dtype=torch.long)
+    dist = torch.as_tensor(data["up_distances"][:, : cfg["upK"]], dtype=torch.float64)
+    M, K = idx.shape
+    query = torch.cat((model.hr_rest_n[:, None, :].expand(M, K, 3), model.lr_rest_n[idx], dist[..., None]), dim=-1)
+    model.up_query = query
+    model.net_upscale.query = query.permute(2, 0, 1).unsqueeze(0).contiguous()
+    n, dim = model.pos_emb.shape
+    i = torch.arange(0, n, dtype=torch.float64).unsqueeze(1)
+    freq = 10000 ** (torch.arange(0, dim, step=2, dtype=torch.float64) / dim)
+    pe = torch.empty(n, dim, dtype=torch.float64)
+    pe[:, 0::2] = torch.sin(i / freq)
+    pe[:, 1::2] = torch.cos(i / freq)
+    model.pos_emb = pe  # the table in double (a float32 table differs by up to 6e-5 at i ~ 1700)
+    return model
 
 
 # ----------------------------------------------------------------------------------------------
@@ -464,15 +488,23 @@ def train_step(model, data, ldx, hdx, optimizer):
     return pred, losses
 
 
-def export(out_dir, data_dir, seed=0, n_frames=2):
+def export(out_dir, data_dir, seed=0, n_frames=2, checkpoint=None, dtype="float32"):
     """Fixtures for an interop test: DIR/state_dict.npz (initial weights, full names) and DIR/io.npz
-    (inputs, intermediates, outputs and losses of an eval-mode forward and of one training step)."""
+    (inputs, intermediates, outputs and losses of an eval-mode forward and of one training step).
+    With `checkpoint` (an official .pth), its weights replace the seeded initial ones. With
+    dtype "float64" everything runs in double (gradients of BatchNorm-projected layers are sums of
+    cancelling terms: float32 runs agree only to ~1e-3 there, double runs to rounding)."""
     torch.set_num_threads(2)
     os.makedirs(out_dir, exist_ok=True)
     model, data = build_bunny_model(data_dir, seed)
+    if checkpoint:
+        model.load_official_state_dicts(torch.load(checkpoint, map_location="cpu"), strict=True)
+    npdtype = np.float64 if dtype == "float64" else np.float32
+    if dtype == "float64":
+        to_float64(model, data)
     lows, highs, frames = bunny_frames(data_dir, n_frames)
-    ldx = displacements(lows, data["lr_rest"])
-    hdx = displacements(highs, data["hr_rest"])
+    ldx = displacements(lows, data["lr_rest"], npdtype)
+    hdx = displacements(highs, data["hr_rest"], npdtype)
 
     init = full_state_dict(model)
     np.savez(os.path.join(out_dir, "state_dict.npz"), **{k: v.numpy() for k, v in init.items()})
@@ -504,7 +536,7 @@ def export(out_dir, data_dir, seed=0, n_frames=2):
         io[prefix + "/hdx_pred"] = pred.detach().numpy()
         io[prefix + "/dx_pred"] = unnormalize_displacement(pred.detach().double()).numpy()
         for k, v in losses.items():
-            io[prefix + "/loss_" + k] = np.float32(v.item())
+            io[prefix + "/loss_" + k] = np.float64(v.item())
 
     model.eval()
     with torch.no_grad():
@@ -555,6 +587,8 @@ def main(argv=None):
     ap.add_argument("--export", metavar="DIR", help="write DIR/state_dict.npz and DIR/io.npz")
     ap.add_argument("--make-checkpoint", metavar="PTH", help="save a checkpoint as the official train.py does")
     ap.add_argument("--steps", type=int, default=1, help="Adam steps before --make-checkpoint saves")
+    ap.add_argument("--checkpoint", help="--export: start from this official checkpoint's weights")
+    ap.add_argument("--dtype", choices=("float32", "float64"), default="float32", help="--export: precision of the run")
     ap.add_argument("--data-dir", default=DEFAULT_DATA_DIR)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
@@ -567,7 +601,7 @@ def main(argv=None):
     if args.count:
         print(count_parameters(build_geometry_free_model()))
     if args.export:
-        export(args.export, args.data_dir, args.seed)
+        export(args.export, args.data_dir, args.seed, checkpoint=args.checkpoint, dtype=args.dtype)
     if args.make_checkpoint:
         make_checkpoint(args.make_checkpoint, args.data_dir, args.seed, args.steps)
     return 0

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <string>
 #include <type_traits>
+#include <Eigen/Geometry>
 
 #include "detail/chunks.hpp"
 #include "graph_features.hpp"

@@ -69,9 +69,11 @@ struct NetworkConfig {
   Index batch_size = 32;
   Index epochs = 200;
   double w_recon = 10.0;
-  bool recon_divide_by_batch = true;       ///< official: L1Loss(mean)/B; paper Eq. 4: plain
+  bool recon_divide_by_batch = true;       ///< official: L1Loss(mean)/B (its quirk, kept)
   double w_fn = 1e-3;                      ///< α of Eq. 7
-  bool fn_mean = true;                     ///< mean over faces (official) or sum (Eq. 5)
+  /// false (official): every term a mean over its entries; true (paper Eq. 4–6): sums over the
+  /// HR vertices, faces and LR points of an item, averaged over the batch items.
+  bool sum_reductions = false;
   LatentRegularizer zreg = LatentRegularizer::mean_abs;
   double w_zreg = 2.0;                     ///< official weight; ramped_norm uses zreg_start→zreg_end
   double zreg_start = 0.001, zreg_end = 20.0;
@@ -99,6 +101,7 @@ struct NetworkConfig {
     c.lr = 1e-4;
     c.w_recon = 1.0;
     c.recon_divide_by_batch = false;
+    c.sum_reductions = true;
     c.zreg = LatentRegularizer::ramped_norm;
     return c;
   }
@@ -181,7 +184,7 @@ struct NetworkConfig {
     j["w_recon"] = w_recon;
     j["recon_divide_by_batch"] = recon_divide_by_batch;
     j["w_fn"] = w_fn;
-    j["fn_mean"] = fn_mean;
+    j["sum_reductions"] = sum_reductions;
     j["zreg"] = zreg == LatentRegularizer::mean_abs ? "mean_abs" : zreg == LatentRegularizer::mean_square ? "mean_square" : "ramped_norm";
     j["w_zreg"] = w_zreg;
     j["zreg_start"] = zreg_start;
@@ -259,7 +262,7 @@ struct NetworkConfig {
     get("w_recon", c.w_recon);
     get("recon_divide_by_batch", c.recon_divide_by_batch);
     get("w_fn", c.w_fn);
-    get("fn_mean", c.fn_mean);
+    get("sum_reductions", c.sum_reductions);
     get_enum("zreg", c.zreg, [](const std::string& s) {
       if (s == "mean_abs") return LatentRegularizer::mean_abs;
       if (s == "mean_square") return LatentRegularizer::mean_square;

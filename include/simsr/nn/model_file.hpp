@@ -1,0 +1,207 @@
+#pragma once
+/// \file
+/// A trained network as one self-contained `.npz` (SPEC §7 "Weights are saved as .npz"): every
+/// tensor under its PyTorch state-dict name and shape (float32; `num_batches_tracked` int64 0-d),
+/// the config as 0-d unicode JSON, and everything inference needs — rest shapes, LR tets, HR
+/// faces, neighbourhoods, normalization (and the embedding for the residual option). The layout is
+/// the one scripts/torch_to_simsr.py writes from an official PyTorch checkpoint, so either loads.
+///
+///     nn::ModelData data = nn::read_model_data("model.npz");         // config + geometry
+///     nn::SuperResolutionNet<float> net(data.config, data.geometry, rng);
+///     nn::load_state(net.store(), nn::read_model_arrays("model.npz"));  // strict, as PyTorch's
+///     nn::save_model("copy.npz", net, data);
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "../io/npz.hpp"
+#include "super_resolution_net.hpp"
+
+namespace simsr::nn {
+
+/// What a model file holds besides the weights.
+struct ModelData {
+  NetworkConfig config;
+  NetworkGeometry geometry;
+  Tets lr_tets;   ///< T×4 LR tetrahedra (the simulation mesh)
+  Tris hr_faces;  ///< F×3 HR surface triangles
+};
+
+/// Module prefixes of state-dict tensors (everything else in the file is data).
+inline bool is_state_tensor_name(const std::string& name) {
+  for (const char* p : {"net_feat_emb.", "net_upscale.", "net_decoder."})
+    if (name.rfind(p, 0) == 0) return true;
+  return false;
+}
+
+/// The state dict of `store` as npz arrays: parameters and buffers as float32 (S cast), with
+/// num_batches_tracked as int64 (PyTorch's dtype).
+template <class S>
+void add_state(io::NpzArrays& out, const ParameterStore<S>& store) {
+  for (const auto& e : store.entries()) {
+    const auto v = store.values(e);
+    std::vector<std::int64_t> shape(e.shape.begin(), e.shape.end());
+    const bool counter = e.name.size() > 20 && e.name.compare(e.name.size() - 20, 20, "num_batches_tracked") == 0;
+    if (counter) {
+      std::vector<std::int64_t> c(v.size());
+      for (std::size_t i = 0; i < v.size(); ++i) c[i] = static_cast<std::int64_t>(v[i]);
+      out[e.name] = io::make_npy<std::int64_t>(shape, c.data());
+    } else {
+      std::vector<float> f(v.begin(), v.end());
+      out[e.name] = io::make_npy<float>(shape, f.data());
+    }
+  }
+}
+
+/// Copies the state tensors of `arrays` into `store`, strictly: every tensor of the store must be
+/// present with its exact shape, and no state tensor (module prefix) may be left over — a
+/// ShapeError / ArgumentError names the tensor. Non-finite values are rejected.
+template <class S>
+void load_state(ParameterStore<S>& store, const io::NpzArrays& arrays) {
+  std::size_t used = 0;
+  for (const auto& e : store.entries()) {
+    if (!arrays.contains(e.name)) throw ArgumentError("nn::load_state: the model file has no tensor '" + e.name + "'");
+    const io::NpyArray& a = arrays.at(e.name);
+    std::vector<Index> shape(a.shape.begin(), a.shape.end());
+    if (shape != e.shape) {
+      auto text = [](const std::vector<Index>& s) {
+        std::string t = "(";
+        for (std::size_t i = 0; i < s.size(); ++i) t += (i ? ", " : "") + std::to_string(s[i]);
+        return t + ")";
+      };
+      throw ArgumentError("nn::load_state: tensor '" + e.name + "' has shape " + text(shape) + ", the network expects " + text(e.shape));
+    }
+    const std::vector<S> v = a.to_vector<S>();
+    auto dst = store.values(e);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!std::isfinite(double(v[i])))
+        throw ArgumentError("nn::load_state: tensor '" + e.name + "' entry " + std::to_string(i) + " is not finite");
+      dst[i] = v[i];
+    }
+    ++used;
+  }
+  std::size_t state = 0;
+  for (const auto& [name, a] : arrays)
+    if (is_state_tensor_name(name)) {
+      ++state;
+      if (!store.find(name)) throw ArgumentError("nn::load_state: the model file has tensor '" + name + "', which this network does not have");
+    }
+  (void)state;
+  (void)used;
+}
+
+namespace detail {
+
+template <class T>
+Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> model_matrix(const io::NpzArrays& a, const std::string& file,
+                                                                                 const std::string& name, Index cols) {
+  if (!a.contains(name)) throw ArgumentError(file + ": the model file has no array '" + name + "'");
+  const io::NpyArray& x = a.at(name);
+  if (x.ndim() != 2 || (cols >= 0 && x.shape[1] != cols))
+    throw ShapeError(file + ": array '" + name + "'", {-1, cols}, {x.ndim() > 0 ? Index(x.shape[0]) : 0, x.ndim() > 1 ? Index(x.shape[1]) : 0});
+  return x.to_matrix<T>();
+}
+
+}  // namespace detail
+
+/// Config, geometry, tets and faces of a model file's arrays; `file` names it in errors.
+inline ModelData model_data(const io::NpzArrays& a, const std::string& file = "<model>") {
+  ModelData d;
+  if (!a.contains("config")) throw ArgumentError(file + ": the model file has no 'config'");
+  const auto cfg_text = a.at("config").to_strings();
+  if (cfg_text.size() != 1) throw ArgumentError(file + ": 'config' must be one JSON string");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(cfg_text[0]);
+  } catch (const nlohmann::json::exception& e) {
+    throw ParseError(file + ":config", 0, e.what());
+  }
+  d.config = NetworkConfig::from_json(j);
+  if (a.contains("norm_mean")) d.config.norm_mean = a.at("norm_mean").item<double>();
+  if (a.contains("norm_std")) d.config.norm_std = a.at("norm_std").item<double>();
+  d.config.validate();
+  auto& g = d.geometry;
+  g.lr_rest = detail::model_matrix<double>(a, file, "lr_rest", 3);
+  g.hr_rest = detail::model_matrix<double>(a, file, "hr_rest", 3);
+  g.lr_graph = detail::model_matrix<VIndex>(a, file, "lr_graph", -1);
+  g.up_indices = detail::model_matrix<VIndex>(a, file, "up_indices", -1);
+  g.up_distances = detail::model_matrix<double>(a, file, "up_distances", -1);
+  d.lr_tets = detail::model_matrix<VIndex>(a, file, "lr_tets", 4);
+  d.hr_faces = detail::model_matrix<VIndex>(a, file, "hr_faces", 3);
+  const Index N = g.lr_rest.rows(), M = g.hr_rest.rows();
+  if (g.lr_graph.rows() != N) throw ShapeError(file + ": 'lr_graph' (N rows)", {N, -1}, {g.lr_graph.rows(), g.lr_graph.cols()});
+  if (g.up_indices.rows() != M || g.up_distances.rows() != M || g.up_distances.cols() != g.up_indices.cols())
+    throw ShapeError(file + ": 'up_indices'/'up_distances' (M×upK)", {M, g.up_indices.cols()}, {g.up_distances.rows(), g.up_distances.cols()});
+  auto check_range = [&](const auto& m, Index n, const char* what) {
+    for (Index i = 0; i < m.size(); ++i)
+      if (m.data()[i] < 0 || m.data()[i] >= n)
+        throw ArgumentError(file + ": '" + what + "' entry " + std::to_string(i) + " = " + std::to_string(m.data()[i]) + " is outside [0, " +
+                            std::to_string(n) + ")");
+  };
+  check_range(g.lr_graph, N, "lr_graph");
+  check_range(g.up_indices, N, "up_indices");
+  check_range(d.lr_tets, N, "lr_tets");
+  check_range(d.hr_faces, M, "hr_faces");
+  if (a.contains("embedding_indptr")) {
+    const auto ptr = a.at("embedding_indptr").to_vector<std::int64_t>();
+    const auto idx = a.at("embedding_indices").to_vector<std::int64_t>();
+    const auto val = a.at("embedding_data").to_vector<double>();
+    if (Index(ptr.size()) != M + 1 || ptr.front() != 0 || std::size_t(ptr.back()) != idx.size() || idx.size() != val.size())
+      throw ArgumentError(file + ": the embedding CSR arrays are inconsistent");
+    std::vector<Eigen::Triplet<double>> t;
+    for (Index r = 0; r < M; ++r) {
+      if (ptr[std::size_t(r + 1)] < ptr[std::size_t(r)]) throw ArgumentError(file + ": embedding_indptr decreases at row " + std::to_string(r));
+      for (auto k = ptr[std::size_t(r)]; k < ptr[std::size_t(r + 1)]; ++k) {
+        if (idx[std::size_t(k)] < 0 || idx[std::size_t(k)] >= N) throw ArgumentError(file + ": embedding index out of range in row " + std::to_string(r));
+        t.emplace_back(r, idx[std::size_t(k)], val[std::size_t(k)]);
+      }
+    }
+    g.embedding.resize(M, N);
+    g.embedding.setFromTriplets(t.begin(), t.end());
+  } else if (d.config.residual) {
+    throw ArgumentError(file + ": a residual model needs the embedding arrays (embedding_indptr, embedding_indices, embedding_data)");
+  }
+  return d;
+}
+
+/// Everything in a model file (weights and data).
+inline io::NpzArrays read_model_arrays(const std::filesystem::path& path) { return io::read_npz(path); }
+inline ModelData read_model_data(const std::filesystem::path& path) { return model_data(io::read_npz(path), path.string()); }
+
+/// The model file's arrays for `net` and its data (which must be the data `net` was built from).
+template <class S>
+io::NpzArrays model_arrays(const SuperResolutionNet<S>& net, const ModelData& data) {
+  io::NpzArrays out;
+  add_state(out, net.store());
+  out["config"] = io::make_npy(std::vector<std::string>{net.config().to_json().dump()});
+  out["config"].shape.clear();  // 0-d, as np.array(json_text)
+  const auto& g = data.geometry;
+  auto i64 = [](const auto& m) { return Eigen::Matrix<std::int64_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>(m.template cast<std::int64_t>()); };
+  out["lr_rest"] = io::make_npy(g.lr_rest);
+  out["lr_tets"] = io::make_npy(i64(data.lr_tets));
+  out["hr_rest"] = io::make_npy(g.hr_rest);
+  out["hr_faces"] = io::make_npy(i64(data.hr_faces));
+  out["lr_graph"] = io::make_npy(i64(g.lr_graph));
+  out["up_indices"] = io::make_npy(i64(g.up_indices));
+  out["up_distances"] = io::make_npy(g.up_distances);
+  const double mean = net.config().norm_mean, sd = net.config().norm_std;
+  out["norm_mean"] = io::make_npy<double>({}, &mean);
+  out["norm_std"] = io::make_npy<double>({}, &sd);
+  if (g.embedding.nonZeros() > 0) {
+    Eigen::SparseMatrix<double, Eigen::RowMajor> E = g.embedding;
+    E.makeCompressed();
+    std::vector<std::int64_t> ptr(E.outerIndexPtr(), E.outerIndexPtr() + E.rows() + 1), idx(E.innerIndexPtr(), E.innerIndexPtr() + E.nonZeros());
+    out["embedding_indptr"] = io::make_npy<std::int64_t>({std::int64_t(ptr.size())}, ptr.data());
+    out["embedding_indices"] = io::make_npy<std::int64_t>({std::int64_t(idx.size())}, idx.data());
+    out["embedding_data"] = io::make_npy<double>({std::int64_t(E.nonZeros())}, E.valuePtr());
+  }
+  return out;
+}
+
+template <class S>
+void save_model(const std::filesystem::path& path, const SuperResolutionNet<S>& net, const ModelData& data) {
+  io::write_npz(path, model_arrays(net, data));
+}
+
+}  // namespace simsr::nn

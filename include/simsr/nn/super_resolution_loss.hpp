@@ -1,0 +1,110 @@
+#pragma once
+/// \file
+/// The training loss of the network (paper Eq. 4–7; SPEC §7 "training"), as the config says:
+///   official: 10·mean|Δx̂ − Δx|/B + 2·mean|z| + 0.001·mean(1 − cos(n̂, n))   (model.py)
+///   paper:    Σ|Δx̂ − Δx| + 0.001·Σ(1 − cos) + β(step)·Σ_s Σ_i ‖h^s_i‖₂, sums per item averaged
+///             over the batch, β ramped 0.001 → 20.
+/// Face normals are those of rest + displacement in normalized units (as the official code).
+///
+///     nn::SuperResolutionLoss<float> loss(cfg, net.hr_rest_normalized(), hr_faces);
+///     auto t = loss.evaluate(exec::omp, pred, target, net.code(), step, &d_pred, &d_code);
+///     net.backward(d_pred, &d_code, exec::omp);
+
+#include <string>
+
+#include "face_normal_loss.hpp"
+#include "latent_norm_loss.hpp"
+#include "losses.hpp"
+#include "network_config.hpp"
+
+namespace simsr::nn {
+
+template <class S = float>
+class SuperResolutionLoss {
+ public:
+  /// The weighted terms (each already multiplied by its weight) and their sum.
+  struct Terms {
+    double total = 0, recon = 0, z_reg = 0, face_normals = 0;
+    double beta = 0;  ///< the latent weight used (w_zreg, or the ramp's value)
+  };
+
+  /// `total_steps`: the run's optimizer steps (the ramp's length when zreg_ramp_steps is 0).
+  template <class DR, class DF>
+  SuperResolutionLoss(const NetworkConfig& cfg, const Eigen::MatrixBase<DR>& hr_rest_normalized, const Eigen::MatrixBase<DF>& faces,
+                      long total_steps = 1)
+      : cfg_(cfg), fn_(hr_rest_normalized, faces, cfg.sum_reductions ? Reduction::sum : Reduction::mean) {
+    if (cfg.zreg == LatentRegularizer::ramped_norm) {
+      ramp_.start = cfg.zreg_start;
+      ramp_.end = cfg.zreg_end;
+      ramp_.ramp_steps = cfg.zreg_ramp_steps > 0 ? long(cfg.zreg_ramp_steps) : std::max(1L, total_steps);
+      ramp_.check();
+    }
+    // the columns of z that hold h¹, h², … (the paper's z̄_s; h⁰ is data)
+    Index off = 0;
+    for (std::size_t s = 0; s < cfg.emb_feat_dims.size(); ++s) {
+      if (s > 0 && cfg.feature_embedding) blocks_.push_back({off, cfg.emb_feat_dims[s]});
+      off += cfg.emb_feat_dims[s];
+    }
+  }
+
+  /// Loss of `pred` ((B·M)×3) against `target` with code z ((B·N)×latent) at optimizer step
+  /// `step`; with d_pred / d_z, writes the gradients of the total (overwritten).
+  template <exec::HostPolicy Policy = exec::seq_t>
+  Terms evaluate(Policy policy, const ConstView<S>& pred, const ConstView<S>& target, const ConstView<S>& z, long step, Matrix<S>* d_pred,
+                 Matrix<S>* d_z) {
+    detail::check_shape("nn::SuperResolutionLoss", "target", target, pred.rows(), 3);
+    const Index M = fn_.vertices();
+    if (pred.rows() == 0 || pred.rows() % M)
+      throw ShapeError("nn::SuperResolutionLoss: prediction (B·" + std::to_string(M) + " rows)", {-1, 3}, {pred.rows(), pred.cols()});
+    const double B = double(pred.rows() / M);
+    const Index N_rows = z.rows();
+    Terms t;
+    // reconstruction (Eq. 4): official mean/B; paper sum per item averaged over items
+    double recon_scale = cfg_.w_recon;
+    if (cfg_.recon_divide_by_batch) recon_scale /= B;
+    if (cfg_.sum_reductions) recon_scale *= double(pred.size()) / B;
+    t.recon = recon_scale * double(l1_loss(policy, pred, target, d_pred, recon_scale));
+    // face normals (Eq. 5)
+    const double fn_scale = cfg_.sum_reductions ? cfg_.w_fn / B : cfg_.w_fn;
+    if (cfg_.w_fn > 0) {
+      t.face_normals = fn_scale * fn_.value_and_gradient(policy, pred, target, d_pred ? &d_fn_ : nullptr, fn_scale);
+      if (d_pred) *d_pred += d_fn_;
+    }
+    // latent regularizer (Eq. 6 or the official mean|z|)
+    if (d_z) {
+      ensure_shape(*d_z, N_rows, z.cols());
+      d_z->setZero();
+    }
+    switch (cfg_.zreg) {
+      case LatentRegularizer::mean_abs:
+        t.beta = cfg_.w_zreg;
+        t.z_reg = t.beta * double(mean_abs(policy, z, d_z, t.beta));
+        break;
+      case LatentRegularizer::mean_square:
+        t.beta = cfg_.w_zreg;
+        t.z_reg = t.beta * double(mean_square(policy, z, d_z, t.beta));
+        break;
+      case LatentRegularizer::ramped_norm: {
+        t.beta = ramp_.at(step);
+        const double scale = t.beta / B;
+        for (const auto& [off, width] : blocks_) {
+          const auto block = z.middleCols(off, width);
+          t.z_reg += scale * row_norm_sum(policy, block, d_z ? &d_block_ : nullptr, scale);
+          if (d_z) d_z->middleCols(off, width) = d_block_;
+        }
+        break;
+      }
+    }
+    t.total = t.recon + t.z_reg + t.face_normals;
+    return t;
+  }
+
+ private:
+  NetworkConfig cfg_;
+  FaceNormalLoss<S> fn_;
+  RampedWeight ramp_;
+  std::vector<std::pair<Index, Index>> blocks_;
+  Matrix<S> d_fn_, d_block_;
+};
+
+}  // namespace simsr::nn

@@ -1,0 +1,222 @@
+/// The C++ half of the PyTorch interop test (driven by test_torch_interop.py, which makes the
+/// fixtures with scripts/peers/official_model.py and converts the checkpoint with
+/// scripts/torch_to_simsr.py):
+///
+///     interop_check --model MODEL.npz --state DIR/state_dict.npz --io DIR/io.npz --data-dir BUNNY
+///
+/// loads the converted model, rebuilds the official network, and compares with PyTorch's
+/// recorded tensors: the inputs (normalization of the bunny frames), the eval forward (code z,
+/// the dynamic feature graph, upsampling weights, z^H, the prediction) both through forward() and
+/// through the precomputed-weights inference path, then one training step (loss terms, every
+/// parameter gradient, the parameters after one Adam step). Prints one JSON object: per tensor
+/// the max |ours − torch| and that divided by max |torch|; exit 0 when every relative error is
+/// at most --tol (default 1e-5), 1 otherwise, 2 on bad usage.
+
+#include <simsr/io/npz.hpp>
+#include <simsr/nn/adam.hpp>
+#include <simsr/nn/model_file.hpp>
+#include <simsr/nn/super_resolution_loss.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <set>
+
+using namespace simsr;
+using nn::Matrix;
+
+namespace {
+
+struct Report {
+  nlohmann::json j = nlohmann::json::object();
+  double tol = 1e-5;
+  /// Denominator floor: a tensor whose exact value is 0 (the softmax-invariant last bias of f_θ)
+  /// is compared by its absolute error, at the precision's rounding level.
+  double floor = 1e-12;
+  bool ok = true;
+
+  template <class A, class B>
+  void compare(const std::string& what, const A& ours, const B& ref) {
+    if (ours.size() != ref.size()) {
+      j[what] = {{"error", "size " + std::to_string(ours.size()) + " vs " + std::to_string(ref.size())}};
+      ok = false;
+      return;
+    }
+    double diff = 0, scale = 0;
+    for (Index i = 0; i < Index(ref.size()); ++i) {
+      diff = std::max(diff, std::abs(double(ours.data()[i]) - double(ref.data()[i])));
+      scale = std::max(scale, std::abs(double(ref.data()[i])));
+    }
+    const double rel = diff / std::max(scale, floor);
+    j[what] = {{"max_abs", diff}, {"rel", rel}, {"scale", scale}};
+    if (!(rel <= tol)) ok = false;
+  }
+  void scalar(const std::string& what, double ours, double ref) {
+    const double rel = std::abs(ours - ref) / std::max(std::abs(ref), 1e-30);
+    j[what] = {{"ours", ours}, {"torch", ref}, {"rel", rel}};
+    if (!(rel <= tol)) ok = false;
+  }
+};
+
+template <class S>
+Matrix<S> as_matrix(const io::NpyArray& a, Index cols) {
+  const auto v = a.template to_vector<S>();
+  return Eigen::Map<const Matrix<S>>(v.data(), Index(v.size()) / cols, cols);
+}
+
+/// Everything above in precision S; `grad_tol` bounds the gradients and the post-Adam weights.
+template <class S>
+int check(const std::string& model, const std::string& state, const std::string& iofile, const std::string& data_dir, double tol,
+          double grad_tol) {
+  Report rep;
+  rep.tol = tol;
+  const io::NpzArrays marr = io::read_npz(model);
+  nn::ModelData data = nn::model_data(marr, model);
+  const io::NpzArrays fx = io::read_npz(iofile);
+  const Index N = data.geometry.lr_rest.rows(), M = data.geometry.hr_rest.rows();
+
+  nn::Rng rng(0);
+  nn::SuperResolutionNet<S> net(data.config, data.geometry, rng);
+  nn::load_state(net.store(), marr);
+  rep.j["parameters"] = net.store().num_parameters();
+
+  // inputs: the bunny frames normalized as dataset.py does (float32, then subtract)
+  const auto frames = fx.at("frames").to_vector<std::int64_t>();
+  const Index B = Index(frames.size());
+  io::NpzReader train(std::filesystem::path(data_dir) / "train_frames.npz");
+  const auto frame_ids = train.read("frame").to_vector<std::int64_t>();
+  const io::NpyArray low = train.read("lowres"), high = train.read("highres");
+  Matrix<S> ldx(B * N, 3), hdx(B * M, 3);
+  const Matrix<S> lr0 = nn::normalize_positions<S>(data.geometry.lr_rest, data.config.norm_mean, data.config.norm_std);
+  const Matrix<S> hr0 = nn::normalize_positions<S>(data.geometry.hr_rest, data.config.norm_mean, data.config.norm_std);
+  for (Index b = 0; b < B; ++b) {
+    const auto it = std::find(frame_ids.begin(), frame_ids.end(), frames[std::size_t(b)]);
+    const Index f = Index(it - frame_ids.begin());
+    ldx.middleRows(b * N, N) = nn::normalize_positions<S>(low.frame_points(f), data.config.norm_mean, data.config.norm_std) - lr0;
+    hdx.middleRows(b * M, M) = nn::normalize_positions<S>(high.frame_points(f), data.config.norm_mean, data.config.norm_std) - hr0;
+  }
+  rep.compare("input/lr_rest_normalized", lr0, as_matrix<S>(fx.at("lr_rest_normalized"), 3));
+  rep.compare("input/ldx", ldx, as_matrix<S>(fx.at("ldx"), 3));
+  rep.compare("input/hdx", hdx, as_matrix<S>(fx.at("hdx"), 3));
+  rep.compare("input/up_query", net.upsampling().query(), as_matrix<S>(fx.at("up_query"), 7));
+
+  // eval forward
+  Matrix<S> pred, pred_inf;
+  net.forward(nn::Mode::eval, ldx, pred);
+  rep.compare("eval/z_lr", net.code(), as_matrix<S>(fx.at("eval/z_lr"), net.latent_dim()));
+  {
+    const auto& g = net.feature_embedding().block(1).edge_conv().graph();
+    const auto ref = fx.at("eval/feature_graph").to_vector<std::int64_t>();
+    Index same = 0;
+    for (Index r = 0; r < g.rows(); ++r) {
+      std::set<std::int64_t> a(g.row(r).data(), g.row(r).data() + g.cols()), b(ref.begin() + r * g.cols(), ref.begin() + (r + 1) * g.cols());
+      same += a == b;
+    }
+    rep.j["eval/feature_graph_rows_equal"] = same;
+    rep.j["eval/feature_graph_rows"] = g.rows();
+    if (same != g.rows()) rep.ok = false;
+  }
+  rep.compare("eval/up_weights", net.upsampling().weights(), as_matrix<S>(fx.at("eval/up_weights"), net.config().up_k).topRows(M));
+  rep.compare("eval/z_hr", net.hr_code(), as_matrix<S>(fx.at("eval/z_hr"), net.latent_dim()));
+  rep.compare("eval/hdx_pred", pred, as_matrix<S>(fx.at("eval/hdx_pred"), 3));
+  net.prepare_inference();
+  net.infer(ldx, pred_inf);
+  rep.compare("infer/hdx_pred", pred_inf, as_matrix<S>(fx.at("eval/hdx_pred"), 3));
+  {
+    nn::SuperResolutionLoss<S> loss(net.config(), net.hr_rest_normalized(), data.hr_faces);
+    const auto t = loss.evaluate(exec::seq, pred, hdx, net.code(), 0, nullptr, nullptr);
+    rep.scalar("eval/loss_recon", t.recon, fx.at("eval/loss_recon").item<double>());
+    rep.scalar("eval/loss_z_reg", t.z_reg, fx.at("eval/loss_z_reg").item<double>());
+    rep.scalar("eval/loss_face_normals", t.face_normals, fx.at("eval/loss_face_normals").item<double>());
+    rep.scalar("eval/loss_total", t.total, fx.at("eval/loss_total").item<double>());
+  }
+
+  // one training step from the exported state
+  nn::load_state(net.store(), io::read_npz(state));
+  net.parameters_changed();
+  nn::SuperResolutionLoss<S> loss(net.config(), net.hr_rest_normalized(), data.hr_faces);
+  nn::Adam<S> adam(net.store(), {.lr = net.config().lr});
+  Matrix<S> d_pred, d_z;
+  net.store().zero_grad();
+  net.forward(nn::Mode::train, ldx, pred, exec::omp);
+  const auto t = loss.evaluate(exec::omp, pred, hdx, net.code(), 0, &d_pred, &d_z);
+  net.backward(d_pred, &d_z, exec::omp);
+  rep.compare("train/z_lr", net.code(), as_matrix<S>(fx.at("train/z_lr"), net.latent_dim()));
+  rep.compare("train/up_weights", net.upsampling().weights(), as_matrix<S>(fx.at("train/up_weights"), net.config().up_k).topRows(M));
+  rep.compare("train/hdx_pred", pred, as_matrix<S>(fx.at("train/hdx_pred"), 3));
+  rep.scalar("train/loss_recon", t.recon, fx.at("train/loss_recon").item<double>());
+  rep.scalar("train/loss_z_reg", t.z_reg, fx.at("train/loss_z_reg").item<double>());
+  rep.scalar("train/loss_face_normals", t.face_normals, fx.at("train/loss_face_normals").item<double>());
+  rep.scalar("train/loss_total", t.total, fx.at("train/loss_total").item<double>());
+  double worst_grad = 0;
+  std::string worst_name;
+  for (const auto& e : net.store().entries()) {
+    if (e.kind != nn::TensorEntry::Kind::parameter) continue;
+    const std::string key = "train/grad/" + e.name;
+    const auto g = net.store().gradient(e);
+    const auto ref = fx.at(key).template to_vector<S>();
+    Report one;
+    one.tol = grad_tol;
+    one.floor = sizeof(S) == 4 ? 1e-6 : 1e-12;
+    one.compare(e.name, Eigen::Map<const nn::Vector<S>>(g.data(), Index(g.size())), Eigen::Map<const nn::Vector<S>>(ref.data(), Index(ref.size())));
+    rep.j["train/grad"][e.name] = one.j[e.name];
+    const double rel = one.j[e.name].value("rel", 1.0);
+    if (rel > worst_grad) worst_grad = rel, worst_name = e.name;
+    if (!one.ok) rep.ok = false;
+  }
+  rep.j["train/grad_worst"] = {{"name", worst_name}, {"rel", worst_grad}};
+  adam.step(exec::omp);
+  double worst_after = 0;
+  for (const auto& e : net.store().entries()) {
+    const auto v = net.store().values(e);
+    const auto ref = fx.at("train/after/" + e.name).template to_vector<S>();
+    Report one;
+    one.tol = grad_tol;
+    one.floor = sizeof(S) == 4 ? 1e-6 : 1e-12;
+    one.compare(e.name, Eigen::Map<const nn::Vector<S>>(v.data(), Index(v.size())), Eigen::Map<const nn::Vector<S>>(ref.data(), Index(ref.size())));
+    worst_after = std::max(worst_after, one.j[e.name].value("rel", 1.0));
+    if (!one.ok) {
+      rep.ok = false;
+      rep.j["train/after_failed"][e.name] = one.j[e.name];
+    }
+  }
+  rep.j["train/after_worst_rel"] = worst_after;
+  rep.j["ok"] = rep.ok;
+  std::cout << rep.j.dump(1) << "\n";
+  return rep.ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string model, state, iofile, data_dir, dtype = "float32";
+  double tol = 1e-5, grad_tol = -1;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string k = argv[i], v = argv[i + 1];
+    if (k == "--model") model = v;
+    else if (k == "--state") state = v;
+    else if (k == "--io") iofile = v;
+    else if (k == "--data-dir") data_dir = v;
+    else if (k == "--tol") tol = std::stod(v);
+    else if (k == "--grad-tol") grad_tol = std::stod(v);
+    else if (k == "--dtype") dtype = v;
+    else {
+      std::cerr << "interop_check: unknown option " << k << "\n";
+      return 2;
+    }
+  }
+  if (model.empty() || state.empty() || iofile.empty() || data_dir.empty()) {
+    std::cerr << "usage: interop_check --model MODEL.npz --state state_dict.npz --io io.npz --data-dir BUNNY [--tol 1e-5]\n";
+    return 2;
+  }
+  try {
+    if (dtype == "float32") return check<float>(model, state, iofile, data_dir, tol, grad_tol < 0 ? tol : grad_tol);
+    if (dtype == "float64") return check<double>(model, state, iofile, data_dir, tol, grad_tol < 0 ? tol : grad_tol);
+    std::cerr << "interop_check: --dtype float32|float64\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "interop_check: " << e.what() << "\n";
+    return 1;
+  }
+}

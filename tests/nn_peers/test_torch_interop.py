@@ -1,0 +1,98 @@
+#!/usr/bin/python3
+"""PyTorch interop of the native network (issue #4): an official-layout checkpoint, converted by
+scripts/torch_to_simsr.py, loads into simsr and gives PyTorch's outputs.
+
+    /usr/bin/python3 tests/nn_peers/test_torch_interop.py INTEROP_CHECK_EXE [WORK_DIR] [SHARED_DATA_DIR]
+
+1. scripts/peers/official_model.py --make-checkpoint: two Adam steps on bunny frames, saved as the
+   official train.py saves (`net_feat_emb`, `net_upscale`, `net_decoder`, optimizer, scheduler).
+2. scripts/torch_to_simsr.py converts it (with the bunny data folder) into MODEL.npz.
+3. official_model.py --export records, from that checkpoint, an eval forward and one training step
+   (loss terms, gradients, weights after Adam) in float32 and in float64.
+4. INTEROP_CHECK_EXE (tests/nn_peers/interop_check.cpp) loads MODEL.npz and compares:
+   float32: inputs, code z, feature graph, upsampling weights, z^H, predictions (forward and the
+            precomputed-weights inference path) and the loss terms within 1e-5 relative;
+            gradients and post-Adam weights within 1e-2 (BatchNorm-projected gradients are sums
+            of cancelling terms: two float32 summation orders differ at ~1e-3 there);
+   float64: everything, gradients and post-Adam weights included, within 1e-5.
+Exit 0 pass, 1 fail, 77 skip (no torch for this interpreter, no bunny data, no executable).
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
+PEER = os.path.join(REPO, "scripts", "peers", "official_model.py")
+CONVERTER = os.path.join(REPO, "scripts", "torch_to_simsr.py")
+
+try:
+    import numpy  # noqa: F401
+    import torch  # noqa: F401
+except ImportError as e:
+    print("SKIP: %s (run with /usr/bin/python3 with python3-torch)" % e)
+    sys.exit(77)
+
+
+def run(args, **kw):
+    print("$ " + " ".join(args), flush=True)
+    p = subprocess.run(args, capture_output=True, text=True, **kw)
+    if p.returncode != 0:
+        print(p.stdout[-4000:])
+        print(p.stderr[-4000:])
+    return p
+
+
+def main():
+    if len(sys.argv) < 2 or not os.path.exists(sys.argv[1]):
+        print("SKIP: no interop_check executable given")
+        return 77
+    exe = sys.argv[1]
+    work = sys.argv[2] if len(sys.argv) > 2 else tempfile.mkdtemp(prefix="simsr_interop_")
+    shared = sys.argv[3] if len(sys.argv) > 3 else os.path.join(REPO, "..", "shared", "data")
+    bunny = os.path.join(shared, "bunny")
+    if not os.path.exists(os.path.join(bunny, "train_frames.npz")):
+        print("SKIP: no bunny data at %s" % bunny)
+        return 77
+    os.makedirs(work, exist_ok=True)
+    ckpt, model = os.path.join(work, "model_latest.pth"), os.path.join(work, "model.npz")
+    py = sys.executable
+    steps = [
+        [py, PEER, "--make-checkpoint", ckpt, "--steps", "2", "--data-dir", bunny],
+        [py, CONVERTER, "--checkpoint", ckpt, "--data-dir", bunny, "--out", model],
+        [py, PEER, "--export", os.path.join(work, "f32"), "--checkpoint", ckpt, "--data-dir", bunny],
+        [py, PEER, "--export", os.path.join(work, "f64"), "--checkpoint", ckpt, "--data-dir", bunny, "--dtype", "float64"],
+    ]
+    for s in steps:
+        if run(s).returncode != 0:
+            return 1
+    failures = []
+    for dtype, grad_tol in (("float32", "1e-2"), ("float64", "1e-5")):
+        d = os.path.join(work, "f32" if dtype == "float32" else "f64")
+        p = run([exe, "--model", model, "--state", os.path.join(d, "state_dict.npz"), "--io", os.path.join(d, "io.npz"),
+                 "--data-dir", bunny, "--dtype", dtype, "--tol", "1e-5", "--grad-tol", grad_tol])
+        try:
+            rep = json.loads(p.stdout)
+        except ValueError:
+            print("FAIL %s: no JSON from interop_check (rc %d)" % (dtype, p.returncode))
+            failures.append(dtype)
+            continue
+        with open(os.path.join(work, "interop_%s.json" % dtype), "w") as f:
+            json.dump(rep, f, indent=1)
+        keys = ["input/ldx", "eval/z_lr", "eval/up_weights", "eval/z_hr", "eval/hdx_pred", "infer/hdx_pred", "train/z_lr", "train/hdx_pred"]
+        print("%s: " % dtype + ", ".join("%s %.1e" % (k, rep[k]["rel"]) for k in keys))
+        print("%s: feature graph rows equal %d/%d, worst gradient %s %.1e, worst post-Adam %.1e, loss total %.1e" % (
+            dtype, rep["eval/feature_graph_rows_equal"], rep["eval/feature_graph_rows"], rep["train/grad_worst"]["name"],
+            rep["train/grad_worst"]["rel"], rep["train/after_worst_rel"], rep["train/loss_total"]["rel"]))
+        if p.returncode != 0 or not rep.get("ok"):
+            failures.append(dtype)
+            print("FAIL %s (details in %s)" % (dtype, os.path.join(work, "interop_%s.json" % dtype)))
+        else:
+            print("ok   %s" % dtype)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
