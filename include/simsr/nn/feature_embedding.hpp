@@ -147,6 +147,8 @@ class FeatureEmbedding {
 
   Index blocks() const { return Index(blocks_.size()); }
   EmbeddingBlock<S>& block(Index b) { return *blocks_.at(std::size_t(b)); }
+  /// The dropout after block b (its Rng is reseeded by the trainer at every step).
+  Dropout<S>& dropout(Index b) { return *drops_.at(std::size_t(b)); }
   Index out_features(Index = -1) const { return cat_->out_features(); }
   /// h^{s+1}, the output of block s after its dropout, from the last forward.
   const Matrix<S>& block_output(Index s) const { return h_.at(std::size_t(s)); }

@@ -35,8 +35,9 @@ inline bool is_state_tensor_name(const std::string& name) {
   return false;
 }
 
-/// The state dict of `store` as npz arrays: parameters and buffers as float32 (S cast), with
-/// num_batches_tracked as int64 (PyTorch's dtype).
+/// The state dict of `store` as npz arrays: parameters and buffers in S (float32 for the default
+/// float network, as PyTorch's; a double network keeps its precision), num_batches_tracked as
+/// int64 (PyTorch's dtype).
 template <class S>
 void add_state(io::NpzArrays& out, const ParameterStore<S>& store) {
   for (const auto& e : store.entries()) {
@@ -48,8 +49,7 @@ void add_state(io::NpzArrays& out, const ParameterStore<S>& store) {
       for (std::size_t i = 0; i < v.size(); ++i) c[i] = static_cast<std::int64_t>(v[i]);
       out[e.name] = io::make_npy<std::int64_t>(shape, c.data());
     } else {
-      std::vector<float> f(v.begin(), v.end());
-      out[e.name] = io::make_npy<float>(shape, f.data());
+      out[e.name] = io::make_npy<S>(shape, v.data());
     }
   }
 }
