@@ -6,13 +6,17 @@
 //   simsr upsample ...         LR frames → HR frames with a baseline interpolator
 //   simsr baselines ...        every baseline on held-out frames: statistics, plots, heatmaps
 //   simsr eval ...             error statistics of predicted HR frames against the truth
+//   simsr train ...            train the super-resolution network → one model .npz
+//   simsr infer ...            run a trained network on LR frames
 // Errors: a message on stderr naming the file, and an exit code in 1..125 (errors.hpp).
 #include "cmd_baselines.hpp"
 #include "cmd_convert.hpp"
 #include "cmd_eval.hpp"
 #include "cmd_info.hpp"
+#include "cmd_infer.hpp"
 #include "cmd_knn.hpp"
 #include "cmd_neighbors.hpp"
+#include "cmd_train.hpp"
 #include "cmd_upsample.hpp"
 #include "errors.hpp"
 
@@ -29,6 +33,8 @@ int main(int argc, char** argv) {
   simsr::cli::add_upsample(app, action);
   simsr::cli::add_baselines(app, action);
   simsr::cli::add_eval(app, action);
+  simsr::cli::add_train(app, action);
+  simsr::cli::add_infer(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -43,7 +43,7 @@ void add_state(io::NpzArrays& out, const ParameterStore<S>& store) {
   for (const auto& e : store.entries()) {
     const auto v = store.values(e);
     std::vector<std::int64_t> shape(e.shape.begin(), e.shape.end());
-    const bool counter = e.name.size() > 20 && e.name.compare(e.name.size() - 20, 20, "num_batches_tracked") == 0;
+    const bool counter = e.name.ends_with(".num_batches_tracked");
     if (counter) {
       std::vector<std::int64_t> c(v.size());
       for (std::size_t i = 0; i < v.size(); ++i) c[i] = static_cast<std::int64_t>(v[i]);

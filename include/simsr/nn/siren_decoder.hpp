@@ -43,6 +43,12 @@ class SirenDecoder {
   }
 
   Index in_features() const { return sines_->in_features(); }
+  /// Sets `last_layer` to zero, so the decoder starts by predicting 0 (the residual option starts
+  /// exactly at the interpolator it corrects; the hidden layers get gradients from the 2nd step).
+  void zero_output_layer() {
+    last_->linear(0).weight().setZero();
+    last_->linear(0).bias().setZero();
+  }
   Index out_features(Index = -1) const { return last_->out_features(); }
 
   template <exec::HostPolicy Policy = exec::seq_t>

@@ -34,7 +34,8 @@ struct NetworkGeometry {
   GraphIndices lr_graph;       ///< N×(≥ knn) LR geodesic neighbours, self first (EdgeConv graph 1)
   GraphIndices up_indices;     ///< M×(≥ upK) LR neighbours of each HR vertex, nearest first
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> up_distances;  ///< M×(≥ upK), raw units
-  /// M×N embedding (barycentric) matrix: needed only with cfg.residual.
+  /// M×N embedding (barycentric) matrix: needed only with cfg.residual (the network then starts
+  /// at the Embedded interpolation: its output layer is initialized to zero).
   Eigen::SparseMatrix<double, Eigen::RowMajor> embedding;
 };
 
@@ -70,6 +71,7 @@ class SuperResolutionNet {
       if (geo.embedding.rows() != M || geo.embedding.cols() != N)
         throw ShapeError("nn::SuperResolutionNet: residual needs the M×N embedding matrix", {M, N}, {geo.embedding.rows(), geo.embedding.cols()});
       embedding_ = geo.embedding.template cast<S>();
+      decoder_->zero_output_layer();
     }
   }
 
