@@ -2,7 +2,7 @@
 """PyTorch interop of the native network (issue #4): an official-layout checkpoint, converted by
 scripts/torch_to_simsr.py, loads into simsr and gives PyTorch's outputs.
 
-    /usr/bin/python3 tests/nn_peers/test_torch_interop.py INTEROP_CHECK_EXE [WORK_DIR] [SHARED_DATA_DIR]
+    /usr/bin/python3 tests/nn_peers/test_torch_interop.py INTEROP_CHECK_EXE [WORK_DIR] [SHARED_DATA_DIR] [SIMSR_EXE]
 
 1. scripts/peers/official_model.py --make-checkpoint: two Adam steps on bunny frames, saved as the
    official train.py saves (`net_feat_emb`, `net_upscale`, `net_decoder`, optimizer, scheduler).
@@ -15,6 +15,8 @@ scripts/torch_to_simsr.py, loads into simsr and gives PyTorch's outputs.
             gradients and post-Adam weights within 1e-2 (BatchNorm-projected gradients are sums
             of cancelling terms: two float32 summation orders differ at ~1e-3 there);
    float64: everything, gradients and post-Adam weights included, within 1e-5.
+5. With SIMSR_EXE: `simsr infer --model MODEL.npz` on the exported frames gives PyTorch's HR
+   positions (rest + σ·prediction) within 1e-5 of the largest displacement.
 Exit 0 pass, 1 fail, 77 skip (no torch for this interpreter, no bunny data, no executable).
 """
 import json
@@ -91,6 +93,28 @@ def main():
             print("FAIL %s (details in %s)" % (dtype, os.path.join(work, "interop_%s.json" % dtype)))
         else:
             print("ok   %s" % dtype)
+    if len(sys.argv) > 4 and os.path.exists(sys.argv[4]):
+        import numpy as np
+        io = np.load(os.path.join(work, "f32", "io.npz"))
+        frames = np.load(os.path.join(bunny, "train_frames.npz"))
+        pick = [int(np.nonzero(frames["frame"] == f)[0][0]) for f in io["frames"]]
+        two = os.path.join(work, "two_frames.npz")
+        np.savez(two, lowres=frames["lowres"][pick], highres=frames["highres"][pick], frame=frames["frame"][pick])
+        out = os.path.join(work, "infer.npz")
+        p = run([sys.argv[4], "infer", "--model", model, "--frames", two, "--out", out])
+        if p.returncode != 0:
+            failures.append("simsr infer")
+        else:
+            m = np.load(model)
+            ref = m["hr_rest"][None] + io["eval/hdx_pred"].reshape(len(pick), -1, 3).astype(np.float64) * float(m["norm_std"])
+            got = np.load(out)["highres"]
+            disp = np.abs(ref - m["hr_rest"][None]).max()
+            rel = np.abs(got - ref).max() / disp
+            ok = got.shape == ref.shape and rel <= 1e-5 and np.array_equal(np.load(out)["frame"], io["frames"])
+            print("%s simsr infer on the converted checkpoint: max |ours - torch| / max displacement = %.1e, %s" % (
+                "ok  " if ok else "FAIL", rel, p.stdout.strip()))
+            if not ok:
+                failures.append("simsr infer")
     return 1 if failures else 0
 
 
