@@ -32,6 +32,18 @@ void check_net_gradients(const nn::NetworkConfig& cfg, Index B, double tol, std:
   nn::Rng init(seed + 1);
   nn::SuperResolutionNet<double> net(cfg, geo, init);
   const Matrix<double> ldx = test::random_matrix(rng, B * net.lr_points(), 3, -0.5, 0.5);
+  if (cfg.residual) {
+    // A fresh residual network is exactly the embedding (zero output layer)...
+    Matrix<double> pred;
+    net.forward(nn::Mode::eval, ldx, pred);
+    for (Index b = 0; b < B; ++b) {
+      const Matrix<double> e = geo.embedding * ldx.middleRows(b * net.lr_points(), net.lr_points());
+      CHECK((pred.middleRows(b * net.hr_points(), net.hr_points()) - e).cwiseAbs().maxCoeff() < 1e-15);
+    }
+    // ...whose hidden layers get no gradient yet: randomize the output layer for a meaningful check.
+    for (const char* n : {"net_decoder.decoder.last_layer.fc.weight", "net_decoder.decoder.last_layer.fc.bias"})
+      for (double& v : net.store().values(net.store().at(n))) v = std::uniform_real_distribution<double>(-0.5, 0.5)(rng);
+  }
   const Matrix<double> zw = test::random_matrix(rng, B * net.lr_points(), net.latent_dim());
   auto& store = net.store();
   // loss = Σ r⊙pred + Σ zw⊙z: d_pred = r, d_code = zw.
