@@ -9,6 +9,7 @@
 ///     knn.query_self_into(simsr::exec::omp, 5, r, false);       // self included (first, distance 0)
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -34,6 +35,14 @@ namespace simsr::neighbors {
 /// same (fixed sizes, not the thread count) and every block product runs single-threaded through
 /// the same kernel, so the results are bitwise identical for any thread count.
 ///
+/// Self queries (query_self_into) use the symmetry of the distance: the points are cut into tiles
+/// of `query_block` rows and only the tile products G_IJ with I ≤ J are computed (half the
+/// flops); each entry is offered to both of its rows. A row keeps the `cap` smallest (approximate
+/// squared distance, index) pairs in lexicographic order, a set that does not depend on the order
+/// in which the pairs arrive: each worker keeps its own lists over the tiles it took, and the
+/// lists are merged per row before the re-ranking, so the result is the same for any thread
+/// count and any assignment of tiles to threads (they are handed out dynamically).
+///
 /// Lifetime and threads: the points are borrowed and must outlive the object. The object owns
 /// its scratch buffers (sized on the first query, reused after), so a query allocates nothing once
 /// `out` has its shape; the price is that one object must not run two queries at once (use one
@@ -47,7 +56,7 @@ class BruteForceKnn {
   using point_matrix = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;  ///< N×D
 
   struct Params {
-    Index query_block = 128;     ///< queries per GEMM block (rows of the block product)
+    Index query_block = 256;     ///< queries per GEMM block (rows of the block product; self queries: the tile size)
     Index point_block = 1024;    ///< points per GEMM block (columns)
     Index extra_candidates = 8;  ///< candidates kept beyond k for the exact re-ranking
   };
@@ -82,7 +91,7 @@ class BruteForceKnn {
   void query_self_into(Policy policy, Index k, KnnResult<S>& out, bool exclude_self = true) {
     constexpr const char* where = "neighbors::BruteForceKnn::query_self";
     detail::check_k(where, k, exclude_self ? n_ - 1 : n_, exclude_self ? "other points" : "points");
-    run(policy, points(), k, exclude_self, out, where);
+    run_self(policy, k, exclude_self, out);
   }
 
   template <exec::HostPolicy Policy, class DQ>
@@ -111,6 +120,11 @@ class BruteForceKnn {
     std::vector<Index> count;
     std::vector<S> exact;        // re-ranking scratch: direct distances
     std::vector<VIndex> order;
+    std::vector<S> d2;           // self queries: one tile row of approximate squared distances
+    std::vector<S> self_d2;      // self queries: per point, this worker's `cap` best pairs (lexicographic)
+    std::vector<VIndex> self_i;
+    std::vector<Index> self_count;
+    std::vector<S> self_worst;   // the cap-th approximate squared distance (+inf until the list is full)
     SerialGemm<S> gemm;
 
     void reserve(Index qb, Index pb, Index d, Index cap) {
@@ -122,6 +136,15 @@ class BruteForceKnn {
       if (cand_d2.size() < c) cand_d2.resize(c), cand_i.resize(c);
       if (count.size() < static_cast<std::size_t>(qb)) count.resize(static_cast<std::size_t>(qb));
       if (exact.size() < static_cast<std::size_t>(cap)) exact.resize(static_cast<std::size_t>(cap)), order.resize(static_cast<std::size_t>(cap));
+      if (d2.size() < static_cast<std::size_t>(pb)) d2.resize(static_cast<std::size_t>(pb));
+    }
+    /// Empty candidate lists for n points.
+    void reserve_lists(Index n, Index cap) {
+      const auto c = static_cast<std::size_t>(n * cap);
+      if (self_d2.size() < c) self_d2.resize(c), self_i.resize(c);
+      if (self_count.size() < static_cast<std::size_t>(n)) self_count.resize(static_cast<std::size_t>(n)), self_worst.resize(static_cast<std::size_t>(n));
+      std::fill(self_count.begin(), self_count.begin() + n, Index(0));
+      std::fill(self_worst.begin(), self_worst.begin() + n, std::numeric_limits<S>::infinity());
     }
   };
 
@@ -157,6 +180,111 @@ class BruteForceKnn {
       const auto [b0, b1] = exec::detail::chunk_range(blocks, workers, w);
       for (Index b = b0; b < b1; ++b) block(Q, b * qb, std::min(qb, nq - b * qb), k, cap, exclude_self, ws, out, where);
     });
+  }
+
+  /// Self queries over tiles of T points: the tile pairs (I, I + d), d ≥ 0, nearest offsets
+  /// first, handed out one at a time to the workers; each worker offers every entry of its tiles
+  /// to both rows in its own candidate lists (no sharing, no barriers), and the lists of the
+  /// workers are merged per row before the re-ranking. The cap smallest (d2, index) pairs of a row
+  /// are the same set whichever worker saw which tile.
+  template <class Policy>
+  void run_self(Policy policy, Index k, bool exclude_self, KnnResult<S>& out) {
+    const Index n = n_;
+    out.resize(n, k);
+    if (n == 0) return;
+    const Index T = std::min(params_.query_block, n);
+    const Index cap = std::min(k + params_.extra_candidates, exclude_self ? n - 1 : n);
+    const Index nb = (n + T - 1) / T, pairs = nb * (nb + 1) / 2;
+    const Index max_workers = std::is_same_v<Policy, exec::omp_t> ? Index(exec::omp_max_threads()) : Index(1);
+    const Index workers = std::max<Index>(1, std::min(pairs, max_workers));
+    if (static_cast<Index>(ws_.size()) < workers) ws_.resize(static_cast<std::size_t>(workers));
+    for (Index w = 0; w < workers; ++w) {
+      Workspace& ws = ws_[static_cast<std::size_t>(w)];
+      ws.reserve(T, T, d_, cap);
+      ws.reserve_lists(n, cap);
+    }
+    std::atomic<Index> next{0};
+    exec::parallel_for(policy, workers, [&](Index w) {
+      Workspace& ws = ws_[static_cast<std::size_t>(w)];
+      // pair number p → offset d and first tile I: offsets 0, 1, … each with nb − d pairs
+      Index d = 0, first = 0;  // pairs before offset d
+      for (Index p; (p = next.fetch_add(1, std::memory_order_relaxed)) < pairs;) {
+        while (p >= first + (nb - d)) first += nb - d, ++d;
+        const Index I = p - first, J = I + d;
+        tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
+      }
+    });
+    // merge the workers' lists into worker 0's, then re-rank (chunks of T rows)
+    const Index wk = std::min(workers, nb);
+    exec::parallel_for(policy, wk, [&](Index w) {
+      Workspace& ws = ws_[static_cast<std::size_t>(w)];
+      Workspace& w0 = ws_[0];
+      for (Index c = w; c < nb; c += wk)
+        for (Index q = c * T; q < std::min(n, (c + 1) * T); ++q) {
+          for (Index o = 1; o < workers; ++o) {
+            const Workspace& wo = ws_[static_cast<std::size_t>(o)];
+            const Index cnt = wo.self_count[static_cast<std::size_t>(q)];
+            for (Index t = 0; t < cnt; ++t) offer(w0, q, wo.self_d2[static_cast<std::size_t>(q * cap + t)], wo.self_i[static_cast<std::size_t>(q * cap + t)], cap);
+          }
+          rerank(points().row(q), w0.self_i.data() + q * cap, cap, k, ws, out, q);
+        }
+    });
+  }
+
+  /// Offers (d2, idx) to row `row`'s candidate list in `ws` (the cap smallest pairs, lexicographic).
+  static void offer(Workspace& ws, Index row, S d2, VIndex idx, Index cap) {
+    S* cd = ws.self_d2.data() + row * cap;
+    VIndex* ci = ws.self_i.data() + row * cap;
+    Index& cnt = ws.self_count[static_cast<std::size_t>(row)];
+    Index t;
+    if (cnt == cap) {
+      if (!detail::closer(d2, idx, cd[cap - 1], ci[cap - 1])) return;
+      t = cap - 1;
+    } else {
+      t = cnt++;
+    }
+    for (; t > 0 && detail::closer(d2, idx, cd[t - 1], ci[t - 1]); --t) cd[t] = cd[t - 1], ci[t] = ci[t - 1];
+    cd[t] = d2;
+    ci[t] = idx;
+    if (cnt == cap) ws.self_worst[static_cast<std::size_t>(row)] = cd[cap - 1];
+  }
+
+  /// The tile of rows [q0, q0 + m) × columns [p0, p0 + pn) (q0 ≤ p0): every entry is offered to
+  /// its row and, off the diagonal, to its column's row. A vectorized filter against the rows'
+  /// current worst candidates skips the rows of the tile that offer nothing.
+  void tile(Index q0, Index m, Index p0, Index pn, Index cap, bool exclude_self, Workspace& ws) const {
+    ws.gemm.run(m, pn, d_, data_ + q0 * d_, d_, false, data_ + p0 * d_, d_, true, ws.G.data(), ws.G.cols(), false);
+    const bool diagonal = q0 == p0;
+    const S* pnorm = norms_.data() + p0;
+    const S* wcol = ws.self_worst.data() + p0;
+    S* d2 = ws.d2.data();
+    for (Index r = 0; r < m; ++r) {
+      const Index q = q0 + r;
+      const S qn = norms_[q];
+      const S* g = ws.G.row(r).data();
+      const S wq = ws.self_worst[static_cast<std::size_t>(q)];
+      unsigned hit = 0;
+      if (diagonal) {
+        for (Index j = 0; j < pn; ++j) {
+          const S v = qn + pnorm[j] - S(2) * g[j];
+          d2[j] = v;
+          hit |= unsigned(v <= wq);
+        }
+      } else {
+        for (Index j = 0; j < pn; ++j) {
+          const S v = qn + pnorm[j] - S(2) * g[j];
+          d2[j] = v;
+          hit |= unsigned(v <= wq) | unsigned(v <= wcol[j]);
+        }
+      }
+      if (!hit) continue;
+      for (Index j = 0; j < pn; ++j) {
+        const Index p = p0 + j;
+        if (diagonal && p == q && exclude_self) continue;
+        if (d2[j] <= ws.self_worst[static_cast<std::size_t>(q)]) offer(ws, q, d2[j], static_cast<VIndex>(p), cap);
+        if (!diagonal && d2[j] <= wcol[j]) offer(ws, p, d2[j], static_cast<VIndex>(q), cap);
+      }
+    }
   }
 
   /// One block of m queries starting at q0: candidates from all point blocks, then re-ranking.

@@ -118,6 +118,37 @@ class BatchNorm1d {
     });
   }
 
+  /// True when eval-mode forward uses the running statistics (a per-channel affine map that
+  /// apply_eval can run in place, e.g. fused into the preceding Linear's chunks).
+  bool eval_uses_running_stats() const { return opt_.track_running_stats; }
+
+  /// The eval-mode transform without the layer's own buffers: prepare_eval() once per forward,
+  /// then apply_eval(x, ld, rows) on a row-major block in place, with the arithmetic of forward(eval)
+  /// (x̂ = (x − μ)·(1/σ), then x̂·γ + β), so the values are those forward would give. It leaves
+  /// normalized() and the backward state alone (Mlp recomputes them before an eval backward).
+  void prepare_eval() {
+    if (!opt_.track_running_stats) throw ArgumentError(where() + ": apply_eval needs running statistics");
+    ensure_size(mean_, c_);
+    ensure_size(inv_std_, c_);
+    mean_ = running_mean().template cast<double>();
+    inv_std_ = (running_var().template cast<double>().array() + opt_.eps).rsqrt();
+    shift_ = mean_.template cast<S>();
+    scale_ = inv_std_.template cast<S>();
+    ensure_size(gamma_, c_);
+    ensure_size(beta_, c_);
+    if (opt_.affine)
+      gamma_ = weight(), beta_ = bias();
+    else
+      gamma_.setOnes(), beta_.setZero();
+  }
+  void apply_eval(S* x, Index ld, Index rows) const {
+    for (Index r = 0; r < rows; ++r) {
+      Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> row(x + r * ld, c_);
+      row = (row - shift_.transpose()).cwiseProduct(scale_.transpose());
+      row = row.cwiseProduct(gamma_.transpose()) + beta_.transpose();
+    }
+  }
+
   /// With batch statistics: d_in = γ/σ·(d_out − mean(d_out) − x̂·mean(d_out ⊙ x̂)) per channel
   /// (every output depends on every row); with running statistics: d_in = γ/σ·d_out.
   /// Adds ∂/∂γ = Σ d_out ⊙ x̂ and ∂/∂β = Σ d_out.

@@ -87,6 +87,10 @@ class EdgeConv {
   }
   Mlp<S>& edge_function() { return mlp_; }
 
+  /// In eval mode (BatchNorm on running statistics) the edge rows are gathered chunk by chunk
+  /// into per-worker scratch and run through the edge MLP there (Mlp::eval_block, the chunks of
+  /// Linear::forward): the (B·N·k)×2C edge features and the MLP's intermediates are never stored,
+  /// and the values are those of the stored path. A backward after it recomputes them.
   template <exec::HostPolicy Policy = exec::seq_t>
   void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
     detail::check_shape("nn::EdgeConv", "input", in, -1, in_);
@@ -94,13 +98,23 @@ class EdgeConv {
       knn_.build(policy, in, n_, k_, dyn_graph_);
       features_.set_graph(dyn_graph_, n_);
     }
-    features_.forward(mode, in, e0_, policy);
-    mlp_.forward(mode, e0_, e4_, policy);
+    lean_ = mode == Mode::eval && mlp_.eval_fusable();
+    if (lean_) {
+      forward_fused(in, policy);
+    } else {
+      features_.forward(mode, in, e0_, policy);
+      mlp_.forward(mode, e0_, e4_, policy);
+    }
     pool_.forward(mode, e4_, out, policy);
   }
 
   template <exec::HostPolicy Policy = exec::seq_t>
   void backward(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+    if (lean_) {  // the fused eval forward stored no edge features: make them (the MLP recomputes its own)
+      detail::check_shape("nn::EdgeConv", "input", in, e4_.rows() / k_, in_);
+      features_.forward(Mode::eval, in, e0_, policy);
+      lean_ = false;
+    }
     detail::check_shape("nn::EdgeConv", "input", in, e0_.rows() / k_, in_);
     pool_.backward(e4_, out, d_out, &g4_, policy);
     mlp_.backward(e0_, e4_, g4_, d_in ? &g0_ : nullptr, policy);
@@ -108,6 +122,25 @@ class EdgeConv {
   }
 
  private:
+  template <class Policy>
+  void forward_fused(const ConstView<S>& in, Policy policy) {
+    if (features_.graph().size() == 0) throw ArgumentError("nn::GraphFeatures: no graph set (call set_graph first)");
+    if (in.rows() % features_.graph().rows())
+      throw ShapeError("nn::GraphFeatures: input rows (a multiple of the graph's " + std::to_string(features_.graph().rows()) + ")",
+                       {-1, in.cols()}, {in.rows(), in.cols()});
+    const Index R = in.rows() * k_, C2 = 2 * in_;
+    ensure_shape(e4_, R, mlp_.out_features());
+    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+    mlp_.prepare_eval_blocks(R, workers);
+    if (gathered_.size() < std::size_t(workers)) gathered_.resize(std::size_t(workers));
+    for (auto& g : gathered_) ensure_shape(g, detail::max_chunk_rows(R, nc), C2);
+    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+      Matrix<S>& g = gathered_[std::size_t(w)];
+      features_.gather(in, b, e, g.data(), C2);
+      mlp_.eval_block(w, e - b, g.data(), C2, e4_.data() + b * e4_.cols(), e4_.cols());
+    });
+  }
+
   Index in_, out_, k_, n_ = 0;
   EdgeMlp kind_;
   bool dynamic_ = false;
@@ -117,6 +150,8 @@ class EdgeConv {
   Mlp<S> mlp_;
   GroupPool<S> pool_;
   Matrix<S> e0_, e4_, g0_, g4_;
+  std::vector<Matrix<S>> gathered_;  ///< fused eval path: per worker, one chunk of edge rows
+  bool lean_ = false;                ///< the last forward was the fused eval one (e0_ not made)
 };
 
 }  // namespace simsr::nn

@@ -95,15 +95,21 @@ class GraphFeatures {
     const Index rows = reps * R;
     const Index nc = detail::chunk_count(rows, detail::product_chunks), workers = detail::worker_count(policy, nc);
     detail::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
-      for (Index row = b; row < e; ++row) {
-        const Index p = row / R, r = row % R, base = p * R + (r / n_) * n_;
-        for (Index j = 0; j < k; ++j) {
-          auto o = out.row(row * k + j);
-          o.head(C) = in.row(base + graph_(r, j)) - in.row(row);
-          o.tail(C) = in.row(row);
-        }
-      }
+      gather(in, b * k, e * k, out.data() + b * k * out.cols(), out.cols());
     });
+  }
+
+  /// Edge rows [e0, e1) of forward's output (row (p·R_g + r)·k + j) written to a row-major block
+  /// at `dst` with leading dimension `ld` (≥ 2C): EdgeConv's fused eval path gathers its chunks
+  /// with it.
+  void gather(const ConstView<S>& in, Index e0, Index e1, S* dst, Index ld) const {
+    const Index R = graph_.rows(), k = graph_.cols(), C = in.cols();
+    for (Index er = e0; er < e1; ++er) {
+      const Index row = er / k, j = er % k, p = row / R, r = row % R, base = p * R + (r / n_) * n_;
+      Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> o(dst + (er - e0) * ld, 2 * C);
+      o.head(C) = in.row(base + graph_(r, j)) - in.row(row);
+      o.tail(C) = in.row(row);
+    }
   }
 
   /// d_in[t] = Σ_{edges (n, j) → t} d_nbr − Σ_j d_nbr(t, j) + Σ_j d_ctr(t, j), where d_nbr and

@@ -6,6 +6,7 @@
 ///     nn::Linear<float> fc(store, "fc_out.0", 323, 384, rng, {.bias = false, .kernel_dims = 1});
 ///     fc.forward(nn::Mode::train, h, y);  // h: rows×323 → y: rows×384
 
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -17,6 +18,26 @@
 #include "parameters.hpp"
 
 namespace simsr::nn {
+
+namespace detail {
+/// for_chunks with the chunks handed out one at a time to whichever worker is free (the chunks,
+/// and so the arithmetic, are the same fixed ones: only who computes which changes), which keeps
+/// both threads busy when one of them is slowed down (a loaded machine).
+template <class Policy, class Body>
+void for_chunks_dynamic(Policy policy, Index n, Index chunks, Index workers, Body&& body) {
+  if (workers <= 1) {
+    for_chunks(policy, n, chunks, workers, body);
+    return;
+  }
+  std::atomic<Index> next{0};
+  exec::parallel_for(policy, workers, [&](Index w) {
+    for (Index c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) {
+      const auto [b, e] = exec::detail::chunk_range(n, chunks, c);
+      body(w, c, b, e);
+    }
+  });
+}
+}  // namespace detail
 
 /// Per-row affine map of rows×in activations to rows×out. Parameters `<name>.weight` (out×in,
 /// row-major like PyTorch's) and, with `bias`, `<name>.bias` (out).
@@ -87,14 +108,27 @@ class Linear {
     const Index R = in.rows();
     ensure_shape(out, R, out_);
     const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    reserve(gemm_fwd_, workers, detail::max_chunk_rows(R, nc), out_, in_);
-    const auto W = std::as_const(*store_).value(w_off_, out_, in_);
-    const S* bias_data = has_bias() ? std::as_const(*store_).values().data() + b_off_ : nullptr;
-    detail::for_chunks(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
-      gemm_fwd_[std::size_t(w)].run(e - b, out_, in_, in.data() + b * in.outerStride(), in.outerStride(), false, W.data(), in_, true,
-                                    out.data() + b * out_, out_, false);
-      if (bias_data) out.middleRows(b, e - b).rowwise() += ConstMatrixMap<S>(bias_data, 1, out_).row(0);
+    if (gemm_fwd_.size() < std::size_t(workers)) gemm_fwd_.resize(std::size_t(workers));
+    for (Index w = 0; w < workers; ++w) reserve_forward(gemm_fwd_[std::size_t(w)], R);
+    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+      forward_block(gemm_fwd_[std::size_t(w)], e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out_, out_);
     });
+  }
+
+  /// The pieces of forward for callers that run it chunk by chunk (Mlp's fused eval path):
+  /// reserve_forward sizes a worker's SerialGemm as forward does for R rows, and forward_block
+  /// computes one block of rows (row-major, leading dimensions ld_in, ld_out) with it. Over the
+  /// row chunks of forward (chunk_count(R, product_chunks)) they give forward's values exactly.
+  void reserve_forward(SerialGemm<S>& gemm, Index R) const {
+    gemm.reserve(detail::max_chunk_rows(R, detail::chunk_count(R, detail::product_chunks)), out_, in_);
+  }
+  void forward_block(SerialGemm<S>& gemm, Index rows, const S* in, Index ld_in, S* out, Index ld_out) const {
+    const ParameterStore<S>& store = *store_;
+    gemm.run(rows, out_, in_, in, ld_in, false, store.value(w_off_, out_, in_).data(), in_, true, out, ld_out, false);
+    if (has_bias()) {
+      Eigen::Map<Matrix<S>, 0, Eigen::OuterStride<>> o(out, rows, out_, Eigen::OuterStride<>(ld_out));
+      o.rowwise() += ConstMatrixMap<S>(store.values().data() + b_off_, 1, out_).row(0);
+    }
   }
 
   /// Adds ∂/∂W = d_outᵀ·in and ∂/∂b = column sums of d_out into the store; d_in = d_out·W.
@@ -108,7 +142,7 @@ class Linear {
       ensure_shape(*d_in, R, in_);
       const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
       reserve(gemm_din_, workers, detail::max_chunk_rows(R, nc), in_, out_);
-      detail::for_chunks(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+      detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
         gemm_din_[std::size_t(w)].run(e - b, in_, out_, d_out.data() + b * d_out.outerStride(), d_out.outerStride(), false, W.data(),
                                       in_, false, d_in->data() + b * in_, in_, false);
       });
@@ -120,7 +154,7 @@ class Linear {
     if (dw_parts_.size() < std::size_t(nr)) dw_parts_.resize(std::size_t(nr));
     for (Index c = 0; c < nr; ++c) ensure_shape(dw_parts_[std::size_t(c)], out_, in_);
     if (has_bias()) ensure_shape(db_parts_, nr, out_);
-    detail::for_chunks(policy, R, nr, workers, [&](Index w, Index c, Index b, Index e) {
+    detail::for_chunks_dynamic(policy, R, nr, workers, [&](Index w, Index c, Index b, Index e) {
       gemm_dw_[std::size_t(w)].run(out_, in_, e - b, d_out.data() + b * d_out.outerStride(), d_out.outerStride(), true,
                                    in.data() + b * in.outerStride(), in.outerStride(), false, dw_parts_[std::size_t(c)].data(), in_, false);
       if (has_bias()) db_parts_.row(c) = d_out.middleRows(b, e - b).colwise().sum();

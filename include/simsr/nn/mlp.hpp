@@ -12,6 +12,8 @@
 ///
 /// Names are the caller's (PyTorch nn.Sequential indices differ by profile), prefixed by `prefix.`.
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -117,8 +119,91 @@ class Mlp {
   }
   const MlpStage& spec(Index i) const { return stages_.at(std::size_t(i))->spec; }
 
+  /// Eval mode (every BatchNorm on running statistics): all stages run on one row chunk after the
+  /// other (the chunks of Linear::forward), BatchNorm and the activation applied in place on the
+  /// chunk (same arithmetic, same values); only the output is stored, and a backward after it
+  /// recomputes the stored forward first.
   template <exec::HostPolicy Policy = exec::seq_t>
   void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+    if (mode == Mode::eval && eval_fusable()) {
+      forward_fused(in, out, policy);
+      lean_ = true;
+      return;
+    }
+    lean_ = false;
+    forward_stored(mode, in, out, policy);
+  }
+
+  /// After forward(…, in, out): parameter gradients added, d_in written when not null.
+  template <exec::HostPolicy Policy = exec::seq_t>
+  void backward(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+    if (lean_) {  // the fused eval forward kept only the stage outputs: redo it storing everything
+      forward_stored(Mode::eval, in, recomputed_, policy);
+      lean_ = false;
+    }
+    backward_stored(in, out, d_out, d_in, policy);
+  }
+
+  /// True when the eval forward can be fused: every BatchNorm uses running statistics in eval.
+  bool eval_fusable() const {
+    for (const auto& s : stages_)
+      if (s->bn && !s->bn->eval_uses_running_stats()) return false;
+    return true;
+  }
+  /// The fused eval forward in pieces, for a caller that makes its input chunk by chunk (EdgeConv
+  /// gathers its edge rows): prepare_eval_blocks(R, workers) once per forward of R rows, then
+  /// eval_block(worker, …) on each row chunk of Linear::forward's chunking of R rows (row-major
+  /// blocks, leading dimensions ld_in, ld_out). The values are those of forward(Mode::eval). A
+  /// later backward recomputes the stored forward first.
+  void prepare_eval_blocks(Index R, Index workers) {
+    if (!eval_fusable()) throw ArgumentError("nn::Mlp: the fused eval path needs BatchNorm with running statistics");
+    for (auto& s : stages_)
+      if (s->bn) s->bn->prepare_eval();
+    Index width = 0;
+    for (const auto& s : stages_) width = std::max(width, s->spec.out);
+    const Index rows = detail::max_chunk_rows(R, detail::chunk_count(R, detail::product_chunks));
+    if (scratch_.size() < std::size_t(workers)) scratch_.resize(std::size_t(workers));
+    for (Index w = 0; w < workers; ++w) {
+      Scratch& sc = scratch_[std::size_t(w)];
+      for (auto& m : sc.buf) ensure_shape(m, rows, width);
+      if (sc.gemm.size() < stages_.size()) sc.gemm.resize(stages_.size());
+      for (std::size_t i = 0; i < stages_.size(); ++i) stages_[i]->linear->reserve_forward(sc.gemm[i], R);
+    }
+    lean_ = true;
+  }
+  void eval_block(Index w, Index rows, const S* in, Index ld_in, S* out, Index ld_out) {
+    Scratch& sc = scratch_[std::size_t(w)];
+    const S* x = in;
+    Index ldx = ld_in;
+    const std::size_t last = stages_.size() - 1;
+    for (std::size_t i = 0; i <= last; ++i) {
+      Stage& s = *stages_[i];
+      S* y = i == last ? out : sc.buf[i % 2].data();
+      const Index ldy = i == last ? ld_out : sc.buf[i % 2].cols();
+      s.linear->forward_block(sc.gemm[i], rows, x, ldx, y, ldy);
+      if (s.bn) s.bn->apply_eval(y, ldy, rows);
+      const Index C = s.spec.out;
+      if (s.spec.act == Act::leaky_relu) {
+        const S slope = static_cast<S>(s.spec.slope);
+        for (Index r = 0; r < rows; ++r) {
+          S* p = y + r * ldy;
+          for (Index c = 0; c < C; ++c) p[c] = p[c] > S(0) ? p[c] : slope * p[c];
+        }
+      } else if (s.spec.act == Act::sine) {
+        const S w0 = static_cast<S>(s.spec.omega0);
+        for (Index r = 0; r < rows; ++r) {
+          S* p = y + r * ldy;
+          for (Index c = 0; c < C; ++c) p[c] = std::sin(w0 * p[c]);
+        }
+      }
+      x = y;
+      ldx = ldy;
+    }
+  }
+
+ private:
+  template <class Policy>
+  void forward_stored(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy) {
     const ConstView<S>* x = &in;
     std::optional<ConstView<S>> view;
     const std::size_t last = stages_.size() - 1;
@@ -143,9 +228,22 @@ class Mlp {
     }
   }
 
-  /// After forward(…, in, out): parameter gradients added, d_in written when not null.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  /// All stages over each fixed row chunk (the chunks of Linear::forward), with per-worker
+  /// scratch: the chunk stays in cache from the first Linear to the last activation.
+  template <class Policy>
+  void forward_fused(const ConstView<S>& in, Matrix<S>& out, Policy policy) {
+    const Index R = in.rows();
+    if (in.cols() != in_features()) detail::check_shape("nn::Linear '" + stages_[0]->linear->name() + "'", "input", in, -1, in_features());
+    ensure_shape(out, R, out_features());
+    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+    prepare_eval_blocks(R, workers);
+    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+      eval_block(w, e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out.cols(), out.cols());
+    });
+  }
+
+  template <class Policy>
+  void backward_stored(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy) {
     const std::size_t last = stages_.size() - 1;
     const ConstView<S>* g = &d_out;
     std::optional<ConstView<S>> gview;
@@ -176,7 +274,6 @@ class Mlp {
     }
   }
 
- private:
   struct Stage {
     MlpStage spec;
     std::optional<Linear<S>> linear;
@@ -212,7 +309,16 @@ class Mlp {
       s.sine->backward(x, y, g, &dx, policy);
   }
 
+  /// Per worker of the fused eval path: ping-pong stage outputs of one chunk, a GEMM per stage.
+  struct Scratch {
+    Matrix<S> buf[2];
+    std::vector<SerialGemm<S>> gemm;
+  };
+
   std::vector<std::unique_ptr<Stage>> stages_;
+  std::vector<Scratch> scratch_;
+  bool lean_ = false;     ///< the last forward was the fused eval one: only its output is stored
+  Matrix<S> recomputed_;  ///< output of the storing forward that an eval backward redoes
 };
 
 }  // namespace simsr::nn

@@ -43,21 +43,30 @@ class GroupPool {
     ensure_shape(out, broadcast_ ? in.rows() : groups, C);
     if (kind_ == PoolKind::max && (argmax_.rows() != groups || argmax_.cols() != C)) argmax_.resize(groups, C);
     ensure_size(pooled_, groups * C);
-    each_group(policy, groups, [&](Index g) {
-      const Index r0 = g * g_;
-      S* p = pooled_.data() + g * C;
-      for (Index c = 0; c < C; ++c) {
-        if (kind_ == PoolKind::max) {
-          Index best = 0;
-          for (Index j = 1; j < g_; ++j)
-            if (in(r0 + j, c) > in(r0 + best, c)) best = j;
-          argmax_(g, c) = best;
-          p[c] = in(r0 + best, c);
-        } else {
-          double s = 0;
-          for (Index j = 0; j < g_; ++j) s += double(in(r0 + j, c));
-          p[c] = static_cast<S>(s / double(g_));
+    if (kind_ == PoolKind::mean) reserve_sums(sums_, policy, groups, C);
+    // The rows of a group are visited in order, all channels side by side (contiguous, so the
+    // loops vectorize); per channel that is the order of the scalar definition: max replaces on
+    // strictly greater (the first maximum wins), mean sums in double in ascending rows.
+    each_group(policy, groups, [&](Index w, Index g) {
+      const Index n = C, G = g_, r0 = g * G;  // locals: the index stores below cannot alias them
+      S* p = pooled_.data() + g * n;
+      if (kind_ == PoolKind::max) {
+        Index* am = argmax_.row(g).data();
+        const S* x0 = in.row(r0).data();
+        for (Index c = 0; c < n; ++c) p[c] = x0[c], am[c] = 0;
+        for (Index j = 1; j < G; ++j) {
+          const S* x = in.row(r0 + j).data();
+          for (Index c = 0; c < n; ++c)
+            if (x[c] > p[c]) p[c] = x[c], am[c] = j;
         }
+      } else {
+        double* acc = sums_[std::size_t(w)].data();
+        for (Index c = 0; c < n; ++c) acc[c] = 0;
+        for (Index j = 0; j < G; ++j) {
+          const S* x = in.row(r0 + j).data();
+          for (Index c = 0; c < n; ++c) acc[c] += double(x[c]);
+        }
+        for (Index c = 0; c < n; ++c) p[c] = static_cast<S>(acc[c] / double(G));
       }
       if (broadcast_)
         for (Index j = 0; j < g_; ++j) out.row(r0 + j) = ConstMatrixMap<S>(p, 1, C);
@@ -73,22 +82,30 @@ class GroupPool {
     if (kind_ == PoolKind::max && argmax_.rows() != groups) throw ArgumentError("nn::GroupPool: backward needs the forward of the same input first");
     if (!d_in) return;
     ensure_shape(*d_in, in.rows(), C);
-    each_group(policy, groups, [&](Index g) {
-      const Index r0 = g * g_;
-      for (Index c = 0; c < C; ++c) {
-        S grad;
-        if (broadcast_) {
-          grad = S(0);
-          for (Index j = 0; j < g_; ++j) grad += d_out(r0 + j, c);
-        } else {
-          grad = d_out(g, c);
+    if (broadcast_) reserve_sums(grads_, policy, groups, C);
+    each_group(policy, groups, [&](Index w, Index g) {
+      const Index n = C, G = g_, r0 = g * G;
+      // the group's gradient per channel: with broadcast the sum over its rows (in S, ascending)
+      const S* grad;
+      if (broadcast_) {
+        S* acc = grads_[std::size_t(w)].data();
+        for (Index c = 0; c < n; ++c) acc[c] = S(0);
+        for (Index j = 0; j < G; ++j) {
+          const S* d = d_out.row(r0 + j).data();
+          for (Index c = 0; c < n; ++c) acc[c] += d[c];
         }
-        if (kind_ == PoolKind::max) {
-          for (Index j = 0; j < g_; ++j) (*d_in)(r0 + j, c) = S(0);
-          (*d_in)(r0 + argmax_(g, c), c) = grad;
-        } else {
-          const S share = grad / S(g_);
-          for (Index j = 0; j < g_; ++j) (*d_in)(r0 + j, c) = share;
+        grad = acc;
+      } else {
+        grad = d_out.row(g).data();
+      }
+      if (kind_ == PoolKind::max) {
+        d_in->middleRows(r0, G).setZero();
+        const Index* am = argmax_.row(g).data();
+        for (Index c = 0; c < n; ++c) (*d_in)(r0 + am[c], c) = grad[c];
+      } else {
+        for (Index j = 0; j < G; ++j) {
+          S* d = d_in->row(r0 + j).data();
+          for (Index c = 0; c < n; ++c) d[c] = grad[c] / S(G);
         }
       }
     });
@@ -100,12 +117,20 @@ class GroupPool {
       throw ShapeError("nn::GroupPool: input rows (groups × " + std::to_string(g_) + ")", {-1, in.cols()}, {in.rows(), in.cols()});
     return in.rows() / g_;
   }
+  /// body(worker, group) for every group, over fixed chunks of groups.
   template <class Policy, class Body>
   void each_group(Policy policy, Index groups, Body&& body) {
     const Index nc = detail::chunk_count(groups, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, groups, nc, workers, [&](Index, Index, Index b, Index e) {
-      for (Index g = b; g < e; ++g) body(g);
+    detail::for_chunks(policy, groups, nc, workers, [&](Index w, Index, Index b, Index e) {
+      for (Index g = b; g < e; ++g) body(w, g);
     });
+  }
+  /// One C-vector per worker of each_group.
+  template <class T, class Policy>
+  static void reserve_sums(std::vector<Vector<T>>& v, Policy policy, Index groups, Index C) {
+    const Index workers = detail::worker_count(policy, detail::chunk_count(groups, detail::product_chunks));
+    if (v.size() < std::size_t(workers)) v.resize(std::size_t(workers));
+    for (Index w = 0; w < workers; ++w) ensure_size(v[std::size_t(w)], C);
   }
 
   PoolKind kind_;
@@ -113,6 +138,8 @@ class GroupPool {
   bool broadcast_;
   Eigen::Matrix<Index, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> argmax_;
   Vector<S> pooled_;
+  std::vector<Vector<double>> sums_;  ///< per worker: the channel sums of a mean group (forward)
+  std::vector<Vector<S>> grads_;      ///< per worker: a broadcast group's gradient (backward)
 };
 
 }  // namespace simsr::nn

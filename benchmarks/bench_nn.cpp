@@ -1,0 +1,199 @@
+/// The super-resolution network (profile `official`) at the paper's sizes and on the bunny:
+///  - BM_official_forward_paper_size/{seq,omp}: inference (eval mode; the upsampling weights are
+///    precomputed once by prepare_inference outside the loop, then infer() per frame) with
+///    up_k = 20 at N = 15,872 LR and M = 35,637 HR vertices, B = 1 (issue #4's "about a second
+///    per frame on 2 cores").
+///  - BM_official_forward_train_mode_paper_size/omp: forward(Mode::train), B = 1, same sizes
+///    (f_θ over the M·upK = 712,740 queries at every call, BatchNorm on batch statistics).
+///  - BM_official_train_step_bunny/omp/B:{32,8}: one training step on the bunny (zero_grad,
+///    forward(train), SuperResolutionLoss::evaluate, backward, Adam step), official config (knn 5,
+///    upK 10), frames 0..B-1 of train_frames.npz normalized as dataset.py (counter: the loss).
+/// Synthetic paper-size geometry (scripts/peers/nn_bench_peer.py builds the same one in numpy):
+/// LR = a 32×31×16 lattice of spacing h = 0.03, centred at 0, with the deterministic jitter
+/// 0.2·h·sin(1.7·i + 2.3·c + 0.5·c²) (i = vertex id, c = coordinate); HR = a Fibonacci sphere of
+/// 35,637 points scaled onto the ellipsoid of semi-axes √3·1.05·(half extents of the lattice),
+/// around the LR points; LR graph = the knn nearest LR vertices (self first), up_indices = the 20
+/// nearest LR vertices of each HR vertex with their Euclidean distances (neighbors::KdTree). The
+/// LR displacements are N(0, 0.3²) per coordinate (normalized units), seeded. Weights: the seeded
+/// initialization (timings do not depend on them).
+/// PyTorch peer: scripts/peers/nn_bench_peer.py.
+#include <benchmark/benchmark.h>
+
+#include <simsr/io/npz.hpp>
+#include <simsr/io/npy.hpp>
+#include <simsr/io/obj.hpp>
+#include <simsr/neighbors/kd_tree.hpp>
+#include <simsr/nn/adam.hpp>
+#include <simsr/nn/super_resolution_loss.hpp>
+#include <simsr/nn/super_resolution_net.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <numbers>
+#include <random>
+
+using namespace simsr;
+using nn::Matrix;
+
+namespace {
+
+constexpr Index kLr = 15872, kHr = 35637, kUpK = 20;
+
+std::filesystem::path data_dir() {
+#ifdef SIMSR_DATA_DIR
+  return std::filesystem::path(SIMSR_DATA_DIR);
+#else
+  return std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared" / "data";
+#endif
+}
+
+/// The synthetic geometry of the file comment (knn columns of LR graph, upK HR→LR neighbours).
+nn::NetworkGeometry paper_geometry(Index knn, Index up_k) {
+  nn::NetworkGeometry g;
+  const int nx = 32, ny = 31, nz = 16;
+  const double h = 0.03;
+  g.lr_rest.resize(kLr, 3);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const Index v = i + nx * (j + ny * k);
+        const double p[3] = {(i - 0.5 * (nx - 1)) * h, (j - 0.5 * (ny - 1)) * h, (k - 0.5 * (nz - 1)) * h};
+        for (int c = 0; c < 3; ++c) g.lr_rest(v, c) = p[c] + 0.2 * h * std::sin(1.7 * double(v) + 2.3 * c + 0.5 * c * c);
+      }
+  const double s = std::sqrt(3.0) * 1.05;
+  const double axes[3] = {s * 0.5 * (nx - 1) * h, s * 0.5 * (ny - 1) * h, s * 0.5 * (nz - 1) * h};
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  g.hr_rest.resize(kHr, 3);
+  for (Index j = 0; j < kHr; ++j) {
+    const double z = 1.0 - (2.0 * double(j) + 1.0) / double(kHr), r = std::sqrt(1.0 - z * z), phi = golden * double(j);
+    g.hr_rest.row(j) << axes[0] * r * std::cos(phi), axes[1] * r * std::sin(phi), axes[2] * z;
+  }
+  neighbors::KdTree<double> tree(g.lr_rest);
+  const auto lr = tree.query(exec::omp, g.lr_rest, knn);
+  g.lr_graph = lr.indices;
+  const auto up = tree.query(exec::omp, g.hr_rest, up_k);
+  g.up_indices = up.indices;
+  g.up_distances = up.distances;
+  return g;
+}
+
+nn::NetworkConfig paper_config() {
+  auto cfg = nn::NetworkConfig::official();
+  cfg.up_k = kUpK;
+  return cfg;
+}
+
+const nn::NetworkGeometry& paper_geo() {
+  static const nn::NetworkGeometry g = paper_geometry(paper_config().knn, kUpK);
+  return g;
+}
+
+Matrix<float> paper_ldx(Index B) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<float> n(0.0f, 0.3f);
+  Matrix<float> x(B * kLr, 3);
+  for (Index i = 0; i < x.size(); ++i) x.data()[i] = n(rng);
+  return x;
+}
+
+template <class Policy>
+void BM_official_forward_paper_size(benchmark::State& state, Policy policy) {
+  nn::Rng rng(0);
+  nn::SuperResolutionNet<float> net(paper_config(), paper_geo(), rng);
+  const Matrix<float> ldx = paper_ldx(1);
+  Matrix<float> pred;
+  net.prepare_inference(exec::omp);
+  net.infer(ldx, pred, policy);  // warm the buffers
+  for (auto _ : state) {
+    net.infer(ldx, pred, policy);
+    benchmark::DoNotOptimize(pred.data());
+  }
+}
+
+void BM_official_forward_train_mode_paper_size(benchmark::State& state) {
+  nn::Rng rng(0);
+  nn::SuperResolutionNet<float> net(paper_config(), paper_geo(), rng);
+  const Matrix<float> ldx = paper_ldx(1);
+  Matrix<float> pred;
+  net.forward(nn::Mode::train, ldx, pred, exec::omp);
+  for (auto _ : state) {
+    net.forward(nn::Mode::train, ldx, pred, exec::omp);
+    benchmark::DoNotOptimize(pred.data());
+  }
+}
+
+/// The bunny: geometry as scripts/torch_to_simsr.py writes it, frames normalized as dataset.py.
+struct Bunny {
+  nn::NetworkGeometry geo;
+  Tris hr_faces;
+  io::NpyArray low, high;  // frames × N × 3 raw positions (train_frames.npz)
+};
+
+const Bunny* bunny() {
+  static std::unique_ptr<Bunny> b = []() -> std::unique_ptr<Bunny> {
+    const auto dir = data_dir() / "bunny";
+    if (!std::filesystem::exists(dir / "train_frames.npz")) return nullptr;
+    auto x = std::make_unique<Bunny>();
+    const auto cfg = nn::NetworkConfig::official();
+    const auto lr = io::read_obj_tets<double>(dir / "lrestshape.obj");
+    const auto hr = io::read_obj_triangles<double>(dir / "hrestshape.obj");
+    x->geo.lr_rest = lr.V;
+    x->geo.hr_rest = hr.V;
+    x->hr_faces = hr.F;
+    x->geo.lr_graph = io::read_npy(dir / "geo_dist_tet2tet_idx.npy").to_matrix<VIndex>().leftCols(cfg.knn);
+    x->geo.up_indices = io::read_npy(dir / "geo_dist_surf2tet_idx.npy").to_matrix<VIndex>().leftCols(cfg.up_k);
+    x->geo.up_distances = io::read_npy(dir / "geo_dist_surf2tet.npy").to_matrix<double>().leftCols(cfg.up_k);
+    io::NpzReader z(dir / "train_frames.npz");
+    x->low = z.read("lowres");
+    x->high = z.read("highres");
+    return x;
+  }();
+  return b.get();
+}
+
+void BM_official_train_step_bunny(benchmark::State& state) {
+  const Bunny* b = bunny();
+  if (!b) {
+    state.SkipWithError("bunny data not found (SIMSR_DATA_DIR/bunny)");
+    return;
+  }
+  const Index B = state.range(0);
+  const auto cfg = nn::NetworkConfig::official();
+  nn::Rng rng(0);
+  nn::SuperResolutionNet<float> net(cfg, b->geo, rng);
+  const Index N = net.lr_points(), M = net.hr_points();
+  // dataset.py: positions parsed to float32, normalized in float32, then the rest subtracted
+  Matrix<float> ldx(B * N, 3), hdx(B * M, 3);
+  for (Index f = 0; f < B; ++f) {
+    ldx.middleRows(f * N, N) = nn::normalize_positions<float>(b->low.frame_points(f), cfg.norm_mean, cfg.norm_std) - net.lr_rest_normalized();
+    hdx.middleRows(f * M, M) = nn::normalize_positions<float>(b->high.frame_points(f), cfg.norm_mean, cfg.norm_std) - net.hr_rest_normalized();
+  }
+  nn::SuperResolutionLoss<float> loss(cfg, net.hr_rest_normalized(), b->hr_faces);
+  nn::Adam<float> adam(net.store(), {.lr = cfg.lr});
+  Matrix<float> pred, d_pred, d_z;
+  auto step = [&] {
+    net.store().zero_grad();
+    net.forward(nn::Mode::train, ldx, pred, exec::omp);
+    const auto t = loss.evaluate(exec::omp, pred, hdx, net.code(), 0, &d_pred, &d_z);
+    net.backward(d_pred, &d_z, exec::omp);
+    adam.step(exec::omp);
+    return t.total;
+  };
+  step();  // warm
+  double total = 0;
+  for (auto _ : state) total = step();
+  state.counters["loss"] = total;
+}
+
+void BM_official_forward_paper_size_seq(benchmark::State& s) { BM_official_forward_paper_size(s, exec::seq); }
+void BM_official_forward_paper_size_omp(benchmark::State& s) { BM_official_forward_paper_size(s, exec::omp); }
+
+}  // namespace
+
+BENCHMARK(BM_official_forward_paper_size_seq)->Name("BM_official_forward_paper_size/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK(BM_official_forward_paper_size_omp)->Name("BM_official_forward_paper_size/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK(BM_official_forward_train_mode_paper_size)->Name("BM_official_forward_train_mode_paper_size/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_official_train_step_bunny)->Name("BM_official_train_step_bunny/omp")->Arg(32)->Arg(8)->ArgName("B")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
+
+BENCHMARK_MAIN();
