@@ -166,8 +166,8 @@ void BM_official_train_step_bunny(benchmark::State& state) {
   // dataset.py: positions parsed to float32, normalized in float32, then the rest subtracted
   Matrix<float> ldx(B * N, 3), hdx(B * M, 3);
   for (Index f = 0; f < B; ++f) {
-    ldx.middleRows(f * N, N) = nn::normalize_positions<float>(b->low.frame_points(f), cfg.norm_mean, cfg.norm_std) - net.lr_rest_normalized();
-    hdx.middleRows(f * M, M) = nn::normalize_positions<float>(b->high.frame_points(f), cfg.norm_mean, cfg.norm_std) - net.hr_rest_normalized();
+    nn::normalized_displacements(b->low.frame_points(f), net.lr_rest_normalized(), cfg.norm_mean, cfg.norm_std, ldx.middleRows(f * N, N));
+    nn::normalized_displacements(b->high.frame_points(f), net.hr_rest_normalized(), cfg.norm_mean, cfg.norm_std, hdx.middleRows(f * M, M));
   }
   nn::SuperResolutionLoss<float> loss(cfg, net.hr_rest_normalized(), b->hr_faces);
   nn::Adam<float> adam(net.store(), {.lr = cfg.lr});

@@ -126,8 +126,7 @@ TEST_CASE("nn::SuperResolutionNet: whole-network gradients match finite differen
   SUBCASE("official, B = 2") { check_net_gradients(cfg, 2, 2e-5, 11); }
   SUBCASE("paper, B = 1") { check_net_gradients(test::tiny_config(nn::NetworkConfig::paper()), 1, 2e-5, 12); }
   SUBCASE("w/o FE") {
-    cfg.feature_embedding = false;
-    cfg.decoder_dims.front() = cfg.latent_dim();
+    cfg.disable_feature_embedding();
     check_net_gradients(cfg, 2, 2e-5, 13);
   }
   SUBCASE("w/o CU (table of logits)") {
@@ -178,6 +177,17 @@ TEST_CASE("nn::SuperResolutionNet: seq == omp bitwise; infer (precomputed sparse
   const long before = simsr_test_malloc_count();
   net.infer(ldx, pi2, exec::omp);
   CHECK(simsr_test_malloc_count() - before == 0);
+  // the residual path (a sparse embedding product per item) allocates nothing either
+  nn::NetworkConfig rcfg = cfg;
+  rcfg.residual = true;
+  nn::Rng init2(4);
+  nn::SuperResolutionNet<float> rnet(rcfg, geo, init2);
+  Matrix<float> pr;
+  rnet.infer(ldx, pr, exec::omp);
+  rnet.infer(ldx, pr, exec::omp);
+  const long before_r = simsr_test_malloc_count();
+  rnet.infer(ldx, pr, exec::omp);
+  CHECK(simsr_test_malloc_count() - before_r == 0);
   // bad input
   CHECK_THROWS_AS(net.infer(Matrix<float>::Zero(59, 3), pi), ShapeError);
   CHECK_THROWS_AS(net.infer(Matrix<float>::Zero(60, 2), pi), ShapeError);

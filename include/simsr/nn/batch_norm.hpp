@@ -98,17 +98,9 @@ class BatchNorm1d {
         buf(nbt_off_, 1)[0] += S(1);
       }
     } else {
-      mean_ = running_mean().template cast<double>();
-      inv_std_ = (running_var().template cast<double>().array() + opt_.eps).rsqrt();
+      load_running_stats();
     }
-    shift_ = mean_.template cast<S>();
-    scale_ = inv_std_.template cast<S>();
-    ensure_size(gamma_, c_);
-    ensure_size(beta_, c_);
-    if (opt_.affine)
-      gamma_ = weight(), beta_ = bias();
-    else
-      gamma_.setOnes(), beta_.setZero();
+    load_transform();
     const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
     detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       for (Index r = b; r < e; ++r) {
@@ -128,18 +120,8 @@ class BatchNorm1d {
   /// normalized() and the backward state alone (Mlp recomputes them before an eval backward).
   void prepare_eval() {
     if (!opt_.track_running_stats) throw ArgumentError(where() + ": apply_eval needs running statistics");
-    ensure_size(mean_, c_);
-    ensure_size(inv_std_, c_);
-    mean_ = running_mean().template cast<double>();
-    inv_std_ = (running_var().template cast<double>().array() + opt_.eps).rsqrt();
-    shift_ = mean_.template cast<S>();
-    scale_ = inv_std_.template cast<S>();
-    ensure_size(gamma_, c_);
-    ensure_size(beta_, c_);
-    if (opt_.affine)
-      gamma_ = weight(), beta_ = bias();
-    else
-      gamma_.setOnes(), beta_.setZero();
+    load_running_stats();
+    load_transform();
   }
   void apply_eval(S* x, Index ld, Index rows) const {
     for (Index r = 0; r < rows; ++r) {
@@ -187,6 +169,25 @@ class BatchNorm1d {
 
  private:
   const std::string& where() const { return where_; }
+  /// μ, 1/σ from the running statistics (eval mode).
+  void load_running_stats() {
+    ensure_size(mean_, c_);
+    ensure_size(inv_std_, c_);
+    mean_ = running_mean().template cast<double>();
+    inv_std_ = (running_var().template cast<double>().array() + opt_.eps).rsqrt();
+  }
+  /// The per-channel transform in S from μ, 1/σ, γ, β: shared by forward and apply_eval, so the
+  /// fused eval path rounds exactly as forward does.
+  void load_transform() {
+    shift_ = mean_.template cast<S>();
+    scale_ = inv_std_.template cast<S>();
+    ensure_size(gamma_, c_);
+    ensure_size(beta_, c_);
+    if (opt_.affine)
+      gamma_ = weight(), beta_ = bias();
+    else
+      gamma_.setOnes(), beta_.setZero();
+  }
   VectorMap<S> param(Index off, bool grad) {
     if (off < 0) throw ArgumentError(where() + " is not affine: it has no weight or bias");
     return VectorMap<S>((grad ? store_->gradients() : store_->values()).data() + off, c_);

@@ -41,21 +41,20 @@ class Concat {
   /// out = [in₀, in₁, …] (rows × Σ widths).
   template <exec::HostPolicy Policy = exec::seq_t>
   void forward(std::initializer_list<ConstView<S>> ins, Matrix<S>& out, Policy policy = {}) const {
-    check_count(ins.size());
-    const Index R = ins.begin()->rows();
-    std::size_t i = 0;
-    for (const auto& x : ins) {
-      detail::check_shape("nn::Concat", part_name(i).c_str(), x, R, widths_[i]);
-      ++i;
-    }
+    forward_parts(ins.size(), [&](std::size_t i) -> const ConstView<S>& { return ins.begin()[i]; }, out, policy);
+  }
+
+  /// The same with the parts given by part(i) (i < n), for a number of parts known at run time
+  /// (FeatureEmbedding's z = [h⁰, h¹, …]); nothing is allocated.
+  template <class Part, exec::HostPolicy Policy = exec::seq_t>
+  void forward_parts(std::size_t n, Part&& part, Matrix<S>& out, Policy policy = {}) const {
+    check_count(n);
+    const Index R = part(0).rows();
+    for (std::size_t i = 0; i < n; ++i) detail::check_shape("nn::Concat", part_name(i).c_str(), part(i), R, widths_[i]);
     ensure_shape(out, R, out_features());
     const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
     detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
-      std::size_t p = 0;
-      for (const auto& x : ins) {
-        out.block(b, offsets_[p], e - b, widths_[p]) = x.middleRows(b, e - b);
-        ++p;
-      }
+      for (std::size_t p = 0; p < n; ++p) out.block(b, offsets_[p], e - b, widths_[p]) = part(p).middleRows(b, e - b);
     });
   }
 
@@ -63,30 +62,32 @@ class Concat {
   /// with `accumulate`, where d_ins[i] must already be rows × width(i)); null entries are skipped.
   template <exec::HostPolicy Policy = exec::seq_t>
   void backward(const ConstView<S>& d_out, std::initializer_list<Matrix<S>*> d_ins, bool accumulate = false, Policy policy = {}) const {
-    check_count(d_ins.size());
+    backward_parts(d_out, d_ins.size(), [&](std::size_t i) { return d_ins.begin()[i]; }, accumulate, policy);
+  }
+
+  /// The same with the gradients given by grad(i) (i < n; null: skipped).
+  template <class Grad, exec::HostPolicy Policy = exec::seq_t>
+  void backward_parts(const ConstView<S>& d_out, std::size_t n, Grad&& grad, bool accumulate = false, Policy policy = {}) const {
+    check_count(n);
     detail::check_shape("nn::Concat", "output gradient", d_out, -1, out_features());
     const Index R = d_out.rows();
-    std::size_t i = 0;
-    for (Matrix<S>* d : d_ins) {
-      if (d) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (Matrix<S>* d = grad(i)) {
         if (accumulate)
           detail::check_shape("nn::Concat", (part_name(i) + " gradient").c_str(), *d, R, widths_[i]);
         else
           ensure_shape(*d, R, widths_[i]);
       }
-      ++i;
     }
     const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
     detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
-      std::size_t p = 0;
-      for (Matrix<S>* d : d_ins) {
-        if (d) {
-          if (accumulate)
-            d->middleRows(b, e - b) += d_out.block(b, offsets_[p], e - b, widths_[p]);
-          else
-            d->middleRows(b, e - b) = d_out.block(b, offsets_[p], e - b, widths_[p]);
-        }
-        ++p;
+      for (std::size_t p = 0; p < n; ++p) {
+        Matrix<S>* d = grad(p);
+        if (!d) continue;
+        if (accumulate)
+          d->middleRows(b, e - b) += d_out.block(b, offsets_[p], e - b, widths_[p]);
+        else
+          d->middleRows(b, e - b) = d_out.block(b, offsets_[p], e - b, widths_[p]);
       }
     });
   }

@@ -24,18 +24,9 @@
 #include "mlp.hpp"
 #include "neighbor_upsample.hpp"
 #include "network_config.hpp"
+#include "normalization.hpp"
 
 namespace simsr::nn {
-
-/// Positions as the official dataset.py normalizes them: parsed to S first, then (x − μ)/σ in S.
-template <class S, class D>
-Matrix<S> normalize_positions(const Eigen::MatrixBase<D>& X, double mean, double std_dev) {
-  const S mu = static_cast<S>(mean), sigma = static_cast<S>(std_dev);
-  Matrix<S> out(X.rows(), X.cols());
-  for (Index r = 0; r < X.rows(); ++r)
-    for (Index c = 0; c < X.cols(); ++c) out(r, c) = (static_cast<S>(X(r, c)) - mu) / sigma;
-  return out;
-}
 
 /// The (M·upK)×7 query of Eq. 2, row j·upK + i = [hr_n(j), lr_n(idx(j,i)), dist(j,i)] where the
 /// positions are normalized (normalize_positions) and the distance is in raw mesh units (as

@@ -185,25 +185,17 @@ class FeatureEmbedding {
   }
 
  private:
+  /// z = [h⁰, h¹, …, h^S].
   template <class Policy>
   void concat_forward(const ConstView<S>& h0, Matrix<S>& z, Policy policy) {
-    switch (blocks_.size()) {
-      case 1: cat_->forward({h0, h_[0]}, z, policy); break;
-      case 2: cat_->forward({h0, h_[0], h_[1]}, z, policy); break;
-      case 3: cat_->forward({h0, h_[0], h_[1], h_[2]}, z, policy); break;
-      case 4: cat_->forward({h0, h_[0], h_[1], h_[2], h_[3]}, z, policy); break;
-      default: throw ArgumentError("nn::FeatureEmbedding: 1 to 4 blocks are supported");
-    }
+    const std::size_t n = blocks_.size() + 1;
+    cat_->forward_parts(n, [&](std::size_t i) { return i == 0 ? h0 : ConstView<S>(h_[i - 1]); }, z, policy);
   }
+  /// d_h_[s] = the h^{s+1} columns of d_z (h⁰ is data: no gradient).
   template <class Policy>
   void split(const ConstView<S>& d_z, Policy policy) {
-    switch (blocks_.size()) {
-      case 1: cat_->backward(d_z, {nullptr, &d_h_[0]}, false, policy); break;
-      case 2: cat_->backward(d_z, {nullptr, &d_h_[0], &d_h_[1]}, false, policy); break;
-      case 3: cat_->backward(d_z, {nullptr, &d_h_[0], &d_h_[1], &d_h_[2]}, false, policy); break;
-      case 4: cat_->backward(d_z, {nullptr, &d_h_[0], &d_h_[1], &d_h_[2], &d_h_[3]}, false, policy); break;
-      default: throw ArgumentError("nn::FeatureEmbedding: 1 to 4 blocks are supported");
-    }
+    const std::size_t n = blocks_.size() + 1;
+    cat_->backward_parts(d_z, n, [&](std::size_t i) { return i == 0 ? nullptr : &d_h_[i - 1]; }, false, policy);
   }
 
   Index n_;

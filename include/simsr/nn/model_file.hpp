@@ -59,7 +59,6 @@ void add_state(io::NpzArrays& out, const ParameterStore<S>& store) {
 /// ShapeError / ArgumentError names the tensor. Non-finite values are rejected.
 template <class S>
 void load_state(ParameterStore<S>& store, const io::NpzArrays& arrays) {
-  std::size_t used = 0;
   for (const auto& e : store.entries()) {
     if (!arrays.contains(e.name)) throw ArgumentError("nn::load_state: the model file has no tensor '" + e.name + "'");
     const io::NpyArray& a = arrays.at(e.name);
@@ -79,16 +78,10 @@ void load_state(ParameterStore<S>& store, const io::NpzArrays& arrays) {
         throw ArgumentError("nn::load_state: tensor '" + e.name + "' entry " + std::to_string(i) + " is not finite");
       dst[i] = v[i];
     }
-    ++used;
   }
-  std::size_t state = 0;
   for (const auto& [name, a] : arrays)
-    if (is_state_tensor_name(name)) {
-      ++state;
-      if (!store.find(name)) throw ArgumentError("nn::load_state: the model file has tensor '" + name + "', which this network does not have");
-    }
-  (void)state;
-  (void)used;
+    if (is_state_tensor_name(name) && !store.find(name))
+      throw ArgumentError("nn::load_state: the model file has tensor '" + name + "', which this network does not have");
 }
 
 namespace detail {

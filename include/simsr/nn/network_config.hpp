@@ -13,6 +13,8 @@
 
 #include <cmath>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -113,6 +115,13 @@ struct NetworkConfig {
     throw ArgumentError("nn::NetworkConfig: unknown profile '" + name + "' (official, paper)");
   }
 
+  /// The w/o-FE ablation: z = h⁰ goes straight to the upsampling, so the decoder's input
+  /// narrows to D₀ (the one place that knows both fields must change together).
+  void disable_feature_embedding() {
+    feature_embedding = false;
+    if (!decoder_dims.empty()) decoder_dims.front() = latent_dim();
+  }
+
   /// Width of the LR code z: D₀ + D₁ + … (or D₀ without feature embedding).
   Index latent_dim() const {
     if (!feature_embedding) return emb_feat_dims.at(0);
@@ -148,133 +157,127 @@ struct NetworkConfig {
     if (zreg_ramp_steps < 0) fail("zreg_ramp_steps must be >= 0");
   }
 
+  /// Calls f(key, field) for every field stored under one JSON key (config.py's names where it
+  /// has one): the single list to_json and from_json share, so a new field is one line here.
+  /// up_hidden and decoder_dims are listed too; from_json also accepts config.py's shorthands.
+  template <class Self, class F>
+  static void each_field(Self& c, F&& f) {
+    f("profile", c.profile);
+    f("pos_feat_dim", c.pos_feat_dim);
+    f("emb_feat_dims", c.emb_feat_dims);
+    f("feature_embedding", c.feature_embedding);
+    f("knn", c.knn);
+    f("edge_batch_norm", c.edge_batch_norm);
+    f("fc_out_batch_norm", c.fc_out_batch_norm);
+    f("dropout", c.dropout);
+    f("upK", c.up_k);
+    f("upsampling", c.upsampling);
+    f("up_hidden", c.up_hidden);
+    f("up_batch_norm", c.up_batch_norm);
+    f("up_w0_initial", c.up_w0_initial);
+    f("up_w0", c.up_w0);
+    f("up_siren_init", c.up_siren_init);
+    f("decoder_dims", c.decoder_dims);
+    f("decoder_dead_layer", c.decoder_dead_layer);
+    f("w0_initial", c.w0_initial);
+    f("w0", c.w0);
+    f("leaky_relu_slope", c.leaky_relu_slope);
+    f("batchnorm_eps", c.batchnorm_eps);
+    f("batchnorm_momentum", c.batchnorm_momentum);
+    f("residual", c.residual);
+    f("norm_mean", c.norm_mean);
+    f("norm_std", c.norm_std);
+    f("lr", c.lr);
+    f("batch_size", c.batch_size);
+    f("n_epochs", c.epochs);
+    f("w_recon", c.w_recon);
+    f("recon_divide_by_batch", c.recon_divide_by_batch);
+    f("w_fn", c.w_fn);
+    f("sum_reductions", c.sum_reductions);
+    f("zreg", c.zreg);
+    f("w_zreg", c.w_zreg);
+    f("zreg_start", c.zreg_start);
+    f("zreg_end", c.zreg_end);
+    f("zreg_ramp_steps", c.zreg_ramp_steps);
+  }
+
   nlohmann::json to_json() const {
     nlohmann::json j;
-    j["profile"] = profile;
-    j["pos_feat_dim"] = pos_feat_dim;
-    j["emb_feat_dims"] = emb_feat_dims;
-    j["feature_embedding"] = feature_embedding;
-    j["knn"] = knn;
-    j["edge_batch_norm"] = edge_batch_norm;
-    j["fc_out_batch_norm"] = fc_out_batch_norm;
-    j["dropout"] = dropout;
-    j["upK"] = up_k;
-    j["upsampling"] = upsampling == UpsamplingKind::mlp ? "mlp" : "table";
-    j["up_hidden"] = up_hidden;
+    each_field(*this, [&](const char* key, const auto& field) {
+      if constexpr (std::is_enum_v<std::remove_cvref_t<decltype(field)>>)
+        j[key] = enum_name(field);
+      else
+        j[key] = field;
+    });
+    // config.py's shorthands, for readers of the official layout
     j["w_up_feat_dim"] = up_hidden.empty() ? Index(0) : up_hidden.front();
     j["n_upscale_layers"] = Index(up_hidden.size());
-    j["up_batch_norm"] = up_batch_norm;
-    j["up_w0_initial"] = up_w0_initial;
-    j["up_w0"] = up_w0;
-    j["up_siren_init"] = up_siren_init;
-    j["decoder_dims"] = decoder_dims;
     j["decoder_dim"] = decoder_dims.size() > 1 ? decoder_dims[1] : Index(0);
-    j["decoder_dead_layer"] = decoder_dead_layer;
-    j["w0_initial"] = w0_initial;
-    j["w0"] = w0;
-    j["leaky_relu_slope"] = leaky_relu_slope;
-    j["batchnorm_eps"] = batchnorm_eps;
-    j["batchnorm_momentum"] = batchnorm_momentum;
-    j["residual"] = residual;
-    j["norm_mean"] = norm_mean;
-    j["norm_std"] = norm_std;
-    j["lr"] = lr;
-    j["batch_size"] = batch_size;
-    j["n_epochs"] = epochs;
-    j["w_recon"] = w_recon;
-    j["recon_divide_by_batch"] = recon_divide_by_batch;
-    j["w_fn"] = w_fn;
-    j["sum_reductions"] = sum_reductions;
-    j["zreg"] = zreg == LatentRegularizer::mean_abs ? "mean_abs" : zreg == LatentRegularizer::mean_square ? "mean_square" : "ramped_norm";
-    j["w_zreg"] = w_zreg;
-    j["zreg_start"] = zreg_start;
-    j["zreg_end"] = zreg_end;
-    j["zreg_ramp_steps"] = zreg_ramp_steps;
     return j;
   }
 
   /// Reads what to_json writes, or a config of scripts/torch_to_simsr.py (official config.py
   /// keys: the official defaults fill what it lacks; `w_up_feat_dim` × `n_upscale_layers` gives
   /// up_hidden, `decoder_dim` gives the halving SIREN widths when `decoder_dims` is absent).
-  /// Unknown keys are ignored; a key of the wrong type is an ArgumentError naming it.
+  /// Unknown keys are ignored; a key of the wrong type or an unknown enum name is an
+  /// ArgumentError naming it.
   static NetworkConfig from_json(const nlohmann::json& j) {
     if (!j.is_object()) throw ArgumentError("nn::NetworkConfig: the config is not a JSON object");
     NetworkConfig c = preset(j.value("profile", std::string("official")));
     auto get = [&](const char* key, auto& field) {
       if (!j.contains(key)) return;
       try {
-        j.at(key).get_to(field);
+        using T = std::remove_cvref_t<decltype(field)>;
+        if constexpr (std::is_enum_v<T>)
+          field = parse_enum<T>(key, j.at(key).get<std::string>());
+        else
+          j.at(key).get_to(field);
       } catch (const nlohmann::json::exception& e) {
         throw ArgumentError(std::string("nn::NetworkConfig: key '") + key + "': " + e.what());
       }
     };
-    auto get_enum = [&](const char* key, auto& field, auto&& parse) {
-      if (!j.contains(key)) return;
-      std::string s;
-      get(key, s);
-      field = parse(s);
-    };
-    get("pos_feat_dim", c.pos_feat_dim);
-    get("emb_feat_dims", c.emb_feat_dims);
-    get("feature_embedding", c.feature_embedding);
-    get("knn", c.knn);
-    get("edge_batch_norm", c.edge_batch_norm);
-    get("fc_out_batch_norm", c.fc_out_batch_norm);
-    get("dropout", c.dropout);
-    get("upK", c.up_k);
-    get_enum("upsampling", c.upsampling, [](const std::string& s) {
-      if (s == "mlp") return UpsamplingKind::mlp;
-      if (s == "table") return UpsamplingKind::table;
-      throw ArgumentError("nn::NetworkConfig: upsampling '" + s + "' (mlp, table)");
-    });
-    if (j.contains("up_hidden")) {
-      get("up_hidden", c.up_hidden);
-    } else if (j.contains("w_up_feat_dim") || j.contains("n_upscale_layers")) {
+    each_field(c, get);
+    if (!j.contains("up_hidden") && (j.contains("w_up_feat_dim") || j.contains("n_upscale_layers"))) {
       Index width = c.up_hidden.empty() ? 128 : c.up_hidden.front(), layers = Index(c.up_hidden.size());
       get("w_up_feat_dim", width);
       get("n_upscale_layers", layers);
       if (layers < 0) throw ArgumentError("nn::NetworkConfig: n_upscale_layers must be >= 0");
       c.up_hidden.assign(std::size_t(layers), width);
     }
-    get("up_batch_norm", c.up_batch_norm);
-    get("up_w0_initial", c.up_w0_initial);
-    get("up_w0", c.up_w0);
-    get("up_siren_init", c.up_siren_init);
-    if (j.contains("decoder_dims")) {
-      get("decoder_dims", c.decoder_dims);
-    } else if (j.contains("decoder_dim")) {
+    if (!j.contains("decoder_dims") && j.contains("decoder_dim")) {
       Index h = 0;
       get("decoder_dim", h);
       c.decoder_dims = {c.latent_dim(), h, h / 2, h / 4, h / 8, h / 16, 3};
     }
-    get("decoder_dead_layer", c.decoder_dead_layer);
-    get("w0_initial", c.w0_initial);
-    get("w0", c.w0);
-    get("leaky_relu_slope", c.leaky_relu_slope);
-    get("batchnorm_eps", c.batchnorm_eps);
-    get("batchnorm_momentum", c.batchnorm_momentum);
-    get("residual", c.residual);
-    get("norm_mean", c.norm_mean);
-    get("norm_std", c.norm_std);
-    get("lr", c.lr);
-    get("batch_size", c.batch_size);
-    get("n_epochs", c.epochs);
-    get("w_recon", c.w_recon);
-    get("recon_divide_by_batch", c.recon_divide_by_batch);
-    get("w_fn", c.w_fn);
-    get("sum_reductions", c.sum_reductions);
-    get_enum("zreg", c.zreg, [](const std::string& s) {
-      if (s == "mean_abs") return LatentRegularizer::mean_abs;
-      if (s == "mean_square") return LatentRegularizer::mean_square;
-      if (s == "ramped_norm") return LatentRegularizer::ramped_norm;
-      throw ArgumentError("nn::NetworkConfig: zreg '" + s + "' (mean_abs, mean_square, ramped_norm)");
-    });
-    get("w_zreg", c.w_zreg);
-    get("zreg_start", c.zreg_start);
-    get("zreg_end", c.zreg_end);
-    get("zreg_ramp_steps", c.zreg_ramp_steps);
     c.validate();
     return c;
+  }
+
+ private:
+  static constexpr std::pair<UpsamplingKind, const char*> upsampling_names[] = {{UpsamplingKind::mlp, "mlp"}, {UpsamplingKind::table, "table"}};
+  static constexpr std::pair<LatentRegularizer, const char*> zreg_names[] = {
+      {LatentRegularizer::mean_abs, "mean_abs"}, {LatentRegularizer::mean_square, "mean_square"}, {LatentRegularizer::ramped_norm, "ramped_norm"}};
+  template <class E>
+  static constexpr const auto& names_of() {
+    if constexpr (std::is_same_v<E, UpsamplingKind>)
+      return upsampling_names;
+    else
+      return zreg_names;
+  }
+  template <class E>
+  static const char* enum_name(E e) {
+    for (const auto& [v, n] : names_of<E>())
+      if (v == e) return n;
+    throw ArgumentError("nn::NetworkConfig: unnamed enum value");
+  }
+  template <class E>
+  static E parse_enum(const char* key, const std::string& s) {
+    std::string known;
+    for (const auto& [v, n] : names_of<E>()) {
+      if (s == n) return v;
+      known += (known.empty() ? "" : ", ") + std::string(n);
+    }
+    throw ArgumentError(std::string("nn::NetworkConfig: ") + key + " '" + s + "' (" + known + ")");
   }
 };
 

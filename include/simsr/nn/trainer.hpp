@@ -38,12 +38,6 @@ struct TrainingFrames {
   std::vector<std::int64_t> ids;  ///< the frames' ids (the `frame` array, or their indices)
 };
 
-/// Normalized displacements of `positions` (one frame, #V×3) from `rest`, as the official code.
-template <class S, class DP, class DR>
-Matrix<S> normalized_displacements(const Eigen::MatrixBase<DP>& positions, const Eigen::MatrixBase<DR>& rest, double mean, double std_dev) {
-  return normalize_positions<S>(positions, mean, std_dev) - normalize_positions<S>(rest, mean, std_dev);
-}
-
 /// The frames `which` (indices into the F frames of lowres F×N×3 / highres F×M×3) as
 /// TrainingFrames. Non-finite positions are an ArgumentError naming the frame and vertex.
 template <class S, class DL, class DH>
@@ -71,8 +65,8 @@ TrainingFrames<S> training_frames(const NetworkConfig& cfg, const Eigen::MatrixB
         if (!P->row(r).allFinite())
           throw ArgumentError(std::string("nn::training_frames: ") + (P == &lo ? "lowres" : "highres") + " frame " + std::to_string(f) + ", vertex " +
                               std::to_string(r) + " is not finite");
-    t.ldx.middleRows(i * t.n, t.n) = normalize_positions<S>(lo, cfg.norm_mean, cfg.norm_std) - lr0;
-    t.hdx.middleRows(i * t.m, t.m) = normalize_positions<S>(hi, cfg.norm_mean, cfg.norm_std) - hr0;
+    normalized_displacements(lo, lr0, cfg.norm_mean, cfg.norm_std, t.ldx.middleRows(i * t.n, t.n));
+    normalized_displacements(hi, hr0, cfg.norm_mean, cfg.norm_std, t.hdx.middleRows(i * t.m, t.m));
     t.ids.push_back(ids.empty() ? std::int64_t(f) : ids.at(std::size_t(f)));
   }
   return t;
