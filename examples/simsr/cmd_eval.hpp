@@ -68,10 +68,6 @@ inline void require_finite(const Points<double>& p, const std::string& file, con
     }
 }
 
-inline nlohmann::ordered_json statistics_json(const eval::ErrorStatistics& s) {
-  return {{"mean", s.mean}, {"median", s.median}, {"std", s.std}, {"max", s.max}, {"min", s.min}};
-}
-
 }  // namespace detail
 
 inline int eval_cmd(const EvalArgs& a) {
@@ -129,8 +125,8 @@ inline int eval_cmd(const EvalArgs& a) {
   j["frames"] = frames;
   j["vertices"] = m;
   j["bbox_diagonal"] = diagonal;
-  j["error"] = detail::statistics_json(stats);
-  j["relative_error"] = detail::statistics_json(stats.scaled(diagonal));
+  j["error"] = statistics_json(stats);
+  j["relative_error"] = statistics_json(stats.scaled(diagonal));
 
   if (!a.out_dir.empty()) {
     const std::filesystem::path dir(a.out_dir);

@@ -56,7 +56,7 @@ inline int infer_cmd(const InferArgs& a) {
     for (Index r = 0; r < N; ++r)
       if (!x.row(r).allFinite())
         throw ArgumentError(a.frames + ": lowres frame " + std::to_string(sel[std::size_t(f)]) + ", vertex " + std::to_string(r) + " is not finite");
-    ldx = nn::normalize_positions<float>(x, md.config.norm_mean, md.config.norm_std) - lr0;
+    nn::normalized_displacements(x, lr0, md.config.norm_mean, md.config.norm_std, ldx);
     const auto s = clock::now();
     net.infer(ldx, pred, exec::omp);
     forward_seconds += sec(clock::now() - s);
@@ -90,8 +90,8 @@ inline int infer_cmd(const InferArgs& a) {
       for (Index f = 0; f < F; ++f)
         acc.add_frame(Eigen::Map<const Points<double>>(out.data() + f * M * 3, M, 3), truth.frame_points<double>(sel[std::size_t(f)]));
       const auto s = acc.statistics(), r = acc.relative_statistics();
-      j["error"] = {{"mean", s.mean}, {"median", s.median}, {"std", s.std}, {"max", s.max}, {"min", s.min}};
-      j["relative_error"] = {{"mean", r.mean}, {"median", r.median}, {"std", r.std}, {"max", r.max}, {"min", r.min}};
+      j["error"] = statistics_json(s);
+      j["relative_error"] = statistics_json(r);
     }
   }
   std::cout << j.dump() << '\n';

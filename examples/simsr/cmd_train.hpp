@@ -8,6 +8,7 @@
 // every epoch when --checkpoint is given (resumable with --resume), and with --out-dir the
 // per-epoch history as CSV and SVG. stdout: one JSON object with the run's figures.
 #include <simsr/discretize/embedding.hpp>
+#include <simsr/eval/error_statistics.hpp>
 #include <simsr/eval/report.hpp>
 #include <simsr/neighbors/geodesic_knn.hpp>
 #include <simsr/neighbors/kd_tree.hpp>
@@ -94,8 +95,6 @@ inline nn::NetworkGeometry network_geometry(const TrainArgs& a, const nn::Networ
     g.up_distances = r.distances;
     log["neighbors"] = "Euclidean kNN (w/o CU)";
   }
-  const auto emb = embed(exec::omp, lr, hr.V);
-  g.embedding = embedding_matrix(emb, lr.T, N).cast<double>();
   return g;
 }
 
@@ -106,10 +105,7 @@ inline int train_cmd(const TrainArgs& a) {
   if (a.knn > 0) cfg.knn = a.knn;
   if (a.upk > 0) cfg.up_k = a.upk;
   cfg.residual = a.residual;
-  if (a.without_fe) {
-    cfg.feature_embedding = false;
-    cfg.decoder_dims.front() = cfg.latent_dim();
-  }
+  if (a.without_fe) cfg.disable_feature_embedding();
   if (a.without_cu) cfg.upsampling = nn::UpsamplingKind::table;
   cfg.epochs = a.epochs >= 0 ? a.epochs : default_epochs(a.profile);
   cfg.batch_size = a.batch_size > 0 ? a.batch_size : default_batch_size;
@@ -129,7 +125,9 @@ inline int train_cmd(const TrainArgs& a) {
   md.geometry = network_geometry(a, cfg, lr, hr, j);
   md.lr_tets = lr.T;
   md.hr_faces = hr.F;
-  if (!cfg.residual) md.geometry.embedding.resize(0, 0);
+  // the embedding: the residual's base and, on the held-out frames, the baseline to beat
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> embedding = embedding_matrix(embed(exec::omp, lr, hr.V), lr.T, lr.V.rows()).cast<double>();
+  if (cfg.residual) md.geometry.embedding = embedding;
   const auto t_geo = clock::now();
 
   io::NpzReader z(a.frames);
@@ -146,34 +144,24 @@ inline int train_cmd(const TrainArgs& a) {
   opt.seed = a.seed;
   opt.progress = !a.quiet;
   opt.lr_decay_epochs = a.lr_decay_epochs;
-  std::unique_ptr<nn::Trainer<float>> trainer;
-  trainer = std::make_unique<nn::Trainer<float>>(net, hr.F, nn::training_frames<float>(cfg, lr.V, hr.V, low, high, train, ids), opt);
+  nn::Trainer<float> trainer(net, hr.F, nn::training_frames<float>(cfg, lr.V, hr.V, low, high, train, ids), opt);
   double embedded_error = -1;
   if (!test.empty()) {
-    trainer->set_holdout(nn::training_frames<float>(cfg, lr.V, hr.V, low, high, test, ids));
-    // the Embedded baseline on the same held-out frames, raw units
-    const auto W = md.geometry.embedding.rows() ? md.geometry.embedding : embedding_matrix(embed(exec::omp, lr, hr.V), lr.T, lr.V.rows()).cast<double>();
-    double sum = 0;
-    for (Index f : test) {
-      const Points<double> x = W * low.frame_points<double>(f);
-      sum += (x - high.frame_points<double>(f)).rowwise().norm().sum();
-    }
-    embedded_error = sum / double(Index(test.size()) * hr.V.rows());
+    trainer.set_holdout(nn::training_frames<float>(cfg, lr.V, hr.V, low, high, test, ids));
+    eval::ErrorAccumulator acc(hr.V);  // the Embedded baseline on the same held-out frames
+    for (Index f : test) acc.add_frame(Points<double>(embedding * low.frame_points<double>(f)), high.frame_points<double>(f));
+    embedded_error = acc.statistics().mean;
   }
-  if (!a.resume.empty()) trainer->load_checkpoint(a.resume);
-  if (!a.checkpoint.empty()) {
-    while (trainer->epoch() < trainer->epochs()) {
-      trainer->run_epoch(exec::omp);
-      if (!a.checkpoint.empty()) trainer->save_checkpoint(a.checkpoint, md);
-    }
-  } else {
-    trainer->run(exec::omp);
+  if (!a.resume.empty()) trainer.load_checkpoint(a.resume);
+  while (trainer.epoch() < trainer.epochs()) {
+    trainer.run_epoch(exec::omp);
+    if (!a.checkpoint.empty()) trainer.save_checkpoint(a.checkpoint, md);
   }
   const auto t_train = clock::now();
   nn::save_model(a.out, net, md);
 
   const double diag = eval::bbox_diagonal(hr.V);
-  const auto& h = trainer->history();
+  const auto& h = trainer.history();
   if (!a.out_dir.empty() && !h.empty()) {
     std::filesystem::create_directories(a.out_dir);
     std::string csv = "epoch,steps,loss,recon,z_reg,face_normals,lr,seconds,holdout_mean_error,holdout_relative_error,embedded_relative_error\n";
@@ -199,9 +187,9 @@ inline int train_cmd(const TrainArgs& a) {
   j["parameters"] = net.store().num_parameters();
   j["train_frames"] = train.size();
   j["holdout_frames"] = test.size();
-  j["epochs"] = trainer->epoch();
-  j["steps"] = trainer->steps();
-  j["batch_size"] = trainer->batch_size();
+  j["epochs"] = trainer.epoch();
+  j["steps"] = trainer.steps();
+  j["batch_size"] = trainer.batch_size();
   j["geometry_seconds"] = sec(t_geo - t_start);
   j["training_seconds"] = sec(t_train - t_geo);
   if (!h.empty()) {

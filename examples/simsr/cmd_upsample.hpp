@@ -85,8 +85,8 @@ inline int upsample(const UpsampleArgs& a) {
     for (Index f = 0; f < frames; ++f)
       acc.add_frame(Eigen::Map<const Points<double>>(out.data() + f * m * 3, m, 3), truth.frame_points<double>(f));
     const auto s = acc.statistics(), r = acc.relative_statistics();
-    j["error"] = {{"mean", s.mean}, {"median", s.median}, {"std", s.std}, {"max", s.max}, {"min", s.min}};
-    j["relative_error"] = {{"mean", r.mean}, {"median", r.median}, {"std", r.std}, {"max", r.max}, {"min", r.min}};
+    j["error"] = statistics_json(s);
+    j["relative_error"] = statistics_json(r);
   }
   std::cout << j.dump() << '\n';
   return 0;

@@ -1,10 +1,12 @@
 #pragma once
 // The interpolation methods the tool knows, behind one variant: each command builds one by name
 // and calls fit / train / apply through std::visit.
+#include <simsr/eval/error_statistics.hpp>
 #include <simsr/interp/interp.hpp>
 #include <simsr/io/npz.hpp>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <string>
 #include <variant>
@@ -116,6 +118,11 @@ inline std::vector<double> frame_displacements(const io::NpyArray& frames, const
     out.insert(out.end(), d.data(), d.data() + d.size());
   }
   return out;
+}
+
+/// Table-1 statistics as the tool prints them (the same keys in every command's JSON).
+inline nlohmann::ordered_json statistics_json(const eval::ErrorStatistics& s) {
+  return {{"mean", s.mean}, {"median", s.median}, {"std", s.std}, {"max", s.max}, {"min", s.min}};
 }
 
 }  // namespace simsr::cli

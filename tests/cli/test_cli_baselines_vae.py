@@ -24,7 +24,7 @@ except ImportError as e:
     sys.exit(77)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from test_cli_nn import box_surface, box_tets, check, deform, run, write_mesh, write_obj, FAILURES  # noqa: E402
+from test_cli_nn import check, run, write_box_pair, FAILURES  # noqa: E402
 
 
 def main():
@@ -36,17 +36,7 @@ def main():
     os.makedirs(work, exist_ok=True)
     P = lambda *a: os.path.join(work, *a)  # noqa: E731
 
-    lrV, lrT = box_tets(3)
-    hrV, hrF = box_surface(5)
-    write_mesh(P("lr.mesh"), lrV, lrT)
-    write_obj(P("hr.obj"), hrV, hrF)
-    rng = np.random.default_rng(11)
-    low, high = [], []
-    for _ in range(10):
-        A, w = 0.05 * rng.standard_normal((3, 3)), rng.uniform(0, 6, 3)
-        low.append(deform(lrV, A, w))
-        high.append(deform(hrV, A, w))
-    np.savez(P("frames.npz"), lowres=np.array(low), highres=np.array(high))
+    lrV, _, hrV, _, _, _ = write_box_pair(work, 3, 5, 10, 11)
 
     def baselines(out, *extra, expect=0):
         return run(exe, ["baselines", "--lr-rest", P("lr.mesh"), "--hr-rest", P("hr.obj"), "--frames", P("frames.npz"), "--out-dir", P(out)]

@@ -107,6 +107,25 @@ def write_obj(path, V, F):
             f.write("f %d %d %d\n" % tuple(t + 1))
 
 
+def write_box_pair(work, n_lr, n_hr, frames, seed, **extra):
+    """work/lr.mesh (n_lr^3 LR tet box), work/hr.obj (n_hr^3 grid boundary), work/frames.npz:
+    `frames` frames of a smooth random map (lowres, highres, plus the `extra` arrays).
+    Returns (lrV, lrT, hrV, hrF, low, high)."""
+    lrV, lrT = box_tets(n_lr)
+    hrV, hrF = box_surface(n_hr)
+    write_mesh(os.path.join(work, "lr.mesh"), lrV, lrT)
+    write_obj(os.path.join(work, "hr.obj"), hrV, hrF)
+    rng = np.random.default_rng(seed)
+    low, high = [], []
+    for _ in range(frames):
+        A, w = 0.05 * rng.standard_normal((3, 3)), rng.uniform(0, 6, 3)
+        low.append(deform(lrV, A, w))
+        high.append(deform(hrV, A, w))
+    low, high = np.array(low), np.array(high)
+    np.savez(os.path.join(work, "frames.npz"), lowres=low, highres=high, **extra)
+    return lrV, lrT, hrV, hrF, low, high
+
+
 def main():
     if len(sys.argv) < 2:
         print("usage: test_cli_nn.py SIMSR_EXE [WORK_DIR]")
@@ -116,19 +135,9 @@ def main():
     os.makedirs(work, exist_ok=True)
     P = lambda *a: os.path.join(work, *a)  # noqa: E731
 
-    lrV, lrT = box_tets(4)
-    hrV, hrF = box_surface(7)
-    write_mesh(P("lr.mesh"), lrV, lrT)
-    write_obj(P("hr.obj"), hrV, hrF)
-    rng = np.random.default_rng(5)
     F = 12
-    low, high = [], []
-    for _ in range(F):
-        A, w = 0.05 * rng.standard_normal((3, 3)), rng.uniform(0, 6, 3)
-        low.append(deform(lrV, A, w))
-        high.append(deform(hrV, A, w))
     ids = np.arange(100, 100 + F, dtype=np.int64)
-    np.savez(P("frames.npz"), lowres=np.array(low), highres=np.array(high), frame=ids)
+    lrV, lrT, hrV, hrF, low, high = write_box_pair(work, 4, 7, F, 5, frame=ids)
     N, M = len(lrV), len(hrV)
 
     base = ["train", "--lr-rest", P("lr.mesh"), "--hr-rest", P("hr.obj"), "--frames", P("frames.npz"), "--knn", "3", "--upk", "4",
@@ -177,7 +186,7 @@ def main():
         check(o["highres"].shape == (F, M, 3) and o["highres"].dtype == np.float64, "highres F×M×3 float64")
         check(np.array_equal(o["frame"], ids), "frame ids copied")
         check(np.isfinite(o["highres"]).all(), "predictions finite")
-        err = np.linalg.norm(o["highres"] - np.array(high), axis=2)
+        err = np.linalg.norm(o["highres"] - high, axis=2)
         check(abs(err.mean() - ji["error"]["mean"]) < 1e-12 * max(1.0, err.mean()), "infer's error mean = numpy's")
         pe = run(exe, ["eval", "--pred", P("pred.npz"), "--truth", P("frames.npz"), "--hr-rest", P("hr.obj")])
         if check(pe.returncode == 0, "eval of infer's output exits 0"):
