@@ -12,8 +12,10 @@ scripts/torch_to_simsr.py, loads into simsr and gives PyTorch's outputs.
 4. INTEROP_CHECK_EXE (tests/nn_peers/interop_check.cpp) loads MODEL.npz and compares:
    float32: inputs, code z, feature graph, upsampling weights, z^H, predictions (forward and the
             precomputed-weights inference path) and the loss terms within 1e-5 relative;
-            gradients and post-Adam weights within 1e-2 (BatchNorm-projected gradients are sums
-            of cancelling terms: two float32 summation orders differ at ~1e-3 there);
+            gradients within 5e-2 (BatchNorm-projected gradients are sums of cancelling terms:
+            two float32 summation orders differ there; observed worst 2e-3 to 8e-3, varying with
+            torch's own run-to-run reduction order), post-Adam weights within 2·lr
+            absolute (Adam's first step is ~lr·sign(g), and a noise-level g may flip its sign);
    float64: everything, gradients and post-Adam weights included, within 1e-5.
 5. With SIMSR_EXE: `simsr infer --model MODEL.npz` on the exported frames gives PyTorch's HR
    positions (rest + σ·prediction) within 1e-5 of the largest displacement.
@@ -71,7 +73,7 @@ def main():
         if run(s).returncode != 0:
             return 1
     failures = []
-    for dtype, grad_tol in (("float32", "1e-2"), ("float64", "1e-5")):
+    for dtype, grad_tol in (("float32", "5e-2"), ("float64", "1e-5")):
         d = os.path.join(work, "f32" if dtype == "float32" else "f64")
         p = run([exe, "--model", model, "--state", os.path.join(d, "state_dict.npz"), "--io", os.path.join(d, "io.npz"),
                  "--data-dir", bunny, "--dtype", dtype, "--tol", "1e-5", "--grad-tol", grad_tol])
