@@ -1,0 +1,202 @@
+#pragma once
+/// \file
+/// Hyperelastic energy of a tet mesh for any Material: E(x) = Σ_t V_t ψ(F_t) (SPEC §3; parameters
+/// are per unit rest volume, so coarse and fine meshes of one body agree in bulk).
+///
+///     physics::ElasticEnergy<physics::NeoHookean<>, exec::omp_t> elastic(mesh, material);
+///     double e = elastic.energy(x);   elastic.add_gradient(x, g);   elastic.add_hessian(x, H);
+///
+/// Assembly is deterministic and free of atomics: element forces and stiffnesses go to per-tet
+/// buffers in parallel, then every vertex (gradient) or block (Hessian) gathers its own
+/// contributions in a fixed order, so seq and omp give bitwise-identical results. The buffers
+/// are owned by the object and reused (const methods mutate them: one object, one thread of
+/// calls at a time).
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "../core/error.hpp"
+#include "../core/parallel.hpp"
+#include "../core/types.hpp"
+#include "../mesh/tet_mesh.hpp"
+#include "energy_term.hpp"
+#include "hessian.hpp"
+#include "materials/material.hpp"
+#include "tet_elements.hpp"
+
+namespace simsr::physics {
+
+namespace detail {
+/// Materials with element data to validate offer `check(element)` (throws ArgumentError).
+template <class M>
+concept ChecksElements = requires(const M& m, const typename M::Element& e) { m.check(e); };
+}  // namespace detail
+
+/// Σ_t V_t ψ(F_t) over the tets of a rest mesh (see the file comment).
+template <Material M, exec::HostPolicy Policy = exec::seq_t>
+class ElasticEnergy {
+ public:
+  using S = typename M::scalar_type;
+  using Element = typename M::Element;
+  using material_type = M;
+
+  /// `elements`: one per tet (fibre directions, activations), or empty for default elements.
+  ElasticEnergy(const TetMesh<S>& rest, M material, std::vector<Element> elements = {}, Policy policy = {})
+      : T_(rest.T), n_(rest.num_vertices()), material_(std::move(material)), policy_(policy) {
+    rest_ = tet_rest_data(policy_, rest.V, rest.T);
+    if (elements.empty()) elements.resize(std::size_t(T_.rows()));
+    set_elements(std::move(elements));
+    D_.resize(std::size_t(T_.rows()));
+    for (Index t = 0; t < T_.rows(); ++t) D_[std::size_t(t)] = shape_gradients(rest_.Dm_inv[std::size_t(t)]);
+    // vertex → (tet, corner) lists for the gradient gather
+    vertex_offsets_.assign(std::size_t(n_) + 1, 0);
+    for (Index t = 0; t < T_.rows(); ++t)
+      for (int a = 0; a < 4; ++a) ++vertex_offsets_[std::size_t(T_(t, a)) + 1];
+    for (Index v = 0; v < n_; ++v) vertex_offsets_[std::size_t(v) + 1] += vertex_offsets_[std::size_t(v)];
+    vertex_entries_.resize(std::size_t(4 * T_.rows()));
+    std::vector<Index> fill(vertex_offsets_.begin(), vertex_offsets_.end() - 1);
+    for (Index t = 0; t < T_.rows(); ++t)
+      for (int a = 0; a < 4; ++a) vertex_entries_[std::size_t(fill[std::size_t(T_(t, a))]++)] = std::int32_t(4 * t + a);
+  }
+
+  Index num_vertices() const { return n_; }
+  Index num_tets() const { return T_.rows(); }
+  const Tets& tets() const { return T_; }
+  const TetRestData<S>& rest() const { return rest_; }
+  const M& material() const { return material_; }
+  M& material() { return material_; }
+  const std::vector<Element>& elements() const { return elements_; }
+  /// Replaces the per-tet data (e.g. this frame's activations); checked like the constructor's.
+  void set_elements(std::vector<Element> elements) {
+    if (Index(elements.size()) != T_.rows())
+      throw ShapeError("ElasticEnergy: element data (one per tet)", {T_.rows()}, {Index(elements.size())});
+    if constexpr (detail::ChecksElements<M>) {
+      for (std::size_t t = 0; t < elements.size(); ++t) {
+        try {
+          material_.check(elements[t]);
+        } catch (const ArgumentError& e) {
+          throw ArgumentError("ElasticEnergy: tet " + std::to_string(t) + ": " + e.what());
+        }
+      }
+    }
+    elements_ = std::move(elements);
+  }
+
+  /// F of tet t at x.
+  template <class DX>
+  Mat3<S> deformation_gradient(const Eigen::MatrixBase<DX>& x, Index t) const {
+    return physics::deformation_gradient(x, T_, t, rest_.Dm_inv[std::size_t(t)]);
+  }
+
+  /// Σ_t V_t ψ(F_t) (J).
+  S energy(const Points<S>& x) const {
+    physics::detail::require_positions("ElasticEnergy::energy: x", x, n_);
+    return exec::parallel_reduce(
+        policy_, T_.rows(), S(0),
+        [&](Index t) { return rest_.volume[t] * material_.energy(deformation_gradient(x, t), elements_[std::size_t(t)]); },
+        [](S a, S b) { return a + b; });
+  }
+
+  /// g += ∂E/∂x (#V×3, N).
+  void add_gradient(const Points<S>& x, Points<S>& g) const {
+    physics::detail::require_positions("ElasticEnergy::add_gradient: x", x, n_);
+    physics::detail::require_positions("ElasticEnergy::add_gradient: g", g, n_);
+    forces_.resize(3, 4 * T_.rows());
+    exec::parallel_for(policy_, T_.rows(), [&](Index t) {
+      const Mat3<S> P = material_.stress(deformation_gradient(x, t), elements_[std::size_t(t)]);
+      forces_.template middleCols<4>(4 * t).noalias() = rest_.volume[t] * P * D_[std::size_t(t)].transpose();
+    });
+    exec::parallel_for(policy_, n_, [&](Index v) {
+      Vec3<S> sum = Vec3<S>::Zero();
+      for (Index k = vertex_offsets_[std::size_t(v)]; k < vertex_offsets_[std::size_t(v) + 1]; ++k) sum += forces_.col(vertex_entries_[std::size_t(k)]);
+      g.row(v) += sum.transpose();
+    });
+  }
+
+  /// Element stiffness of tet t (12×12, vertex-major), with the definiteness fix by default.
+  template <class DX>
+  Mat12<S> element_hessian(const Eigen::MatrixBase<DX>& x, Index t, Definiteness d = Definiteness::project) const {
+    const Mat9<S> A = material_.stress_derivative(deformation_gradient(x, t), elements_[std::size_t(t)], d);
+    return element_stiffness(A, D_[std::size_t(t)], rest_.volume[t]);
+  }
+
+  /// Generic path (EnergyTerm): every element's 16 blocks as triplets.
+  void add_hessian(const Points<S>& x, BlockTriplets<S>& H) const {
+    physics::detail::require_positions("ElasticEnergy::add_hessian: x", x, n_);
+    for (Index t = 0; t < T_.rows(); ++t) {
+      const Mat12<S> K = element_hessian(x, t);
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) H.add(T_(t, a), T_(t, b), K.template block<3, 3>(3 * a, 3 * b));
+    }
+  }
+
+  /// Fast path: element stiffnesses computed in parallel, then gathered block by block into H's
+  /// pattern (which must contain the tets' blocks, as BlockHessian(num_vertices, T) does).
+  void add_hessian(const Points<S>& x, BlockHessian<S>& H) const {
+    physics::detail::require_positions("ElasticEnergy::add_hessian: x", x, n_);
+    if (H.num_vertices() != n_) throw ShapeError("ElasticEnergy::add_hessian: Hessian vertices", {n_}, {H.num_vertices()});
+    if (gather_version_ != H.pattern_version()) build_gather(H);
+    stiffness_.resize(std::size_t(T_.rows()));
+    exec::parallel_for(policy_, T_.rows(), [&](Index t) { stiffness_[std::size_t(t)] = element_hessian(x, t); });
+    exec::parallel_for(policy_, H.num_blocks(), [&](Index s) {
+      Mat3<S> sum = Mat3<S>::Zero();
+      for (Index k = gather_offsets_[std::size_t(s)]; k < gather_offsets_[std::size_t(s) + 1]; ++k) {
+        const std::int64_t e = gather_entries_[std::size_t(k)];
+        const int ab = int(e & 15);
+        sum += stiffness_[std::size_t(e >> 4)].template block<3, 3>(3 * (ab >> 2), 3 * (ab & 3));
+      }
+      H.block(s) += sum;
+    });
+  }
+
+  /// Number of tets with det F ≤ 0 at x.
+  Index count_inverted(const Points<S>& x) const {
+    return exec::parallel_reduce(
+        policy_, T_.rows(), Index(0), [&](Index t) { return Index(deformation_gradient(x, t).determinant() <= S(0)); },
+        [](Index a, Index b) { return a + b; });
+  }
+
+ private:
+  void build_gather(const BlockHessian<S>& H) const {
+    const Index nb = H.num_blocks();
+    std::vector<Index> slots(std::size_t(16 * T_.rows()));
+    exec::parallel_for(policy_, T_.rows(), [&](Index t) {
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) {
+          const Index s = H.slot(T_(t, a), T_(t, b));
+          if (s < 0) throw MeshError("tet", t, "its vertex pair is missing from the Hessian pattern (build it from the same tets)");
+          slots[std::size_t(16 * t + 4 * a + b)] = s;
+        }
+    });
+    gather_offsets_.assign(std::size_t(nb) + 1, 0);
+    for (Index s : slots) ++gather_offsets_[std::size_t(s) + 1];
+    for (Index s = 0; s < nb; ++s) gather_offsets_[std::size_t(s) + 1] += gather_offsets_[std::size_t(s)];
+    gather_entries_.resize(slots.size());
+    std::vector<Index> fill(gather_offsets_.begin(), gather_offsets_.end() - 1);
+    for (std::size_t e = 0; e < slots.size(); ++e) gather_entries_[std::size_t(fill[std::size_t(slots[e])]++)] = std::int64_t(e);
+    gather_version_ = H.pattern_version();
+  }
+
+  Tets T_;
+  Index n_ = 0;
+  M material_;
+  Policy policy_;
+  TetRestData<S> rest_;
+  std::vector<Element> elements_;
+  std::vector<Eigen::Matrix<S, 4, 3>, Eigen::aligned_allocator<Eigen::Matrix<S, 4, 3>>> D_;
+  std::vector<Index> vertex_offsets_;
+  std::vector<std::int32_t> vertex_entries_;
+  // scratch (see the file comment)
+  mutable Eigen::Matrix<S, 3, Eigen::Dynamic> forces_;
+  mutable std::vector<Mat12<S>, Eigen::aligned_allocator<Mat12<S>>> stiffness_;
+  mutable std::vector<Index> gather_offsets_;
+  mutable std::vector<std::int64_t> gather_entries_;
+  mutable std::uint64_t gather_version_ = 0;
+};
+
+}  // namespace simsr::physics

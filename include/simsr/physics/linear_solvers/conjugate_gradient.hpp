@@ -1,0 +1,162 @@
+#pragma once
+/// \file
+/// Preconditioned conjugate gradients under an execution policy, with Jacobi (1/A_ii) or
+/// block-Jacobi (the inverse 3×3 vertex blocks) preconditioning. Products and dot products run
+/// under the policy with fixed chunking, so seq and omp iterate identically.
+///
+///     physics::ConjugateGradient<physics::BlockJacobi<>, exec::omp_t> pcg({.tolerance = 1e-6});
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "../../core/error.hpp"
+#include "../../core/parallel.hpp"
+#include "../../core/types.hpp"
+#include "linear_solver.hpp"
+
+namespace simsr::physics {
+
+/// z = D⁻¹ r with D = diag(A). Non-positive diagonal entries (rows with no stiffness) act as 1.
+template <class S = Scalar>
+class Jacobi {
+ public:
+  template <exec::HostPolicy P>
+  void compute(P policy, const SparseMatrix<S>& A) {
+    inv_.resize(A.rows());
+    exec::parallel_for(policy, A.rows(), [&](Index r) {
+      const S d = A.coeff(r, r);
+      inv_[r] = d > S(0) ? S(1) / d : S(1);
+    });
+  }
+  template <exec::HostPolicy P>
+  void apply(P policy, const VecX<S>& r, VecX<S>& z) const {
+    exec::parallel_for(policy, r.size(), [&](Index i) { z[i] = inv_[i] * r[i]; });
+  }
+
+ private:
+  VecX<S> inv_;
+};
+
+/// z_v = B_v⁻¹ r_v with B_v the 3×3 diagonal block of vertex v (A is 3V×3V, vertex-major). A
+/// singular block falls back to its diagonal.
+template <class S = Scalar>
+class BlockJacobi {
+ public:
+  template <exec::HostPolicy P>
+  void compute(P policy, const SparseMatrix<S>& A) {
+    if (A.rows() % 3 != 0) throw ShapeError("BlockJacobi: matrix rows (3 per vertex)", {-1}, {A.rows()});
+    inv_.resize(std::size_t(A.rows() / 3));
+    exec::parallel_for(policy, A.rows() / 3, [&](Index v) {
+      Mat3<S> B;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) B(i, j) = A.coeff(3 * v + i, 3 * v + j);
+      const S scale = B.cwiseAbs().maxCoeff();
+      const S det = B.determinant();
+      Mat3<S> inv = Mat3<S>::Zero();
+      if (scale > S(0) && det > S(1e-12) * scale * scale * scale) {
+        inv = B.inverse();
+      } else {
+        for (int i = 0; i < 3; ++i) inv(i, i) = B(i, i) > S(0) ? S(1) / B(i, i) : S(1);
+      }
+      inv_[std::size_t(v)] = inv;
+    });
+  }
+  template <exec::HostPolicy P>
+  void apply(P policy, const VecX<S>& r, VecX<S>& z) const {
+    exec::parallel_for(policy, Index(inv_.size()), [&](Index v) { z.template segment<3>(3 * v).noalias() = inv_[std::size_t(v)] * r.template segment<3>(3 * v); });
+  }
+
+ private:
+  std::vector<Mat3<S>, Eigen::aligned_allocator<Mat3<S>>> inv_;
+};
+
+/// Options of ConjugateGradient.
+struct ConjugateGradientOptions {
+  double tolerance = 1e-6;     ///< stop when ‖b − A x‖ ≤ tolerance·‖b‖
+  Index max_iterations = 0;    ///< 0: the system size
+};
+
+/// PCG from x = 0 (see the file comment). Buffers are kept between solves.
+template <class Preconditioner = BlockJacobi<Scalar>, exec::HostPolicy Policy = exec::seq_t, class S = Scalar>
+class ConjugateGradient {
+ public:
+  using scalar_type = S;
+  explicit ConjugateGradient(ConjugateGradientOptions options = {}, Policy policy = {}) : options_(options), policy_(policy) {}
+
+  ConjugateGradientOptions& options() { return options_; }
+
+  void compute(const SparseMatrix<S>& A, std::uint64_t /*pattern_version*/ = 0) {
+    if (A.rows() != A.cols()) throw ShapeError("ConjugateGradient: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
+    A_ = &A;
+    preconditioner_.compute(policy_, A);
+  }
+
+  LinearSolveInfo solve(const VecX<S>& b, VecX<S>& x) {
+    if (!A_) throw Error("ConjugateGradient::solve called before compute");
+    const Index n = A_->rows();
+    if (b.size() != n) throw ShapeError("ConjugateGradient: right-hand side", {n}, {b.size()});
+    x.setZero(n);
+    r_ = b;
+    z_.resize(n);
+    p_.resize(n);
+    q_.resize(n);
+    const S bnorm = std::sqrt(dot(b, b));
+    LinearSolveInfo info;
+    if (bnorm == S(0)) return info;
+    const Index max_it = options_.max_iterations > 0 ? options_.max_iterations : n;
+    preconditioner_.apply(policy_, r_, z_);
+    p_ = z_;
+    S rz = dot(r_, z_);
+    S rnorm = bnorm;
+    for (Index it = 0; it < max_it; ++it) {
+      multiply(p_, q_);
+      const S pq = dot(p_, q_);
+      if (!(pq > S(0))) break;  // direction of zero curvature: the system is singular along p
+      const S alpha = rz / pq;
+      exec::parallel_for(policy_, n, [&](Index i) {
+        x[i] += alpha * p_[i];
+        r_[i] -= alpha * q_[i];
+      });
+      info.iterations = it + 1;
+      rnorm = std::sqrt(dot(r_, r_));
+      if (rnorm <= S(options_.tolerance) * bnorm) break;
+      preconditioner_.apply(policy_, r_, z_);
+      const S rz_new = dot(r_, z_);
+      const S beta = rz_new / rz;
+      rz = rz_new;
+      exec::parallel_for(policy_, n, [&](Index i) { p_[i] = z_[i] + beta * p_[i]; });
+    }
+    info.relative_residual = double(rnorm / bnorm);
+    info.converged = info.relative_residual <= options_.tolerance;
+    return info;
+  }
+
+ private:
+  S dot(const VecX<S>& a, const VecX<S>& b) const {
+    return exec::parallel_reduce(policy_, a.size(), S(0), [&](Index i) { return a[i] * b[i]; }, [](S u, S v) { return u + v; });
+  }
+  void multiply(const VecX<S>& v, VecX<S>& out) const {
+    const SparseMatrix<S>& A = *A_;
+    const int* outer = A.outerIndexPtr();
+    const int* inner = A.innerIndexPtr();
+    const S* val = A.valuePtr();
+    exec::parallel_for(policy_, A.rows(), [&](Index r) {
+      S s = 0;
+      for (int k = outer[r]; k < outer[r + 1]; ++k) s += val[k] * v[inner[k]];
+      out[r] = s;
+    });
+  }
+
+  ConjugateGradientOptions options_;
+  Policy policy_;
+  Preconditioner preconditioner_;
+  const SparseMatrix<S>* A_ = nullptr;
+  VecX<S> r_, z_, p_, q_;
+};
+
+}  // namespace simsr::physics

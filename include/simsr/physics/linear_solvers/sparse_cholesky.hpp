@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// Sparse direct solver: Eigen's simplicial LDLᵀ with AMD ordering. The symbolic analysis is
+/// redone only when the Hessian's pattern changes; each Newton iteration refactorizes.
+///
+///     physics::QuasistaticSolver<physics::SparseCholesky<>> newton;
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include "../../core/error.hpp"
+#include "../../core/types.hpp"
+#include "linear_solver.hpp"
+
+namespace simsr::physics {
+
+/// LDLᵀ of a symmetric positive definite matrix (see the file comment). Sequential (Eigen's
+/// simplicial factorization has no parallel path).
+template <class S = Scalar>
+class SparseCholesky {
+ public:
+  using scalar_type = S;
+
+  /// Throws ConvergenceError (0 iterations, residual NaN) when the factorization breaks down
+  /// (a zero pivot: the matrix is singular, e.g. rigid motions left unconstrained).
+  void compute(const SparseMatrix<S>& A, std::uint64_t pattern_version = 0) {
+    if (A.rows() != A.cols()) throw ShapeError("SparseCholesky: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
+    // A symmetric row-major CSR read as column-major is its transpose, i.e. itself.
+    const Eigen::Map<const Eigen::SparseMatrix<S, Eigen::ColMajor, int>> Ac(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(),
+                                                                          A.innerIndexPtr(), A.valuePtr());
+    if (!analyzed_ || pattern_version != version_ || A.rows() != rows_ || A.nonZeros() != nnz_) {
+      ldlt_.analyzePattern(Ac);
+      analyzed_ = true;
+      version_ = pattern_version;
+      rows_ = A.rows();
+      nnz_ = A.nonZeros();
+    }
+    ldlt_.factorize(Ac);
+    if (ldlt_.info() != Eigen::Success)
+      throw ConvergenceError("SparseCholesky (LDLT factorization: singular matrix)", 0, std::numeric_limits<double>::quiet_NaN());
+    A_ = &A;
+  }
+
+  LinearSolveInfo solve(const VecX<S>& b, VecX<S>& x) {
+    if (!A_) throw Error("SparseCholesky::solve called before compute");
+    if (b.size() != rows_) throw ShapeError("SparseCholesky: right-hand side", {rows_}, {b.size()});
+    x = ldlt_.solve(b);
+    LinearSolveInfo info;
+    const S bn = b.norm();
+    info.relative_residual = bn > S(0) ? double((b - (*A_) * x).norm() / bn) : 0.0;
+    info.converged = std::isfinite(info.relative_residual);
+    return info;
+  }
+
+ private:
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+  const SparseMatrix<S>* A_ = nullptr;
+  bool analyzed_ = false;
+  std::uint64_t version_ = 0;
+  Index rows_ = 0, nnz_ = 0;
+};
+
+}  // namespace simsr::physics

@@ -1,0 +1,214 @@
+#pragma once
+/// \file
+/// Quasistatic solver (SPEC §3, Park et al. 2023 §4: both simulators are quasistatic): minimize
+/// the total potential Σ E_k(x) over the free vertices, bones held by Dirichlet conditions, by
+/// Newton's method with a backtracking (Armijo) line search on the total energy. The Hessian is
+/// the terms' definiteness-fixed one, so every Newton direction descends. Warm start: x comes in
+/// as the previous frame's solution and leaves as this frame's.
+///
+///     physics::QuasistaticSolver<physics::SparseCholesky<>, exec::omp_t> newton(mesh.num_vertices(), mesh.T);
+///     auto report = newton.solve(x, bones.boundary(), elastic, gravity, tracks);   // throws ConvergenceError
+///
+/// The linear solver is a policy (LinearSolver concept): SparseCholesky, or ConjugateGradient with
+/// Jacobi / BlockJacobi preconditioning under seq or omp.
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "../core/error.hpp"
+#include "../core/parallel.hpp"
+#include "../core/types.hpp"
+#include "energy_term.hpp"
+#include "forces/bone_attachment.hpp"
+#include "hessian.hpp"
+#include "linear_solvers/linear_solvers.hpp"
+
+namespace simsr::physics {
+
+/// One Newton iteration, as reported to a progress callback and kept in NewtonReport::history.
+struct NewtonIteration {
+  Index iteration = 0;
+  double energy = 0;              ///< total energy before the step (J)
+  double gradient_norm = 0;       ///< ‖∂E/∂x‖ over free DOFs before the step (N)
+  double step_length = 0;         ///< accepted line-search factor α
+  Index backtracks = 0;
+  Index linear_iterations = 0;
+  double linear_residual = 0;
+};
+
+/// Options of QuasistaticSolver.
+struct NewtonOptions {
+  /// Converged when ‖g‖ ≤ max(absolute_tolerance, relative_tolerance · reference), where
+  /// reference = reference_force if > 0, else ‖g‖ at the start of this solve.
+  double relative_tolerance = 1e-6;
+  double absolute_tolerance = 0;  ///< N
+  double reference_force = 0;     ///< N
+  Index max_iterations = 100;
+  double armijo = 1e-4;           ///< sufficient decrease: E(x+αd) ≤ E(x) + armijo·α·gᵀd
+  Index max_backtracks = 40;      ///< each halves α
+  /// Called after every iteration (progress lines for long runs).
+  std::function<void(const NewtonIteration&)> progress;
+};
+
+/// What a solve did.
+struct NewtonReport {
+  bool converged = false;
+  Index iterations = 0;
+  double energy = 0;
+  double initial_gradient_norm = 0;
+  double gradient_norm = 0;
+  Index linear_iterations = 0;
+  std::vector<NewtonIteration> history;
+};
+
+/// Newton with line search over a sum of EnergyTerms (see the file comment).
+template <LinearSolver Linear = SparseCholesky<Scalar>, exec::HostPolicy Policy = exec::seq_t>
+class QuasistaticSolver {
+ public:
+  using S = typename Linear::scalar_type;
+
+  /// The Hessian pattern comes from the tets (every term coupling vertices within one tet fits it).
+  QuasistaticSolver(Index num_vertices, const Tets& T, NewtonOptions options = {}, Linear linear = {}, Policy policy = {})
+      : n_(num_vertices), options_(std::move(options)), linear_(std::move(linear)), policy_(policy), H_(num_vertices, T) {}
+
+  NewtonOptions& options() { return options_; }
+  Linear& linear_solver() { return linear_; }
+  const BlockHessian<S>& hessian() const { return H_; }
+
+  /// Minimizes Σ terms over x (#V×3, in/out: the warm start), with x of the boundary's vertices
+  /// set to their targets first. Throws ConvergenceError (iterations, gradient norm) when the
+  /// tolerance is not met within max_iterations or the line search cannot decrease the energy.
+  template <class... Terms>
+  NewtonReport solve(Points<S>& x, const DirichletBoundary<S>& boundary, const Terms&... terms) {
+    static_assert(sizeof...(Terms) > 0, "QuasistaticSolver::solve needs at least one energy term");
+    static_assert((EnergyTerm<Terms, S> && ...), "every term passed to QuasistaticSolver::solve must model physics::EnergyTerm "
+                                                 "(energy(x), add_gradient(x, g), add_hessian(x, BlockTriplets&))");
+    detail::require_positions("QuasistaticSolver::solve: x", x, n_);
+    apply_boundary(x, boundary);
+    NewtonReport report;
+    double reference = 0;
+    for (Index it = 0;; ++it) {
+      const double E = total_energy(x, terms...);
+      if (!std::isfinite(E)) throw ConvergenceError("quasistatic Newton (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
+      gradient(x, terms...);
+      const double gnorm = double(g_.norm());
+      if (it == 0) {
+        report.initial_gradient_norm = gnorm;
+        reference = options_.reference_force > 0 ? options_.reference_force : gnorm;
+      }
+      report.iterations = it;
+      report.energy = E;
+      report.gradient_norm = gnorm;
+      if (gnorm <= std::max(options_.absolute_tolerance, options_.relative_tolerance * reference)) {
+        report.converged = true;
+        return report;
+      }
+      if (it >= options_.max_iterations) throw ConvergenceError("quasistatic Newton", it, gnorm);
+
+      // Newton direction: H d = −g (fixed DOFs: identity rows, zero right-hand side).
+      H_.set_zero();
+      (add_hessian(x, terms), ...);
+      const SparseMatrix<S>& A = H_.assemble(policy_, fixed_);
+      linear_.compute(A, H_.pattern_version());
+      rhs_ = -g_;
+      const LinearSolveInfo info = linear_.solve(rhs_, d_);
+      report.linear_iterations += info.iterations;
+      double slope = double(g_.dot(d_));
+      if (!(slope < 0) || !d_.allFinite()) {  // not a descent direction (an unconverged iterative solve): fall back to −g
+        d_ = -g_;
+        slope = -double(g_.squaredNorm());
+      }
+
+      // Backtracking on the total energy; differences below round-off of the terms' magnitudes
+      // count as no increase, so the last steps of a converged solve are not rejected by noise.
+      const double noise = 64 * std::numeric_limits<double>::epsilon() * magnitude_;
+      double alpha = 1;
+      Index backtracks = 0;
+      for (;; ++backtracks) {
+        trial_ = x;
+        Eigen::Map<VecX<S>>(trial_.data(), 3 * n_) += S(alpha) * d_;
+        const double Et = total_energy(trial_, terms...);
+        if (std::isfinite(Et) && Et <= E + options_.armijo * alpha * slope + noise) break;
+        if (backtracks >= options_.max_backtracks)
+          throw ConvergenceError("quasistatic Newton (line search: no decrease along the Newton direction at iteration " + std::to_string(it) + ")",
+                                 it, gnorm);
+        alpha *= 0.5;
+      }
+      x.swap(trial_);
+      NewtonIteration record{it, E, gnorm, alpha, backtracks, info.iterations, info.relative_residual};
+      report.history.push_back(record);
+      if (options_.progress) options_.progress(record);
+    }
+  }
+
+  /// Σ terms' energies at x (J).
+  template <class... Terms>
+  double total_energy(const Points<S>& x, const Terms&... terms) {
+    double sum = 0, mag = 0;
+    const auto one = [&](const auto& t) {
+      const double e = double(t.energy(x));
+      sum += e;
+      mag += std::abs(e);
+    };
+    (one(terms), ...);
+    magnitude_ = mag;
+    return sum;
+  }
+
+  /// ∂E/∂x over the free DOFs (fixed ones zeroed) as a 3V vector, vertex-major.
+  template <class... Terms>
+  const VecX<S>& gradient(const Points<S>& x, const Terms&... terms) {
+    grad_.setZero(n_, 3);
+    (terms.add_gradient(x, grad_), ...);
+    g_ = Eigen::Map<const VecX<S>>(grad_.data(), 3 * n_);
+    for (Index k = 0; k < 3 * n_; ++k)
+      if (fixed_[std::size_t(k)]) g_[k] = 0;
+    return g_;
+  }
+
+ private:
+  void apply_boundary(Points<S>& x, const DirichletBoundary<S>& b) {
+    if (b.targets.rows() != b.vertices.size() || b.targets.cols() != 3)
+      throw ShapeError("QuasistaticSolver: Dirichlet targets", {b.vertices.size(), 3}, {b.targets.rows(), b.targets.cols()});
+    fixed_.assign(std::size_t(3 * n_), 0);
+    for (Index k = 0; k < b.vertices.size(); ++k) {
+      const VIndex v = b.vertices[k];
+      if (v < 0 || v >= n_) throw MeshError("vertex", v, "Dirichlet vertex out of range [0, " + std::to_string(n_) + ")");
+      if (!b.targets.row(k).allFinite()) throw MeshError("vertex", v, "Dirichlet target is not finite");
+      x.row(v) = b.targets.row(k);
+      for (int c = 0; c < 3; ++c) fixed_[std::size_t(3 * v + c)] = 1;
+    }
+    if (!x.allFinite()) throw ShapeError("QuasistaticSolver: x has non-finite entries", {n_, 3}, {x.rows(), x.cols()});
+  }
+
+  template <class T>
+  void add_hessian(const Points<S>& x, const T& term) {
+    if constexpr (requires { term.add_hessian(x, H_); }) {
+      term.add_hessian(x, H_);
+    } else {
+      triplets_.clear();
+      term.add_hessian(x, triplets_);
+      H_.add(triplets_);
+    }
+  }
+
+  Index n_;
+  NewtonOptions options_;
+  Linear linear_;
+  Policy policy_;
+  BlockHessian<S> H_;
+  BlockTriplets<S> triplets_;
+  std::vector<char> fixed_;
+  Points<S> grad_, trial_;
+  VecX<S> g_, rhs_, d_;
+  double magnitude_ = 0;
+};
+
+}  // namespace simsr::physics

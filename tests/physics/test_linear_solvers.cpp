@@ -1,0 +1,108 @@
+#include <simsr/mesh/generators.hpp>
+#include <simsr/physics/elastic_energy.hpp>
+#include <simsr/physics/linear_solvers/linear_solvers.hpp>
+
+#include <doctest/doctest.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+#include "stvk_material.hpp"
+
+using namespace simsr;
+using namespace simsr::physics;
+
+namespace {
+
+/// An SPD system from a real stiffness matrix: a StVK block at rest with its x = 0 face fixed.
+struct System {
+  BlockHessian<> H;
+  std::vector<char> fixed;
+  VecX<> b;
+};
+
+System make_system(unsigned seed) {
+  const auto mesh = box_tet_mesh<double>(4, 2, 2, Vec3<>(0, 0, 0), Vec3<>(2, 1, 1));
+  ElasticEnergy<simsr_test::StVK> E(mesh, {1.0, 2.0});
+  System s{BlockHessian<>(mesh.num_vertices(), mesh.T), std::vector<char>(std::size_t(3 * mesh.num_vertices()), 0), {}};
+  s.H.set_zero();
+  E.add_hessian(mesh.V, s.H);
+  for (Index v = 0; v < mesh.num_vertices(); ++v)
+    if (mesh.V(v, 0) == 0.0)
+      for (int c = 0; c < 3; ++c) s.fixed[std::size_t(3 * v + c)] = 1;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> N;
+  s.b.resize(3 * mesh.num_vertices());
+  for (Index i = 0; i < s.b.size(); ++i) s.b[i] = s.fixed[std::size_t(i)] ? 0.0 : N(rng);
+  return s;
+}
+
+template <class L>
+void check_solver(L solver, double tol) {
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    System s = make_system(seed);
+    const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
+    const Eigen::MatrixXd Ad(A);
+    const VecX<> ref = Ad.ldlt().solve(s.b);
+    solver.compute(A, s.H.pattern_version());
+    VecX<> x;
+    const LinearSolveInfo info = solver.solve(s.b, x);
+    CHECK(info.converged);
+    CHECK((x - ref).norm() <= tol * ref.norm());
+    CHECK((Ad * x - s.b).norm() <= 10 * tol * s.b.norm());
+  }
+}
+
+}  // namespace
+
+TEST_CASE("linear solvers model the concept") {
+  static_assert(LinearSolver<SparseCholesky<>>);
+  static_assert(LinearSolver<ConjugateGradient<Jacobi<>, exec::seq_t>>);
+  static_assert(LinearSolver<ConjugateGradient<BlockJacobi<>, exec::omp_t>>);
+}
+
+TEST_CASE("SparseCholesky and PCG (Jacobi, block-Jacobi; seq, omp) solve stiffness systems like a dense LDLT") {
+  check_solver(SparseCholesky<>{}, 1e-10);
+  check_solver(ConjugateGradient<Jacobi<>, exec::seq_t>({.tolerance = 1e-11}), 1e-8);
+  check_solver(ConjugateGradient<BlockJacobi<>, exec::seq_t>({.tolerance = 1e-11}), 1e-8);
+  check_solver(ConjugateGradient<BlockJacobi<>, exec::omp_t>({.tolerance = 1e-11}), 1e-8);
+}
+
+TEST_CASE("PCG: block-Jacobi needs no more iterations than Jacobi; seq and omp iterate identically") {
+  System s = make_system(9);
+  const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
+  ConjugateGradient<Jacobi<>, exec::seq_t> jac({.tolerance = 1e-8});
+  ConjugateGradient<BlockJacobi<>, exec::seq_t> blk({.tolerance = 1e-8});
+  ConjugateGradient<BlockJacobi<>, exec::omp_t> blk_omp({.tolerance = 1e-8});
+  VecX<> x1, x2, x3;
+  jac.compute(A);
+  blk.compute(A);
+  blk_omp.compute(A);
+  const auto i1 = jac.solve(s.b, x1), i2 = blk.solve(s.b, x2), i3 = blk_omp.solve(s.b, x3);
+  CHECK(i2.iterations <= i1.iterations);
+  CHECK(i2.iterations == i3.iterations);
+  CHECK((x2 - x3).cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("PCG reports non-convergence; Cholesky of a singular matrix is a ConvergenceError; b = 0 gives x = 0") {
+  System s = make_system(3);
+  const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
+  ConjugateGradient<Jacobi<>, exec::seq_t> pcg({.tolerance = 1e-12, .max_iterations = 3});
+  pcg.compute(A);
+  VecX<> x;
+  const auto info = pcg.solve(s.b, x);
+  CHECK_FALSE(info.converged);
+  CHECK(info.iterations == 3);
+  CHECK(info.relative_residual > 1e-12);
+  CHECK(pcg.solve(VecX<>::Zero(s.b.size()), x).converged);
+  CHECK(x.norm() == 0.0);
+
+  // rank 2 in exact arithmetic: every symmetric pivot order meets an exact zero pivot
+  Eigen::Matrix3d Sd;
+  Sd << 1, 1, 0, 1, 1, 0, 0, 0, 1;
+  const SparseMatrix<> singular = Eigen::MatrixXd(Sd).sparseView();
+  SparseCholesky<> chol;
+  CHECK_THROWS_WITH_AS(chol.compute(singular, 1), doctest::Contains("SparseCholesky"), ConvergenceError);
+  chol.compute(A, s.H.pattern_version());
+  CHECK_THROWS_AS(chol.solve(VecX<>::Zero(5), x), ShapeError);
+}
