@@ -126,10 +126,10 @@ class ElasticEnergy {
   }
 
   /// Generic path (EnergyTerm): every element's 16 blocks as triplets.
-  void add_hessian(const Points<S>& x, BlockTriplets<S>& H) const {
+  void add_hessian(const Points<S>& x, BlockTriplets<S>& H, Definiteness d = Definiteness::project) const {
     physics::detail::require_positions("ElasticEnergy::add_hessian: x", x, n_);
     for (Index t = 0; t < T_.rows(); ++t) {
-      const Mat12<S> K = element_hessian(x, t);
+      const Mat12<S> K = element_hessian(x, t, d);
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b) H.add(T_(t, a), T_(t, b), K.template block<3, 3>(3 * a, 3 * b));
     }
@@ -137,12 +137,12 @@ class ElasticEnergy {
 
   /// Fast path: element stiffnesses computed in parallel, then gathered block by block into H's
   /// pattern (which must contain the tets' blocks, as BlockHessian(num_vertices, T) does).
-  void add_hessian(const Points<S>& x, BlockHessian<S>& H) const {
+  void add_hessian(const Points<S>& x, BlockHessian<S>& H, Definiteness d = Definiteness::project) const {
     physics::detail::require_positions("ElasticEnergy::add_hessian: x", x, n_);
     if (H.num_vertices() != n_) throw ShapeError("ElasticEnergy::add_hessian: Hessian vertices", {n_}, {H.num_vertices()});
     if (gather_version_ != H.pattern_version()) build_gather(H);
     stiffness_.resize(std::size_t(T_.rows()));
-    exec::parallel_for(policy_, T_.rows(), [&](Index t) { stiffness_[std::size_t(t)] = element_hessian(x, t); });
+    exec::parallel_for(policy_, T_.rows(), [&](Index t) { stiffness_[std::size_t(t)] = element_hessian(x, t, d); });
     exec::parallel_for(policy_, H.num_blocks(), [&](Index s) {
       Mat3<S> sum = Mat3<S>::Zero();
       for (Index k = gather_offsets_[std::size_t(s)]; k < gather_offsets_[std::size_t(s) + 1]; ++k) {

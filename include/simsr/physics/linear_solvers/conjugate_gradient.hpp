@@ -116,7 +116,11 @@ class ConjugateGradient {
     for (Index it = 0; it < max_it; ++it) {
       multiply(p_, q_);
       const S pq = dot(p_, q_);
-      if (!(pq > S(0))) break;  // direction of zero curvature: the system is singular along p
+      if (!(pq > S(0))) {  // zero or negative curvature along p: A is not positive definite
+        info.converged = false;
+        info.relative_residual = double(rnorm / bnorm);
+        return info;
+      }
       const S alpha = rz / pq;
       exec::parallel_for(policy_, n, [&](Index i) {
         x[i] += alpha * p_[i];

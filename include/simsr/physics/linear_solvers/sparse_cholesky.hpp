@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -32,23 +33,27 @@ class SparseCholesky {
     // A symmetric row-major CSR read as column-major is its transpose, i.e. itself.
     const Eigen::Map<const Eigen::SparseMatrix<S, Eigen::ColMajor, int>> Ac(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(),
                                                                           A.innerIndexPtr(), A.valuePtr());
+    if (!ldlt_) ldlt_ = std::make_unique<Factorization>();
     if (!analyzed_ || pattern_version != version_ || A.rows() != rows_ || A.nonZeros() != nnz_) {
-      ldlt_.analyzePattern(Ac);
+      ldlt_->analyzePattern(Ac);
       analyzed_ = true;
       version_ = pattern_version;
       rows_ = A.rows();
       nnz_ = A.nonZeros();
     }
-    ldlt_.factorize(Ac);
-    if (ldlt_.info() != Eigen::Success)
+    ldlt_->factorize(Ac);
+    if (ldlt_->info() != Eigen::Success)
       throw ConvergenceError("SparseCholesky (LDLT factorization: singular matrix)", 0, std::numeric_limits<double>::quiet_NaN());
     A_ = &A;
   }
 
+  /// Whether the last factorized matrix was positive definite (every pivot of D > 0).
+  bool positive_definite() const { return ldlt_ && (ldlt_->vectorD().array() > S(0)).all(); }
+
   LinearSolveInfo solve(const VecX<S>& b, VecX<S>& x) {
     if (!A_) throw Error("SparseCholesky::solve called before compute");
     if (b.size() != rows_) throw ShapeError("SparseCholesky: right-hand side", {rows_}, {b.size()});
-    x = ldlt_.solve(b);
+    x = ldlt_->solve(b);
     LinearSolveInfo info;
     const S bn = b.norm();
     info.relative_residual = bn > S(0) ? double((b - (*A_) * x).norm() / bn) : 0.0;
@@ -57,7 +62,10 @@ class SparseCholesky {
   }
 
  private:
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+  // Eigen's factorizations can be neither copied nor moved: held by pointer so the solver can be
+  // passed by value into QuasistaticSolver.
+  using Factorization = Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>, Eigen::Lower, Eigen::AMDOrdering<int>>;
+  std::unique_ptr<Factorization> ldlt_;
   const SparseMatrix<S>* A_ = nullptr;
   bool analyzed_ = false;
   std::uint64_t version_ = 0;
