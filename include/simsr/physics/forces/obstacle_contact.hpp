@@ -1,0 +1,199 @@
+#pragma once
+/// \file
+/// Penalty contact of designated vertices against analytic rigid obstacles (SPEC §3: a rigid
+/// sphere pushed into the cheek, §5.3 of Park et al. 2023). With d_i the obstacle's signed
+/// distance at vertex i (negative inside) and k_i the vertex's penalty stiffness (N/m):
+///
+///     E(x) = Σ_i k_i/2 min(d(x_i), 0)²                        (J)
+///
+///     physics::ObstacleContact contact(physics::Sphere<>(centre, 0.02), surface_vertices, V.rows(), 1e4);
+///     contact.obstacle().set_centre(centre + frame * step);   // move it each frame
+///
+/// Stiffness is per vertex in N/m; for resolution-independent contact pass k_i = κ A_i (κ in
+/// N/m³, A_i the vertex areas of simsr::vertex_areas), as the track springs do. The energy is
+/// C¹ (its Hessian jumps at d = 0). Obstacles are a concept: any type with signed distance,
+/// its gradient and its Hessian works.
+
+#include <cmath>
+#include <concepts>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+#include "../../core/types.hpp"
+#include "../energy_term.hpp"
+#include "detail/checks.hpp"
+
+namespace simsr::physics {
+
+/// A rigid obstacle: signed distance d(x) (m, negative inside), its gradient ∇d (unit outward
+/// normal where d is smooth) and its Hessian ∇²d (1/m), all total functions of x ∈ ℝ³.
+template <class O, class S = typename O::scalar_type>
+concept Obstacle = requires(const O& o, const Vec3<S>& x) {
+  { o.distance(x) } -> std::convertible_to<S>;
+  { o.distance_gradient(x) } -> std::convertible_to<Vec3<S>>;
+  { o.distance_hessian(x) } -> std::convertible_to<Mat3<S>>;
+};
+
+/// The half-space behind a plane through `point` with normal `normal` (normalized here; the
+/// free side is where it points): d = (x − p)·n, ∇d = n, ∇²d = 0.
+template <class S = Scalar>
+class Plane {
+ public:
+  using scalar_type = S;
+  /// ArgumentError for a zero or non-finite normal or a non-finite point.
+  Plane(const Vec3<S>& point, const Vec3<S>& normal) : p_(point) {
+    detail::require_finite_vector("Plane: point", point);
+    set_normal(normal);
+  }
+  const Vec3<S>& point() const { return p_; }
+  const Vec3<S>& normal() const { return n_; }
+  void set_point(const Vec3<S>& p) {
+    detail::require_finite_vector("Plane: point", p);
+    p_ = p;
+  }
+  void set_normal(const Vec3<S>& n) {
+    detail::require_finite_vector("Plane: normal", n);
+    if (!(n.norm() > S(0))) throw ArgumentError("Plane: normal is zero");
+    n_ = n.normalized();
+  }
+  S distance(const Vec3<S>& x) const { return (x - p_).dot(n_); }
+  Vec3<S> distance_gradient(const Vec3<S>&) const { return n_; }
+  Mat3<S> distance_hessian(const Vec3<S>&) const { return Mat3<S>::Zero(); }
+
+ private:
+  Vec3<S> p_, n_;
+};
+
+/// A solid ball: d = ‖x − c‖ − r, ∇d = n = (x − c)/‖x − c‖, ∇²d = (I − n nᵀ)/‖x − c‖. At the
+/// centre itself (where n is undefined) n = +z and ∇²d = 0.
+template <class S = Scalar>
+class Sphere {
+ public:
+  using scalar_type = S;
+  /// ArgumentError for a non-finite centre or a radius not finite and > 0.
+  Sphere(const Vec3<S>& centre, S radius) : r_(radius) {
+    detail::require_positive("Sphere: radius", radius);
+    set_centre(centre);
+  }
+  const Vec3<S>& centre() const { return c_; }
+  S radius() const { return r_; }
+  void set_centre(const Vec3<S>& c) {
+    detail::require_finite_vector("Sphere: centre", c);
+    c_ = c;
+  }
+  S distance(const Vec3<S>& x) const { return (x - c_).norm() - r_; }
+  Vec3<S> distance_gradient(const Vec3<S>& x) const {
+    const S l = (x - c_).norm();
+    return l > S(0) ? Vec3<S>((x - c_) / l) : Vec3<S>::UnitZ();
+  }
+  Mat3<S> distance_hessian(const Vec3<S>& x) const {
+    const S l = (x - c_).norm();
+    if (!(l > S(0))) return Mat3<S>::Zero();
+    const Vec3<S> n = (x - c_) / l;
+    return (Mat3<S>::Identity() - n * n.transpose()) / l;
+  }
+
+ private:
+  Vec3<S> c_;
+  S r_;
+};
+
+/// Penalty contact of `vertices` (indices into x) against one obstacle O.
+///
+/// Hessian per penetrating vertex: the 3×3 block k (∇d ∇dᵀ + d ∇²d), exact when positive
+/// semi-definite, otherwise with its negative eigenvalues clamped to 0 (PSD projection). For a
+/// Plane this is exactly k n nᵀ; for a Sphere d < 0 makes the tangential part k d/‖x − c‖ (I − n nᵀ)
+/// negative, so the projection keeps k n nᵀ (the penalty does not resist sliding on the sphere).
+template <class O, class S = typename O::scalar_type>
+  requires Obstacle<O, S>
+class ObstacleContact {
+ public:
+  using scalar_type = S;
+
+  /// Same stiffness k (N/m, finite, ≥ 0) on every vertex. ArgumentError for a vertex outside
+  /// [0, num_vertices) or a bad k.
+  ObstacleContact(O obstacle, IndexVector vertices, Index num_vertices, S k)
+      : ObstacleContact(std::move(obstacle), vertices, num_vertices, VecX<S>::Constant(vertices.size(), k)) {
+    detail::require_nonnegative("ObstacleContact: stiffness", k);
+  }
+  /// Per-vertex stiffness (#vertices, N/m; e.g. κ × vertex area). ShapeError for a size mismatch.
+  ObstacleContact(O obstacle, IndexVector vertices, Index num_vertices, VecX<S> k)
+      : o_(std::move(obstacle)), v_(std::move(vertices)), n_(num_vertices), k_(std::move(k)) {
+    detail::require_vertex_indices("ObstacleContact: vertices", v_, n_);
+    detail::require_nonnegative_each("ObstacleContact: stiffness", k_, v_.size());
+  }
+
+  O& obstacle() { return o_; }  ///< to move the obstacle between frames
+  const O& obstacle() const { return o_; }
+  const IndexVector& vertices() const { return v_; }
+  const VecX<S>& stiffness() const { return k_; }
+  Index num_vertices() const { return n_; }
+
+  /// Positions in `vertices()` (not vertex ids) of the penetrating vertices (d < 0), ascending.
+  std::vector<Index> active(const Points<S>& x) const {
+    detail::require_positions("ObstacleContact: x", x, n_);
+    std::vector<Index> a;
+    for (Index i = 0; i < v_.size(); ++i)
+      if (o_.distance(pos(x, i)) < S(0)) a.push_back(i);
+    return a;
+  }
+
+  S energy(const Points<S>& x) const {
+    detail::require_positions("ObstacleContact: x", x, n_);
+    S e = S(0);
+    for (Index i = 0; i < v_.size(); ++i) {
+      const S d = o_.distance(pos(x, i));
+      if (d < S(0)) e += k_[i] / S(2) * d * d;
+    }
+    return e;
+  }
+
+  void add_gradient(const Points<S>& x, Points<S>& g) const {
+    detail::require_positions("ObstacleContact: x", x, n_);
+    detail::require_positions("ObstacleContact: gradient", g, n_);
+    for (Index i = 0; i < v_.size(); ++i) {
+      const Vec3<S> p = pos(x, i);
+      const S d = o_.distance(p);
+      if (d < S(0)) g.row(v_[i]) += (k_[i] * d) * o_.distance_gradient(p).transpose();
+    }
+  }
+
+  void add_hessian(const Points<S>& x, BlockTriplets<S>& H) const {
+    detail::require_positions("ObstacleContact: x", x, n_);
+    for (Index i = 0; i < v_.size(); ++i) {
+      const Vec3<S> p = pos(x, i);
+      const S d = o_.distance(p);
+      if (!(d < S(0))) continue;
+      const Vec3<S> n = o_.distance_gradient(p);
+      H.add(v_[i], v_[i], k_[i] * project_psd(Mat3<S>(n * n.transpose() + d * o_.distance_hessian(p))));
+    }
+  }
+
+ private:
+  Vec3<S> pos(const Points<S>& x, Index i) const { return x.row(v_[i]).transpose(); }
+  static Mat3<S> project_psd(const Mat3<S>& A) {
+    const Mat3<S> sym = (A + A.transpose()) / S(2);
+    Eigen::SelfAdjointEigenSolver<Mat3<S>> es;
+    es.computeDirect(sym);
+    const S tol = S(64) * Eigen::NumTraits<S>::epsilon() * es.eigenvalues().cwiseAbs().maxCoeff();
+    if (es.eigenvalues().minCoeff() >= -tol) return sym;  // PSD up to rounding: keep the exact block
+    return es.eigenvectors() * es.eigenvalues().cwiseMax(S(0)).asDiagonal() * es.eigenvectors().transpose();
+  }
+
+  O o_;
+  IndexVector v_;
+  Index n_;
+  VecX<S> k_;
+};
+
+/// `ObstacleContact c(Sphere<>(...), vertices, n, k)` with k a scalar or any vector expression.
+template <class O, class K>
+ObstacleContact(O, IndexVector, Index, K) -> ObstacleContact<O>;
+
+static_assert(Obstacle<Plane<double>> && Obstacle<Sphere<double>>);
+static_assert(EnergyTerm<ObstacleContact<Sphere<double>>, double>);
+
+}  // namespace simsr::physics

@@ -1,0 +1,130 @@
+#include <simsr/physics/forces/obstacle_contact.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "forces_checks.hpp"
+
+using namespace simsr;
+using namespace simsr::physics;
+
+namespace {
+
+/// A user-defined obstacle: the inside of a spherical bowl (free inside, d = r − ‖x − c‖). Its
+/// exact penalty Hessian is PSD where d < 0, so ObstacleContact must return it unchanged.
+struct Bowl {
+  using scalar_type = double;
+  Vec3<> c;
+  double r;
+  double distance(const Vec3<>& x) const { return r - (x - c).norm(); }
+  Vec3<> distance_gradient(const Vec3<>& x) const { return -(x - c).normalized(); }
+  Mat3<> distance_hessian(const Vec3<>& x) const {
+    const double l = (x - c).norm();
+    const Vec3<> n = (x - c) / l;
+    return -(Mat3<>::Identity() - n * n.transpose()) / l;
+  }
+};
+static_assert(Obstacle<Bowl>);
+
+IndexVector every_other(Index n) {
+  IndexVector v((n + 1) / 2);
+  for (Index i = 0; i < v.size(); ++i) v[i] = VIndex(2 * i);
+  return v;
+}
+
+VecX<> random_stiffness(Index n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(1.0, 100.0);
+  VecX<> k(n);
+  for (Index i = 0; i < n; ++i) k[i] = u(rng);
+  return k;
+}
+
+}  // namespace
+
+TEST_CASE("ObstacleContact: plane and bowl Hessians are exact, sphere drops its negative tangential part") {
+  std::mt19937 rng(21);
+  double worst_g = 0, worst_h_plane = 0, worst_h_sphere = 0, worst_h_bowl = 0, min_eig = 0;
+  Index active = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const Index n = 12;
+    const Points<> x = test::random_points(n, -1, 1, rng);
+    const IndexVector v = every_other(n);
+    const VecX<> k = random_stiffness(v.size(), rng);
+    const Vec3<> p = test::random_points(1, -0.3, 0.3, rng).row(0).transpose();
+    const Vec3<> dir = test::random_points(1, -1, 1, rng).row(0).transpose();
+
+    const ObstacleContact plane(Plane<>(p, dir), v, n, k);
+    const ObstacleContact sphere(Sphere<>(p, 0.9), v, n, k);
+    const ObstacleContact bowl(Bowl{p, 0.8}, v, n, k);
+    active += Index(sphere.active(x).size());
+
+    worst_g = std::max({worst_g, test::rel_error(test::gradient(plane, x), test::fd_gradient(plane, x, 1e-6)),
+                        test::rel_error(test::gradient(sphere, x), test::fd_gradient(sphere, x, 1e-6)),
+                        test::rel_error(test::gradient(bowl, x), test::fd_gradient(bowl, x, 1e-6))});
+
+    const Eigen::MatrixXd Hp = test::assembled_hessian(plane, x), Hs = test::assembled_hessian(sphere, x), Hb = test::assembled_hessian(bowl, x);
+    worst_h_plane = std::max(worst_h_plane, test::rel_error(Hp, test::fd_hessian(plane, x, 1e-6)));
+    worst_h_bowl = std::max(worst_h_bowl, test::rel_error(Hb, test::fd_hessian(bowl, x, 1e-6)));
+    // sphere: exact Hessian minus the dropped k d/‖x − c‖ (I − n nᵀ) of each penetrating vertex
+    Eigen::MatrixXd expect = test::fd_hessian(sphere, x, 1e-6);
+    for (Index i = 0; i < v.size(); ++i) {
+      const Vec3<> xi = x.row(v[i]).transpose();
+      const double d = sphere.obstacle().distance(xi);
+      if (d < 0) expect.block<3, 3>(3 * v[i], 3 * v[i]) -= k[i] * d * sphere.obstacle().distance_hessian(xi);
+    }
+    worst_h_sphere = std::max(worst_h_sphere, test::rel_error(Hs, expect));
+    for (const Eigen::MatrixXd* H : {&Hp, &Hs, &Hb}) min_eig = std::min(min_eig, test::min_eigenvalue(*H) / std::max(1.0, H->cwiseAbs().maxCoeff()));
+  }
+  MESSAGE("obstacle contact: gradient " << worst_g << ", Hessian plane " << worst_h_plane << ", sphere (projected) " << worst_h_sphere
+                                        << ", bowl " << worst_h_bowl << ", min eigenvalue " << min_eig << ", active sphere contacts " << active);
+  CHECK(active > 20);
+  CHECK(worst_g < 1e-7);
+  CHECK(worst_h_plane < 1e-6);
+  CHECK(worst_h_sphere < 1e-6);
+  CHECK(worst_h_bowl < 1e-6);
+  CHECK(min_eig > -1e-12);
+}
+
+TEST_CASE("ObstacleContact: analytic plane and moving sphere") {
+  Points<> x(2, 3);
+  x << 0.3, 0.2, -0.01, 0.0, 0.0, 0.5;
+  IndexVector v(2);
+  v << 0, 1;
+  ObstacleContact plane(Plane<>(Vec3<>::Zero(), Vec3<>(0, 0, 3)), v, 2, 100.0);
+  CHECK(plane.energy(x) == doctest::Approx(50.0 * 1e-4));
+  const Points<> g = test::gradient(plane, x);
+  CHECK((g.row(0) - Eigen::RowVector3d(0, 0, -1.0)).norm() < 1e-12);  // force +1 N along the normal
+  CHECK(g.row(1).norm() == 0.0);
+
+  ObstacleContact sphere(Sphere<>(Vec3<>(0, 0, 1.0), 0.4), v, 2, 10.0);
+  CHECK(sphere.energy(x) == 0.0);
+  CHECK(sphere.active(x).empty());
+  sphere.obstacle().set_centre(Vec3<>(0, 0, 0.8));  // pushed in: vertex 1 is 0.3 from the centre
+  REQUIRE(sphere.active(x).size() == 1);
+  CHECK(sphere.energy(x) == doctest::Approx(5.0 * 0.1 * 0.1));
+  CHECK((test::gradient(sphere, x).row(1) - Eigen::RowVector3d(0, 0, 10.0 * 0.1)).norm() < 1e-12);  // pushed towards −z
+  // the centre itself: finite energy, gradient along +z by convention
+  sphere.obstacle().set_centre(Vec3<>(0, 0, 0.5));
+  CHECK(sphere.energy(x) == doctest::Approx(5.0 * 0.16));
+  CHECK(test::gradient(sphere, x).allFinite());
+}
+
+TEST_CASE("ObstacleContact: bad input throws typed errors") {
+  IndexVector v(2);
+  v << 0, 3;
+  CHECK_THROWS_AS(Plane<>(Vec3<>::Zero(), Vec3<>::Zero()), ArgumentError);
+  CHECK_THROWS_AS(Plane<>(Vec3<>(0, std::nan(""), 0), Vec3<>::UnitZ()), ArgumentError);
+  CHECK_THROWS_AS(Sphere<>(Vec3<>::Zero(), -1.0), ArgumentError);
+  CHECK_THROWS_AS(Sphere<>(Vec3<>::Zero(), 0.0), ArgumentError);
+  CHECK_THROWS_AS(Sphere<>(Vec3<>::Constant(std::nan("")), 1.0), ArgumentError);
+  const Sphere<> s(Vec3<>::Zero(), 1.0);
+  CHECK_THROWS_AS(ObstacleContact(s, v, 3, 1.0), ArgumentError);   // vertex 3 of 3
+  CHECK_THROWS_AS(ObstacleContact(s, v, 4, -1.0), ArgumentError);  // negative stiffness
+  CHECK_THROWS_AS(ObstacleContact(s, v, 4, VecX<>::Ones(3)), ShapeError);
+  CHECK_THROWS_AS(ObstacleContact(s, v, 4, VecX<>::Constant(2, std::nan(""))), ArgumentError);
+  ObstacleContact c(s, v, 4, 1.0);
+  CHECK_THROWS_AS(c.energy(Points<>::Zero(3, 3)), ShapeError);
+  CHECK_THROWS_AS(c.obstacle().set_centre(Vec3<>::Constant(INFINITY)), ArgumentError);
+}
