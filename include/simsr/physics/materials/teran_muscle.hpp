@@ -1,0 +1,120 @@
+#pragma once
+/// \file
+/// Anisotropic active muscle (Teran et al. 2003 §5, as in PhysBAM's face of Sifakis et al. 2005):
+/// Mooney–Rivlin flesh plus a fibre term along the rest fibre direction a.
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "fibre_curves.hpp"
+#include "mooney_rivlin.hpp"
+
+namespace simsr::physics {
+
+/// A muscle tet's fibre: unit rest direction and activation ∈ [0, 1].
+template <class S = Scalar>
+struct MuscleFibre {
+  Vec3<S> fibre = Vec3<S>::UnitX();
+  S activation = S(0);
+};
+
+/// ψ = ψ_MR(F) + σ_max [W_p(λ) + α W_a(λ)], λ = ‖F a‖  [Pa], W_p, W_a the energies of the
+/// passive and active fibre curves (fibre_curves.hpp), α the activation. The fibre stress
+/// ψ_f' = σ_max (f_p + α f_a) ≥ 0 is a tension: activation lowers the energy of shorter fibres.
+///
+/// Fibre term: P_f = ψ_f' n aᵀ, n = F a/λ; ∂P_f/∂F = ψ_f'' v vᵀ + (ψ_f'/λ)(a aᵀ ⊗ I₃ − v vᵀ),
+/// v = vec(n aᵀ) (the two terms are orthogonal, the second a projector: `project` clamps ψ_f''
+/// and ψ_f'/λ at 0 separately). Both curves vanish for λ < min(1, 0.4 λ_ofl), so the fibre term
+/// is constant there and contributes nothing to P and ∂P/∂F: the direction n is never formed
+/// where λ → 0 would make it undefined.
+template <class S = Scalar>
+class TeranMuscle {
+ public:
+  using scalar_type = S;
+  using Element = MuscleFibre<S>;
+
+  /// σ_max = 3e5 Pa: Teran et al. 2003's maximum isometric muscle stress (0.3 MPa).
+  explicit TeranMuscle(MooneyRivlin<S> isotropic = MooneyRivlin<S>(), S max_stress = S(3e5),
+                       PassiveFibreCurve<S> passive = {}, ActiveFibreCurve<S> active = {})
+      : iso_(isotropic), max_stress_(max_stress), passive_(passive), active_(active) {
+    detail::check_parameter(max_stress >= S(0) && std::isfinite(max_stress), "TeranMuscle", "max_stress", max_stress,
+                            "must be >= 0");
+    passive_.check();
+    active_.check();
+  }
+
+  const MooneyRivlin<S>& isotropic() const { return iso_; }
+  S max_stress() const { return max_stress_; }
+  const PassiveFibreCurve<S>& passive() const { return passive_; }
+  const ActiveFibreCurve<S>& active() const { return active_; }
+
+  /// ArgumentError unless the fibre is finite and of unit length (to 1e-6) and the activation
+  /// lies in [0, 1]. The elastic energy calls it once per element at setup, not per evaluation.
+  static void check(const Element& e) {
+    const S n = e.fibre.norm();
+    detail::check_parameter(std::isfinite(n) && std::abs(n - S(1)) <= S(1e-6), "TeranMuscle", "fibre length", n,
+                            "must be 1 (use TeranMuscle::element to normalize)");
+    detail::check_parameter(e.activation >= S(0) && e.activation <= S(1), "TeranMuscle", "activation", e.activation,
+                            "must lie in [0, 1]");
+  }
+
+  /// Element data from any non-zero finite direction (normalized) and an activation in [0, 1].
+  static Element element(const Vec3<S>& direction, S activation) {
+    const S n = direction.norm();
+    detail::check_parameter(std::isfinite(n) && n > S(0), "TeranMuscle", "fibre direction length", n,
+                            "must be finite and > 0");
+    Element e{direction / n, activation};
+    check(e);
+    return e;
+  }
+
+  S energy(const Mat3<S>& F, const Element& e) const {
+    const S lambda = (F * e.fibre).norm();
+    return iso_.energy(F) + max_stress_ * (passive_.energy(lambda) + e.activation * active_.energy(lambda));
+  }
+
+  Mat3<S> stress(const Mat3<S>& F, const Element& e) const {
+    Mat3<S> P = iso_.stress(F);
+    const Vec3<S> Fa = F * e.fibre;
+    const S lambda = Fa.norm();
+    if (lambda >= flat_below()) P += (fibre_stress(lambda, e.activation) / lambda) * Fa * e.fibre.transpose();
+    return P;
+  }
+
+  Mat9<S> stress_derivative(const Mat3<S>& F, const Element& e, Definiteness definiteness) const {
+    Mat9<S> D = iso_.stress_derivative(F, {}, definiteness);
+    const Vec3<S> Fa = F * e.fibre;
+    const S lambda = Fa.norm();
+    if (lambda < flat_below()) return D;
+    const Vec3<S> n = Fa / lambda;
+    S d2 = max_stress_ * (passive_.derivative(lambda) + e.activation * active_.derivative(lambda));
+    S d1 = fibre_stress(lambda, e.activation) / lambda;
+    if (definiteness == Definiteness::project) {
+      d2 = std::max(d2, S(0));
+      d1 = std::max(d1, S(0));
+    }
+    Vec9<S> v;
+    for (int c = 0; c < 3; ++c) v.template segment<3>(3 * c) = e.fibre(c) * n;
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < 3; ++l) D.template block<3, 3>(3 * c, 3 * l).diagonal().array() += d1 * e.fibre(c) * e.fibre(l);
+    D.noalias() += (d2 - d1) * v * v.transpose();
+    return D;
+  }
+
+  /// ψ_f'(λ) = σ_max (f_p(λ) + α f_a(λ)), the fibre's first Piola stress magnitude [Pa].
+  S fibre_stress(S lambda, S activation) const {
+    return max_stress_ * (passive_.value(lambda) + activation * active_.value(lambda));
+  }
+
+ private:
+  /// Below this stretch both fibre curves vanish identically.
+  S flat_below() const { return std::min(S(1), ActiveFibreCurve<S>::lower * active_.optimal_length); }
+
+  MooneyRivlin<S> iso_;
+  S max_stress_;
+  PassiveFibreCurve<S> passive_;
+  ActiveFibreCurve<S> active_;
+};
+
+}  // namespace simsr::physics
