@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Umbrella header: every area of simsr, in the order data flows through them
-/// (core → mesh/io → discretize → neighbors → interp | nn → eval). Include single areas
+/// (core → mesh/io → discretize → physics → neighbors → interp | nn → eval). Include single areas
 /// (simsr/mesh/mesh.hpp, simsr/interp/interp.hpp, ...) to keep compile times short.
 
 #include "core/core.hpp"
@@ -12,3 +12,4 @@
 #include "mesh/mesh.hpp"
 #include "neighbors/neighbors.hpp"
 #include "nn/nn.hpp"
+#include "physics/physics.hpp"

@@ -53,6 +53,10 @@ struct NewtonOptions {
   double relative_tolerance = 1e-6;
   double absolute_tolerance = 0;  ///< N
   double reference_force = 0;     ///< N
+  /// Also converged when a Newton step (from a converged linear solve) moves no vertex by more
+  /// than step_tolerance × the bounding-box diagonal: the iterate is then the minimum to within
+  /// round-off of the positions, even where no force scale exists (an unloaded body at rest).
+  double step_tolerance = 1e-13;
   Index max_iterations = 100;
   double armijo = 1e-4;           ///< sufficient decrease: E(x+αd) ≤ E(x) + armijo·α·gᵀd
   Index max_backtracks = 40;      ///< each halves α
@@ -104,6 +108,7 @@ class QuasistaticSolver {
     apply_boundary(x, boundary);
     NewtonReport report;
     double reference = 0;
+    const double size = double((x.colwise().maxCoeff() - x.colwise().minCoeff()).norm());
     for (Index it = 0;; ++it) {
       const double E = total_energy(x, terms...);
       if (!std::isfinite(E)) throw ConvergenceError("quasistatic Newton (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
@@ -129,9 +134,11 @@ class QuasistaticSolver {
       LinearSolveInfo info;
       double slope = 0;
       if (!projected) {
-        const bool ok = newton_direction(x, Definiteness::exact, info, terms...);
-        slope = double(g_.dot(d_));
-        projected = !ok || !(slope < 0);
+        projected = !newton_direction(x, Definiteness::exact, info, terms...);
+        if (!projected) {
+          slope = double(g_.dot(d_));
+          projected = !(slope < 0) || !d_.allFinite();
+        }
       }
       if (projected) {
         newton_direction(x, Definiteness::project, info, terms...);
@@ -140,6 +147,9 @@ class QuasistaticSolver {
       if (!(slope < 0) || !d_.allFinite()) {  // still no descent (an unconverged iterative solve): fall back to −g
         d_ = -g_;
         slope = -double(g_.squaredNorm());
+      } else if (info.converged && double(d_.cwiseAbs().maxCoeff()) <= options_.step_tolerance * size) {
+        report.converged = true;
+        return report;
       }
 
       // Backtracking on the total energy; differences below round-off of the terms' magnitudes

@@ -86,7 +86,8 @@ template <class Preconditioner = BlockJacobi<Scalar>, exec::HostPolicy Policy = 
 class ConjugateGradient {
  public:
   using scalar_type = S;
-  explicit ConjugateGradient(ConjugateGradientOptions options = {}, Policy policy = {}) : options_(options), policy_(policy) {}
+  ConjugateGradient() = default;
+  explicit ConjugateGradient(ConjugateGradientOptions options, Policy policy = {}) : options_(options), policy_(policy) {}
 
   ConjugateGradientOptions& options() { return options_; }
 

@@ -1,0 +1,198 @@
+#include <simsr/discretize/bcc_lattice.hpp>
+#include <simsr/discretize/embedding.hpp>
+#include <simsr/mesh/generators.hpp>
+#include <simsr/mesh/topology.hpp>
+#include <simsr/physics/elastic_energy.hpp>
+#include <simsr/physics/forces/bone_attachment.hpp>
+#include <simsr/physics/forces/gravity.hpp>
+#include <simsr/physics/materials/materials.hpp>
+#include <simsr/physics/quasistatic.hpp>
+
+#include <doctest/doctest.h>
+
+#include <random>
+
+#include "stvk_material.hpp"
+
+using namespace simsr;
+using namespace simsr::physics;
+
+namespace {
+
+bool on_box_boundary(const Vec3<>& p, const Vec3<>& lo, const Vec3<>& hi) {
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(p[a] - lo[a]) < 1e-12 || std::abs(p[a] - hi[a]) < 1e-12) return true;
+  return false;
+}
+
+/// Patch test: boundary vertices follow an affine map, interior ones start perturbed; the
+/// solution must be the affine map everywhere (uniform F, so div P = 0 for any material).
+template <class M, class Linear>
+double patch_test(const M& material, std::vector<typename M::Element> elements, Linear linear) {
+  const auto mesh = box_tet_mesh<double>(3, 3, 3);
+  Mat3<> A;
+  A << 1.1, 0.05, 0.0, 0.02, 0.95, 0.03, 0.0, 0.04, 1.05;
+  const Vec3<> b(0.1, -0.2, 0.3);
+  Points<> affine = (mesh.V * A.transpose()).rowwise() + b.transpose();
+  BoneAttachments<> frame(mesh.V);
+  frame.add_bone("boundary", select_vertices(mesh.V, [](const Vec3<>& p) { return on_box_boundary(p, Vec3<>::Zero(), Vec3<>::Ones()); }));
+  DirichletBoundary<> bc = frame.boundary();
+  for (Index k = 0; k < bc.size(); ++k) bc.targets.row(k) = affine.row(bc.vertices[k]);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  Points<> x = mesh.V;
+  for (Index i = 0; i < x.size(); ++i) x.data()[i] += u(rng);
+  ElasticEnergy<M> elastic(mesh, material, std::move(elements));
+  QuasistaticSolver<Linear> newton(mesh.num_vertices(), mesh.T, NewtonOptions{.relative_tolerance = 1e-14, .progress = {}}, std::move(linear));
+  newton.solve(x, bc, elastic);
+  return (x - affine).cwiseAbs().maxCoeff();
+}
+
+}  // namespace
+
+TEST_CASE("patch test: an affine boundary displacement is reproduced exactly inside, for every material and solver") {
+  CHECK(patch_test(NeoHookean<>::from_young_poisson(1e5, 0.3), {}, SparseCholesky<>{}) < 1e-10);
+  CHECK(patch_test(Corotated<>::from_young_poisson(1e5, 0.3), {}, SparseCholesky<>{}) < 1e-10);
+  CHECK(patch_test(MooneyRivlin<>(), {}, ConjugateGradient<BlockJacobi<>>({.tolerance = 1e-10})) < 1e-10);
+  CHECK(patch_test(simsr_test::StVK{1e5, 1e5}, {}, ConjugateGradient<Jacobi<>>({.tolerance = 1e-12})) < 1e-10);
+  const auto fibre = TeranMuscle<>::element(Vec3<>(1, 1, 0).normalized(), 0.3);
+  CHECK(patch_test(TeranMuscle<>(), std::vector<MuscleFibre<>>(std::size_t(6 * 27), fibre), SparseCholesky<>{}) < 1e-10);
+}
+
+TEST_CASE("a mesh started fully inverted (mirrored through its clamped face) recovers its rest shape") {
+  const auto mesh = box_tet_mesh<double>(2, 2, 3);
+  BoneAttachments<> floor(mesh.V);
+  floor.add_bone("floor", select_vertices(mesh.V, [](const Vec3<>& p) { return p.z() < 1e-12; }));
+  for (const char* start : {"mirrored", "collapsed"}) {
+    CAPTURE(start);
+    Points<> x = mesh.V;
+    if (std::string(start) == "mirrored")
+      x.col(2) *= -1.0;  // every tet inverted
+    else
+      x.col(2).setZero();  // every tet flat (J = 0)
+    ElasticEnergy<NeoHookean<>> elastic(mesh, NeoHookean<>::from_young_poisson(1e4, 0.3));
+    if (std::string(start) == "mirrored") CHECK(elastic.count_inverted(x) == mesh.num_tets());
+    QuasistaticSolver<SparseCholesky<>> newton(mesh.num_vertices(), mesh.T, NewtonOptions{.relative_tolerance = 1e-10, .progress = {}});
+    const auto report = newton.solve(x, floor.boundary(), elastic);
+    CHECK(report.converged);
+    CHECK(elastic.count_inverted(x) == 0);
+    CHECK((x - mesh.V).cwiseAbs().maxCoeff() < 1e-8);
+  }
+}
+
+TEST_CASE("a muscle block contracts along its fibres when activated, more with more activation") {
+  const auto mesh = box_tet_mesh<double>(8, 2, 2, Vec3<>(0, 0, 0), Vec3<>(0.04, 0.01, 0.01));  // 4 cm × 1 cm × 1 cm
+  BoneAttachments<> origin(mesh.V);
+  origin.add_bone("origin", select_vertices(mesh.V, [](const Vec3<>& p) { return p.x() < 1e-12; }));
+  const IndexVector tip = select_vertices(mesh.V, [](const Vec3<>& p) { return p.x() > 0.04 - 1e-12; });
+  ElasticEnergy<TeranMuscle<>> muscle(mesh, TeranMuscle<>());
+  QuasistaticSolver<SparseCholesky<>> newton(mesh.num_vertices(), mesh.T);
+  Points<> x = mesh.V;
+  double previous_length = 0.04;
+  for (double a : {0.0, 0.25, 0.5, 1.0}) {
+    CAPTURE(a);
+    muscle.set_elements(std::vector<MuscleFibre<>>(std::size_t(mesh.num_tets()), TeranMuscle<>::element(Vec3<>::UnitX(), a)));
+    newton.solve(x, origin.boundary(), muscle);  // warm start from the previous activation
+    double length = 0;
+    for (Index k = 0; k < tip.size(); ++k) length += x(tip[k], 0) / double(tip.size());
+    if (a == 0.0) {
+      CHECK((x - mesh.V).cwiseAbs().maxCoeff() < 1e-12);  // passive and unloaded: stays at rest
+    } else {
+      CHECK(length < previous_length - 1e-4);  // shorter than with less activation, by ≥ 0.1 mm
+    }
+    previous_length = length;
+  }
+  CHECK(previous_length < 0.04 * 0.95);  // full activation shortens the block by more than 5 %
+  CHECK(muscle.count_inverted(x) == 0);
+}
+
+TEST_CASE("coarse and fine meshes of one hanging block (conforming and BCC embedded) agree in bulk within 5 %") {
+  // A soft 10×10×20 cm block hanging from its top face under gravity; bulk response = the mean
+  // displacement of a fixed set of material points (the fine mesh's vertices) read through each mesh.
+  const Vec3<> lo(0, 0, 0), hi(0.1, 0.1, 0.2);
+  const auto fine = box_tet_mesh<double>(6, 6, 12, lo, hi);
+  const auto material = NeoHookean<>::from_young_poisson(2e4, 0.3);
+  const auto mean_drop = [&](const TetMesh<>& mesh) {
+    ElasticEnergy<NeoHookean<>> elastic(mesh, material);
+    Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
+    BoneAttachments<> top(mesh.V);
+    top.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > hi.z() - 1e-12; }));
+    QuasistaticSolver<SparseCholesky<>> newton(mesh.num_vertices(), mesh.T);
+    Points<> x = mesh.V;
+    newton.solve(x, top.boundary(), elastic, gravity);
+    const auto emb = embed(mesh, fine.V);
+    return -(deform(emb, mesh.T, x).col(2) - fine.V.col(2)).mean();
+  };
+  const double reference = mean_drop(fine);
+  const double coarse = mean_drop(box_tet_mesh<double>(3, 3, 6, lo, hi));
+  const double embedded = mean_drop(discretize::bcc_lattice(boundary_surface(fine), 0.05).mesh);
+  MESSAGE("mean drop: fine " << reference << " m, coarse conforming " << coarse << ", coarse BCC " << embedded);
+  CHECK(reference > 0.005);  // a real load: ≥ 5 mm
+  CHECK(std::abs(coarse - reference) < 0.05 * reference);
+  CHECK(std::abs(embedded - reference) < 0.05 * reference);
+}
+
+TEST_CASE("Newton: warm start at the solution converges at once; seq and omp solves agree bitwise; failures are ConvergenceErrors") {
+  const auto mesh = box_tet_mesh<double>(6, 1, 1, Vec3<>(0, 0, 0), Vec3<>(0.6, 0.1, 0.1));
+  ElasticEnergy<NeoHookean<>> elastic(mesh, NeoHookean<>::from_young_poisson(1e5, 0.3));
+  ElasticEnergy<NeoHookean<>, exec::omp_t> elastic_omp(mesh, NeoHookean<>::from_young_poisson(1e5, 0.3));
+  Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
+  BoneAttachments<> wall(mesh.V);
+  wall.add_bone("wall", select_vertices(mesh.V, [](const Vec3<>& p) { return p.x() < 1e-12; }));
+  QuasistaticSolver<ConjugateGradient<BlockJacobi<>, exec::seq_t>> seq(mesh.num_vertices(), mesh.T);
+  QuasistaticSolver<ConjugateGradient<BlockJacobi<>, exec::omp_t>, exec::omp_t> omp(mesh.num_vertices(), mesh.T, NewtonOptions{},
+                                                                                  ConjugateGradient<BlockJacobi<>, exec::omp_t>{}, exec::omp);
+  Points<> x = mesh.V, y = mesh.V;
+  const auto r1 = seq.solve(x, wall.boundary(), elastic, gravity);
+  const auto r2 = omp.solve(y, wall.boundary(), elastic_omp, gravity);
+  CHECK(r1.converged);
+  CHECK(r1.iterations == r2.iterations);
+  CHECK((x - y).cwiseAbs().maxCoeff() == 0.0);
+  CHECK(x(mesh.num_vertices() - 1, 2) < -1e-3);  // it sags
+  const auto again = seq.solve(x, wall.boundary(), elastic, gravity);
+  CHECK(again.iterations == 0);
+
+  // A load far beyond what 2 iterations can reach.
+  Gravity<> heavy(mesh, 1e5, Vec3<>(0, 0, -9.81));
+  QuasistaticSolver<SparseCholesky<>> short_newton(mesh.num_vertices(), mesh.T, NewtonOptions{.max_iterations = 2, .progress = {}});
+  Points<> z = mesh.V;
+  try {
+    short_newton.solve(z, wall.boundary(), elastic, heavy);
+    FAIL("expected a ConvergenceError");
+  } catch (const ConvergenceError& e) {
+    CHECK(e.iterations() == 2);
+    CHECK(e.residual() > 0);
+  }
+  // Bad input: wrong position shape, Dirichlet vertex out of range, non-finite target.
+  Points<> wrong(3, 3);
+  CHECK_THROWS_AS(seq.solve(wrong, wall.boundary(), elastic), ShapeError);
+  DirichletBoundary<> bad = wall.boundary();
+  bad.vertices[0] = VIndex(mesh.num_vertices());
+  CHECK_THROWS_AS(seq.solve(x, bad, elastic), MeshError);
+  bad = wall.boundary();
+  bad.targets(0, 1) = std::nan("");
+  CHECK_THROWS_AS(seq.solve(x, bad, elastic), MeshError);
+}
+
+TEST_CASE("Newton progress: every iteration is reported, with the Hessian it used") {
+  const auto mesh = box_tet_mesh<double>(4, 1, 1, Vec3<>(0, 0, 0), Vec3<>(0.4, 0.1, 0.1));
+  ElasticEnergy<NeoHookean<>> elastic(mesh, NeoHookean<>::from_young_poisson(1e5, 0.3));
+  Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
+  BoneAttachments<> wall(mesh.V);
+  wall.add_bone("wall", select_vertices(mesh.V, [](const Vec3<>& p) { return p.x() < 1e-12; }));
+  std::vector<NewtonIteration> seen;
+  for (auto mode : {NewtonOptions::Hessian::adaptive, NewtonOptions::Hessian::projected}) {
+    seen.clear();
+    NewtonOptions o;
+    o.hessian = mode;
+    o.progress = [&](const NewtonIteration& it) { seen.push_back(it); };
+    QuasistaticSolver<SparseCholesky<>> newton(mesh.num_vertices(), mesh.T, o);
+    Points<> x = mesh.V;
+    const auto r = newton.solve(x, wall.boundary(), elastic, gravity);
+    CHECK(Index(seen.size()) == r.iterations);
+    CHECK(r.history.size() == seen.size());
+    for (std::size_t k = 1; k < seen.size(); ++k) CHECK(seen[k].energy <= seen[k - 1].energy);
+    if (mode == NewtonOptions::Hessian::projected)
+      for (const auto& it : seen) CHECK(it.projected);
+  }
+}
