@@ -19,27 +19,27 @@ enum ExitCode : int {
   exit_usage = 64,       ///< bad command line (EX_USAGE)
 };
 
-/// Runs `body`, mapping exceptions to messages on stderr and exit codes.
-inline int run_guarded(const std::function<int()>& body) {
+/// Runs `body`, mapping exceptions to messages on stderr (prefixed by the program name) and exit codes.
+inline int run_guarded(const std::function<int()>& body, const char* program = "simsr") {
   try {
     return body();
   } catch (const ParseError& e) {
-    std::fprintf(stderr, "simsr: error: %s\n", e.what());
+    std::fprintf(stderr, "%s: error: %s\n", program, e.what());
     return exit_parse;
   } catch (const MeshError& e) {
-    std::fprintf(stderr, "simsr: invalid mesh: %s\n", e.what());
+    std::fprintf(stderr, "%s: invalid mesh: %s\n", program, e.what());
     return exit_mesh;
   } catch (const ShapeError& e) {
-    std::fprintf(stderr, "simsr: shape mismatch: %s\n", e.what());
+    std::fprintf(stderr, "%s: shape mismatch: %s\n", program, e.what());
     return exit_shape;
   } catch (const ArgumentError& e) {
-    std::fprintf(stderr, "simsr: invalid argument: %s\n", e.what());
+    std::fprintf(stderr, "%s: invalid argument: %s\n", program, e.what());
     return exit_argument;
   } catch (const ConvergenceError& e) {
-    std::fprintf(stderr, "simsr: no convergence: %s\n", e.what());
+    std::fprintf(stderr, "%s: no convergence: %s\n", program, e.what());
     return exit_convergence;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "simsr: error: %s\n", e.what());
+    std::fprintf(stderr, "%s: error: %s\n", program, e.what());
     return exit_error;
   }
 }
