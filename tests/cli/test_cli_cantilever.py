@@ -54,7 +54,15 @@ check(finer["relative_error"] < coarse["relative_error"] / 2, f"refinement: {coa
 same = result("--cells", "4", "--solver", "pcg-jacobi")
 check(abs(same["tip_deflection"] - finer["tip_deflection"]) < 1e-6 * eb, "PCG-Jacobi and PCG-block-Jacobi agree")
 
-embedded = result("--cells", "2", "--embedded")
+import os
+import tempfile
+vtu = os.path.join(tempfile.mkdtemp(), "beam.vtu")
+embedded = result("--cells", "2", "--embedded", "--vtu", vtu)
+with open(vtu, "rb") as f:
+    text = f.read()
+check(b'Name="displacement"' in text and b'Name="volume_ratio"' in text, "--vtu writes displacement and volume ratio")
+check(f'NumberOfPoints="{embedded["vertices"]}"'.encode() in text and f'NumberOfCells="{embedded["tets"]}"'.encode() in text,
+      "--vtu holds the solved mesh")
 check(embedded["discretization"] == "embedded_bcc" and embedded["tets"] > coarse["tets"], "BCC lattice: more tets than the 6-tet split")
 check(0 < embedded["tip_deflection"] < eb, "embedded beam sags")
 

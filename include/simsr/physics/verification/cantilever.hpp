@@ -52,6 +52,8 @@ struct CantileverResult {
   Index vertices = 0, tets = 0;
   Index newton_iterations = 0;
   double seconds = 0;           ///< mesh + solve wall time
+  TetMesh<> mesh;               ///< the rest mesh solved on
+  Points<> positions;           ///< its equilibrium positions (#V×3)
 };
 
 /// Euler–Bernoulli tip deflection of a cantilever under its own weight.
@@ -102,6 +104,8 @@ CantileverResult solve_cantilever(const CantileverOptions& o, Policy policy = {}
   r.tets = mesh.num_tets();
   r.newton_iterations = rep.iterations;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.mesh = std::move(mesh);
+  r.positions = std::move(x);
   return r;
 }
 
