@@ -38,8 +38,12 @@ concept ChecksElements = requires(const M& m, const typename M::Element& e) { m.
 }  // namespace detail
 
 /// Σ_t V_t ψ(F_t) over the tets of a rest mesh (see the file comment).
-template <Material M, exec::HostPolicy Policy = exec::seq_t>
+template <class M, exec::HostPolicy Policy = exec::seq_t>
 class ElasticEnergy {
+  static_assert(Material<M>, "ElasticEnergy<M>: M must model physics::Material (materials/material.hpp): types scalar_type "
+                             "and Element, and const methods energy(F, element), stress(F, element) -> Mat3 and "
+                             "stress_derivative(F, element, Definiteness) -> Mat9");
+
  public:
   using S = typename M::scalar_type;
   using Element = typename M::Element;

@@ -83,8 +83,12 @@ struct NewtonReport {
 };
 
 /// Newton with line search over a sum of EnergyTerms (see the file comment).
-template <LinearSolver Linear = SparseCholesky<Scalar>, exec::HostPolicy Policy = exec::seq_t>
+template <class Linear = SparseCholesky<Scalar>, exec::HostPolicy Policy = exec::seq_t>
 class QuasistaticSolver {
+  static_assert(LinearSolver<Linear>, "QuasistaticSolver<Linear>: Linear must model physics::LinearSolver "
+                                      "(linear_solvers/linear_solver.hpp): a scalar_type, compute(A, pattern_version) and "
+                                      "solve(b, x) -> LinearSolveInfo, e.g. SparseCholesky<> or ConjugateGradient<BlockJacobi<>>");
+
  public:
   using S = typename Linear::scalar_type;
 
