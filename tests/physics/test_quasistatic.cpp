@@ -95,6 +95,7 @@ TEST_CASE("a muscle block contracts along its fibres when activated, more with m
     newton.solve(x, origin.boundary(), muscle);  // warm start from the previous activation
     double length = 0;
     for (Index k = 0; k < tip.size(); ++k) length += x(tip[k], 0) / double(tip.size());
+    MESSAGE("activation " << a << ": muscle length " << length * 100 << " cm (rest 4 cm)");
     if (a == 0.0) {
       CHECK((x - mesh.V).cwiseAbs().maxCoeff() < 1e-12);  // passive and unloaded: stays at rest
     } else {
