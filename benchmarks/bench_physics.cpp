@@ -1,0 +1,442 @@
+// One quasistatic frame at the paper's LR size (Park et al. 2023 §4: ~73k tets), and its kernels.
+//
+// Scene (built once, lazily, shared by every case): a 12-tet BCC lattice (discretize::bcc_lattice)
+// of the bunny, with the cell size h found by bisection so that it has ≈ 73,000 tets (printed to
+// stderr, and as counters h_mm / tets / vertices). The code voxelizes the HR surface
+// data/bunny/hrestshape.obj if it is closed; the shipped one is open (an edge of triangle 4882 has
+// no neighbour), so it falls back to the cells overlapping the LR tet mesh lrestshape.obj
+// (bcc_lattice(TetMesh, h)): h = 6.35 mm → 73,008 tets, 14,131 vertices. The bunny is
+// ~16 × 15 × 12 cm as stored: a face-sized body, so the data's units are taken as metres
+// unchanged (y up).
+//   flesh    TeranMuscle<> (default Mooney–Rivlin μ10 6e4, μ01 2e4, κ 1.6e6 Pa, σ_max 3e5 Pa)
+//            in every tet, fibres along x; tets whose centroid lies above mid-height are the
+//            active "muscle" (activation per frame), the others passive fibres (activation 0)
+//   cranium  lattice vertices in the bottom 10 % of the height, held fixed (Dirichlet)
+//   jaw      lattice vertices in the front-lower block x < x_min + 25 % width,
+//            y in [y_min + 15 %, y_min + 45 %] height, rotated rigidly about a hinge along z
+//            through (x_min + 25 % width, y_min + 45 % height, z_mid) (hinge_rotation)
+//   gravity  1060 kg/m³, g = (0, −9.81, 0)
+//   tracks   track springs (κ = 1e4 N/m³ × Voronoi area) on the HR surface vertices in the top
+//            30 % of the height (the ears), embedded in the lattice; targets = rest positions
+//            shifted along z per frame
+// A frame: controls change from frame A (jaw 0.10 rad, activation 0.10, targets +0 mm) to frame B
+// (jaw 0.12 rad, activation 0.15, targets +0.5 mm) — at 30 fps a jaw opening at ~34°/s — and
+// Newton (NewtonOptions defaults: ‖g‖ ≤ 1e-6 × force scale, adaptive Hessian) runs to tolerance
+// from frame A's converged solution (computed once at setup). Every timed iteration copies
+// frame A's solution into x first (a 14k×3 copy, negligible next to a solve) and sets frame B's
+// controls, so iterations repeat the same frame exactly; one untimed warm-up Newton iteration per
+// case builds the gather lists and the Cholesky's symbolic analysis (done once per simulation).
+//
+// Cases (all wall-clock, UseRealTime; ms):
+//   BM_frame_73k/<linear>/<policy>   one frame: Newton to tolerance. <linear>: cholesky
+//       (Eigen SimplicialLDLT, AMD; sequential itself — /omp runs the energy, Hessian assembly
+//       and gradient under exec::omp), pcg_jacobi, pcg_block_jacobi (ConjugateGradient with
+//       relative tolerance kCgTolerance, products/dots under the policy). Counters:
+//       newton_iterations, linear_iterations (PCG iterations summed over the frame), fps.
+//   BM_kernel_73k/energy+gradient/<policy>   E(x) and ∂E/∂x of the elastic energy
+//   BM_kernel_73k/hessian/<policy>           projected element Hessians (Newton tries the exact
+//       one first; same cost: both go through the signed SVD) gathered into the
+//       BlockHessian + assemble() of the scalar CSR with the Dirichlet rows (what each Newton
+//       iteration does before the linear solve)
+//   BM_linear_73k/<solver>[/<policy>]        one linear solve of the first Newton system of the
+//       frame (projected Hessian at frame A's solution with frame B's boundary applied, rhs = −g):
+//       cholesky = numeric LDLᵀ + solve (symbolic analysis done once before), cholesky_symbolic =
+//       analysis + factorization + solve, pcg_* = preconditioner setup + PCG solve.
+//
+// Run:   build/benchmarks/bench_physics
+//        OMP_NUM_THREADS=1 build/benchmarks/bench_physics --benchmark_filter=omp
+//        build/benchmarks/bench_physics --benchmark_filter='BM_frame'
+// Setup (lattice search + frame A from rest, PCG) takes ~5 s. The whole binary takes ~6 min on 2
+// cores, 2 × ~100 s of it the Cholesky frames (a ~19 s factorization per Newton iteration);
+// --benchmark_filter=-cholesky leaves them out.
+#include <benchmark/benchmark.h>
+
+#include <simsr/discretize/bcc_lattice.hpp>
+#include <simsr/discretize/embedding.hpp>
+#include <simsr/io/obj.hpp>
+#include <simsr/mesh/vertex_areas.hpp>
+#include <simsr/physics/elastic_energy.hpp>
+#include <simsr/physics/forces/bone_attachment.hpp>
+#include <simsr/physics/forces/embedded_springs.hpp>
+#include <simsr/physics/forces/gravity.hpp>
+#include <simsr/physics/hessian.hpp>
+#include <simsr/physics/linear_solvers/linear_solvers.hpp>
+#include <simsr/physics/materials/teran_muscle.hpp>
+#include <simsr/physics/quasistatic.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+using namespace simsr;
+using namespace simsr::physics;
+
+namespace {
+
+constexpr Index kTargetTets = 73000;
+constexpr double kCgTolerance = 1e-4;  ///< PCG relative residual (inexact Newton; NewtonOptions stay default)
+constexpr double kDensity = 1060;      ///< soft tissue, kg/m³
+constexpr double kTrackStiffness = 1e4;  ///< N/m³ (× surface area → N/m)
+struct Controls {
+  double jaw_angle;   ///< rad
+  double activation;  ///< of the muscle tets
+  double target_dz;   ///< m, track targets' shift along z
+};
+constexpr Controls kFrameA{0.10, 0.10, 0.0};
+constexpr Controls kFrameB{0.12, 0.15, 0.0005};
+
+std::filesystem::path data_dir() {
+#ifdef SIMSR_DATA_DIR
+  return std::filesystem::path(SIMSR_DATA_DIR);
+#else
+  return std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared" / "data";
+#endif
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Everything shared by the cases (see the file comment).
+struct Scene {
+  double h = 0;
+  std::string source;
+  TetMesh<> mesh;
+  std::optional<BoneAttachments<>> bones;
+  Vec3<> hinge_point, hinge_axis{0, 0, 1};
+  std::vector<char> muscle;  ///< per tet
+  std::optional<Gravity<>> gravity;
+  std::optional<EmbeddedSprings<>> springs;
+  Points<> track_rest;  ///< rest positions of the tracked points
+  // per frame
+  std::vector<MuscleFibre<>> elements_a, elements_b;
+  Points<> targets_a, targets_b;
+  DirichletBoundary<> bc_a, bc_b;
+  Points<> x_a;  ///< frame A's converged solution (the warm start of every timed frame)
+  Index setup_iterations = 0;
+
+  std::vector<MuscleFibre<>> elements(const Controls& c) const {
+    std::vector<MuscleFibre<>> e(std::size_t(mesh.num_tets()));
+    for (std::size_t t = 0; t < e.size(); ++t) e[t] = MuscleFibre<>{Vec3<>::UnitX(), muscle[t] ? c.activation : 0.0};
+    return e;
+  }
+  DirichletBoundary<> boundary(const Controls& c) {
+    bones->set_transform("jaw", hinge_rotation(hinge_point, hinge_axis, c.jaw_angle));
+    return bones->boundary();
+  }
+  Points<> targets(const Controls& c) const {
+    Points<> y = track_rest;
+    y.col(2).array() += c.target_dz;
+    return y;
+  }
+};
+
+/// Lattice of ≈ kTargetTets tets: geometric bisection on h (the count falls roughly as h⁻³, with
+/// small jumps from the grid anchoring); the closest count seen wins.
+template <class Body>
+discretize::Lattice<> search_lattice(const Body& body, double& h_out) {
+  double lo = 1e-3, hi = 0.05;  // h (m): far too many tets / far too few
+  std::optional<discretize::Lattice<>> best;
+  double best_h = 0;
+  for (int it = 0; it < 24; ++it) {
+    const double h = std::sqrt(lo * hi);
+    discretize::Lattice<> L = discretize::bcc_lattice(body, h);
+    const Index n = L.mesh.num_tets();
+    if (!best || std::abs(double(n - kTargetTets)) < std::abs(double(best->mesh.num_tets() - kTargetTets))) {
+      best = std::move(L);
+      best_h = h;
+    }
+    if (std::abs(double(n - kTargetTets)) <= 0.002 * double(kTargetTets)) break;
+    (n > kTargetTets ? lo : hi) = h;
+  }
+  h_out = best_h;
+  return std::move(*best);
+}
+
+Scene build_scene() {
+  const auto t0 = std::chrono::steady_clock::now();
+  Scene s;
+  const TriMesh<> surface = io::read_obj_triangles<double>(data_dir() / "bunny" / "hrestshape.obj");
+  try {
+    s.mesh = search_lattice(surface, s.h).mesh;
+    s.source = "bunny/hrestshape.obj (closed HR surface)";
+  } catch (const MeshError& e) {  // not closed: voxelize the LR tet mesh instead
+    std::fprintf(stderr, "bench_physics: HR surface not usable (%s); using lrestshape.obj\n", e.what());
+    const TetMesh<> lr = io::read_obj_tets<double>(data_dir() / "bunny" / "lrestshape.obj");
+    s.mesh = search_lattice(lr, s.h).mesh;
+    s.source = "bunny/lrestshape.obj (LR tet mesh)";
+  }
+  const TetMesh<>& m = s.mesh;
+  const Vec3<> lo = m.V.colwise().minCoeff().transpose(), hi = m.V.colwise().maxCoeff().transpose(), ext = hi - lo;
+
+  // Bones: cranium (bottom 10 %) and jaw (front-lower block), hinge at the jaw's upper back edge.
+  s.bones.emplace(m.V);
+  s.bones->add_bone("cranium", select_vertices(m.V, [&](const Vec3<>& p) { return p.y() < lo.y() + 0.10 * ext.y(); }));
+  s.bones->add_bone("jaw", select_vertices(m.V, [&](const Vec3<>& p) {
+                      return p.x() < lo.x() + 0.25 * ext.x() && p.y() >= lo.y() + 0.15 * ext.y() && p.y() <= lo.y() + 0.45 * ext.y();
+                    }));
+  if (s.bones->vertices("jaw").size() == 0) throw Error("bench_physics: the jaw block holds no lattice vertex");
+  s.hinge_point = Vec3<>(lo.x() + 0.25 * ext.x(), lo.y() + 0.45 * ext.y(), lo.z() + 0.5 * ext.z());
+
+  // Muscle tets: centroid above mid-height.
+  s.muscle.resize(std::size_t(m.num_tets()));
+  for (Index t = 0; t < m.num_tets(); ++t) {
+    double y = 0;
+    for (int k = 0; k < 4; ++k) y += 0.25 * m.V(m.T(t, k), 1);
+    s.muscle[std::size_t(t)] = y > lo.y() + 0.5 * ext.y();
+  }
+  s.gravity.emplace(m, kDensity, Vec3<>(0, -9.81, 0));
+
+  // Track springs on the HR surface vertices of the top 30 %.
+  const VecX<> areas = voronoi_areas(surface.V, surface.F);
+  std::vector<Index> tracked;
+  const double y_top = surface.V.col(1).minCoeff() + 0.7 * (surface.V.col(1).maxCoeff() - surface.V.col(1).minCoeff());
+  for (Index v = 0; v < surface.num_vertices(); ++v)
+    if (surface.V(v, 1) > y_top) tracked.push_back(v);
+  s.track_rest.resize(Index(tracked.size()), 3);
+  VecX<> k(Index(tracked.size()));
+  for (std::size_t q = 0; q < tracked.size(); ++q) {
+    s.track_rest.row(Index(q)) = surface.V.row(tracked[q]);
+    k[Index(q)] = kTrackStiffness * areas[tracked[q]];
+  }
+  s.springs.emplace(embed(exec::omp, m, s.track_rest), m.T, m.num_vertices(), k, s.track_rest);
+
+  s.elements_a = s.elements(kFrameA);
+  s.elements_b = s.elements(kFrameB);
+  s.targets_a = s.targets(kFrameA);
+  s.targets_b = s.targets(kFrameB);
+  s.bc_a = s.boundary(kFrameA);
+  s.bc_b = s.boundary(kFrameB);
+
+  // Frame A from rest (PCG block-Jacobi, omp): the "previous frame" of every timed frame.
+  const double t_mesh = seconds_since(t0);
+  ElasticEnergy<TeranMuscle<>, exec::omp_t> elastic(m, TeranMuscle<>(), s.elements_a, exec::omp);
+  s.springs->set_targets(s.targets_a);
+  using Pcg = ConjugateGradient<BlockJacobi<>, exec::omp_t>;
+  QuasistaticSolver<Pcg, exec::omp_t> newton(m.num_vertices(), m.T, NewtonOptions{}, Pcg({.tolerance = kCgTolerance}, exec::omp), exec::omp);
+  s.x_a = m.V;
+  const NewtonReport r = newton.solve(s.x_a, s.bc_a, elastic, *s.gravity, *s.springs);
+  s.setup_iterations = r.iterations;
+  std::fprintf(stderr,
+               "bench_physics scene: %s, h = %.5f m -> %lld tets, %lld vertices (bbox %.3f x %.3f x %.3f m); cranium %lld, jaw %lld "
+               "vertices; %lld muscle tets; %lld track springs; mass %.3f kg; lattice %.1f s; frame A from rest: %lld Newton "
+               "iterations, %.1f s, %lld inverted tets\n",
+               s.source.c_str(), s.h, (long long)m.num_tets(), (long long)m.num_vertices(), ext.x(), ext.y(), ext.z(),
+               (long long)s.bones->vertices("cranium").size(), (long long)s.bones->vertices("jaw").size(),
+               (long long)std::count(s.muscle.begin(), s.muscle.end(), char(1)), (long long)s.springs->num_springs(),
+               s.gravity->total_mass(), t_mesh, (long long)r.iterations, seconds_since(t0) - t_mesh,
+               (long long)elastic.count_inverted(s.x_a));
+  return s;
+}
+
+const Scene& scene() {
+  static const Scene s = build_scene();
+  return s;
+}
+
+void scene_counters(benchmark::State& state) {
+  const Scene& s = scene();
+  state.counters["tets"] = double(s.mesh.num_tets());
+  state.counters["vertices"] = double(s.mesh.num_vertices());
+  state.counters["h_mm"] = 1e3 * s.h;
+}
+
+template <class Linear>
+Linear make_linear() {
+  if constexpr (requires { Linear(ConjugateGradientOptions{}); })
+    return Linear(ConjugateGradientOptions{.tolerance = kCgTolerance});
+  else
+    return Linear{};
+}
+
+// ---------------------------------------------------------------------------------------------
+// One frame.
+
+template <class Linear, class Policy>
+void BM_frame(benchmark::State& state) {
+  const Scene& s = scene();
+  ElasticEnergy<TeranMuscle<>, Policy> elastic(s.mesh, TeranMuscle<>(), s.elements_a, Policy{});
+  EmbeddedSprings<> springs = *s.springs;
+  QuasistaticSolver<Linear, Policy> newton(s.mesh.num_vertices(), s.mesh.T, NewtonOptions{}, make_linear<Linear>(), Policy{});
+  Points<> x(s.mesh.num_vertices(), 3);
+  NewtonReport report;
+  const auto frame = [&] {
+    x = s.x_a;                         // previous frame's converged solution
+    elastic.set_elements(s.elements_b);  // this frame's activations
+    springs.set_targets(s.targets_b);    // this frame's track targets
+    report = newton.solve(x, s.bc_b, elastic, *s.gravity, springs);  // jaw at this frame's angle
+  };
+  // Warm-up: one Newton iteration of the frame (gather lists, the Cholesky's symbolic analysis,
+  // buffers), cut short by max_iterations = 1 (which reports as a ConvergenceError).
+  newton.options().max_iterations = 1;
+  try {
+    frame();
+  } catch (const ConvergenceError&) {
+  }
+  newton.options().max_iterations = NewtonOptions{}.max_iterations;
+  for (auto _ : state) {
+    frame();
+    benchmark::DoNotOptimize(x.data());
+    benchmark::ClobberMemory();
+  }
+  scene_counters(state);
+  state.counters["newton_iterations"] = double(report.iterations);
+  state.counters["linear_iterations"] = double(report.linear_iterations);
+  state.counters["fps"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+using Cholesky = SparseCholesky<>;
+template <class P>
+using PcgJacobi = ConjugateGradient<Jacobi<>, P>;
+template <class P>
+using PcgBlockJacobi = ConjugateGradient<BlockJacobi<>, P>;
+
+BENCHMARK_TEMPLATE(BM_frame, Cholesky, exec::seq_t)->Name("BM_frame_73k/cholesky/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_TEMPLATE(BM_frame, Cholesky, exec::omp_t)->Name("BM_frame_73k/cholesky/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_TEMPLATE(BM_frame, PcgJacobi<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgJacobi<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+// ---------------------------------------------------------------------------------------------
+// Kernels, at frame A's solution with frame B's controls (the start of a timed frame).
+
+/// x = frame A's solution with frame B's Dirichlet targets applied; the fixed-DOF mask.
+Points<> frame_start(std::vector<char>& fixed) {
+  const Scene& s = scene();
+  Points<> x = s.x_a;
+  fixed.assign(std::size_t(3 * s.mesh.num_vertices()), 0);
+  for (Index k = 0; k < s.bc_b.size(); ++k) {
+    x.row(s.bc_b.vertices[k]) = s.bc_b.targets.row(k);
+    for (int c = 0; c < 3; ++c) fixed[std::size_t(3 * s.bc_b.vertices[k] + c)] = 1;
+  }
+  return x;
+}
+
+template <class Policy>
+void BM_energy_gradient(benchmark::State& state) {
+  const Scene& s = scene();
+  ElasticEnergy<TeranMuscle<>, Policy> elastic(s.mesh, TeranMuscle<>(), s.elements_b, Policy{});
+  std::vector<char> fixed;
+  const Points<> x = frame_start(fixed);
+  Points<> g(s.mesh.num_vertices(), 3);
+  double e = 0;
+  for (int warm = 0; warm < 2; ++warm) {
+    e = elastic.energy(x);
+    g.setZero();
+    elastic.add_gradient(x, g);
+  }
+  for (auto _ : state) {
+    e = elastic.energy(x);
+    g.setZero();
+    elastic.add_gradient(x, g);
+    benchmark::DoNotOptimize(e);
+    benchmark::DoNotOptimize(g.data());
+    benchmark::ClobberMemory();
+  }
+  scene_counters(state);
+  state.counters["tets/s"] = benchmark::Counter(double(s.mesh.num_tets()), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK_TEMPLATE(BM_energy_gradient, exec::seq_t)->Name("BM_kernel_73k/energy+gradient/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_energy_gradient, exec::omp_t)->Name("BM_kernel_73k/energy+gradient/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+template <class Policy>
+void BM_hessian(benchmark::State& state) {
+  const Scene& s = scene();
+  ElasticEnergy<TeranMuscle<>, Policy> elastic(s.mesh, TeranMuscle<>(), s.elements_b, Policy{});
+  std::vector<char> fixed;
+  const Points<> x = frame_start(fixed);
+  BlockHessian<> H(s.mesh.num_vertices(), s.mesh.T);
+  const auto assemble = [&]() -> const SparseMatrix<>& {
+    H.set_zero();
+    elastic.add_hessian(x, H, Definiteness::project);
+    return H.assemble(Policy{}, fixed);
+  };
+  assemble();  // warm-up: gather lists
+  for (auto _ : state) {
+    const SparseMatrix<>& A = assemble();
+    benchmark::DoNotOptimize(A.valuePtr());
+    benchmark::ClobberMemory();
+  }
+  scene_counters(state);
+  state.counters["blocks"] = double(H.num_blocks());
+  state.counters["tets/s"] = benchmark::Counter(double(s.mesh.num_tets()), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t)->Name("BM_kernel_73k/hessian/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t)->Name("BM_kernel_73k/hessian/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+/// The first Newton system of the frame: A (projected Hessian of all terms, Dirichlet rows
+/// eliminated) and b = −g over the free DOFs. Built once (omp).
+struct NewtonSystem {
+  BlockHessian<> H;
+  SparseMatrix<> A;
+  VecX<> b;
+};
+const NewtonSystem& newton_system() {
+  static const NewtonSystem sys = [] {
+    const Scene& s = scene();
+    NewtonSystem out;
+    std::vector<char> fixed;
+    const Points<> x = frame_start(fixed);
+    ElasticEnergy<TeranMuscle<>, exec::omp_t> elastic(s.mesh, TeranMuscle<>(), s.elements_b, exec::omp);
+    EmbeddedSprings<> springs = *s.springs;
+    springs.set_targets(s.targets_b);
+    out.H = BlockHessian<>(s.mesh.num_vertices(), s.mesh.T);
+    out.H.set_zero();
+    elastic.add_hessian(x, out.H, Definiteness::project);
+    BlockTriplets<> trip;
+    springs.add_hessian(x, trip);
+    out.H.add(trip);
+    out.A = out.H.assemble(exec::omp, fixed);
+    Points<> g = Points<>::Zero(s.mesh.num_vertices(), 3);
+    elastic.add_gradient(x, g);
+    s.gravity->add_gradient(x, g);
+    springs.add_gradient(x, g);
+    out.b = -Eigen::Map<const VecX<>>(g.data(), g.size());
+    for (std::size_t d = 0; d < fixed.size(); ++d)
+      if (fixed[d]) out.b[Index(d)] = 0;
+    return out;
+  }();
+  return sys;
+}
+
+template <class Linear, bool Symbolic>
+void BM_linear(benchmark::State& state) {
+  const NewtonSystem& sys = newton_system();
+  Linear linear = make_linear<Linear>();
+  VecX<> d(sys.b.size());
+  LinearSolveInfo info;
+  std::uint64_t version = 1;
+  if (!Symbolic) {  // warm-up (and the symbolic analysis of the numeric-only case)
+    linear.compute(sys.A, version);
+    info = linear.solve(sys.b, d);
+  }
+  for (auto _ : state) {
+    if (Symbolic) ++version;  // a new pattern version: SparseCholesky redoes analyzePattern
+    linear.compute(sys.A, version);
+    info = linear.solve(sys.b, d);
+    benchmark::DoNotOptimize(d.data());
+    benchmark::ClobberMemory();
+  }
+  scene_counters(state);
+  state.counters["dofs"] = double(sys.A.rows());
+  state.counters["nnz"] = double(sys.A.nonZeros());
+  state.counters["linear_iterations"] = double(info.iterations);
+  state.counters["rel_residual"] = info.relative_residual;
+}
+BENCHMARK_TEMPLATE(BM_linear, Cholesky, false)->Name("BM_linear_73k/cholesky")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_TEMPLATE(BM_linear, Cholesky, true)->Name("BM_linear_73k/cholesky_symbolic")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_TEMPLATE(BM_linear, PcgJacobi<exec::seq_t>, false)->Name("BM_linear_73k/pcg_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgJacobi<exec::omp_t>, false)->Name("BM_linear_73k/pcg_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi<exec::seq_t>, false)->Name("BM_linear_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi<exec::omp_t>, false)->Name("BM_linear_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+}  // namespace
+
+BENCHMARK_MAIN();
