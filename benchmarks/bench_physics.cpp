@@ -30,8 +30,9 @@
 // Cases (all wall-clock, UseRealTime; ms):
 //   BM_frame_73k/<linear>/<policy>   one frame: Newton to tolerance. <linear>: cholesky
 //       (Eigen SimplicialLDLT, AMD; sequential itself — /omp runs the energy, Hessian assembly
-//       and gradient under exec::omp), pcg_jacobi, pcg_block_jacobi (ConjugateGradient with
-//       relative tolerance kCgTolerance, products/dots under the policy). Counters:
+//       and gradient under exec::omp), pcg_jacobi, pcg_block_jacobi, pcg_ichol (ConjugateGradient
+//       with relative tolerance kCgTolerance, products/dots under the policy; incomplete Cholesky
+//       is Eigen's, sequential setup and triangular solves). Counters:
 //       newton_iterations, linear_iterations (PCG iterations summed over the frame), fps.
 //   BM_kernel_73k/energy+gradient/<policy>   E(x) and ∂E/∂x of the elastic energy
 //   BM_kernel_73k/hessian/<policy>           projected element Hessians (Newton tries the exact
@@ -46,8 +47,8 @@
 // Run:   build/benchmarks/bench_physics
 //        OMP_NUM_THREADS=1 build/benchmarks/bench_physics --benchmark_filter=omp
 //        build/benchmarks/bench_physics --benchmark_filter='BM_frame'
-// Setup (lattice search + frame A from rest, PCG) takes ~5 s. The whole binary takes ~6 min on 2
-// cores, 2 × ~100 s of it the Cholesky frames (a ~19 s factorization per Newton iteration);
+// Setup (lattice search + frame A from rest, PCG) takes ~3.5 s. The whole binary takes ~5 min on 2
+// cores, 2 × ~70 s of it the Cholesky frames (a ~17 s factorization per Newton iteration);
 // --benchmark_filter=-cholesky leaves them out.
 #include <benchmark/benchmark.h>
 
@@ -296,6 +297,8 @@ template <class P>
 using PcgJacobi = ConjugateGradient<Jacobi<>, P>;
 template <class P>
 using PcgBlockJacobi = ConjugateGradient<BlockJacobi<>, P>;
+template <class P>
+using PcgIncompleteCholesky = ConjugateGradient<IncompleteCholesky<>, P>;
 
 BENCHMARK_TEMPLATE(BM_frame, Cholesky, exec::seq_t)->Name("BM_frame_73k/cholesky/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK_TEMPLATE(BM_frame, Cholesky, exec::omp_t)->Name("BM_frame_73k/cholesky/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
@@ -303,6 +306,8 @@ BENCHMARK_TEMPLATE(BM_frame, PcgJacobi<exec::seq_t>, exec::seq_t)->Name("BM_fram
 BENCHMARK_TEMPLATE(BM_frame, PcgJacobi<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_ichol/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 // ---------------------------------------------------------------------------------------------
 // Kernels, at frame A's solution with frame B's controls (the start of a timed frame).
@@ -436,6 +441,7 @@ BENCHMARK_TEMPLATE(BM_linear, PcgJacobi<exec::seq_t>, false)->Name("BM_linear_73
 BENCHMARK_TEMPLATE(BM_linear, PcgJacobi<exec::omp_t>, false)->Name("BM_linear_73k/pcg_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi<exec::seq_t>, false)->Name("BM_linear_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi<exec::omp_t>, false)->Name("BM_linear_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgIncompleteCholesky<exec::seq_t>, false)->Name("BM_linear_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 }  // namespace
 
