@@ -197,4 +197,30 @@ PrincipalDerivatives<S> principal_from_invariants(const Vec3<S>& s, const Invari
   return r;
 }
 
+/// CRTP base of isotropic materials written as Ψ(I1, I2, J): `Derived::partials(Invariants)`
+/// gives Ψ and its partials; the energy and P come straight from F (no SVD), ∂P/∂F through the
+/// signed SVD's eigen-modes (exact, or with the definiteness fix).
+template <class Derived, class S>
+class InvariantMaterial {
+ public:
+  using scalar_type = S;
+  using Element = NoElementData;
+
+  S energy(const Mat3<S>& F, const Element& = {}) const { return self().partials(invariants(F)).psi; }
+
+  Mat3<S> stress(const Mat3<S>& F, const Element& = {}) const {
+    const Invariants<S> inv = invariants(F);
+    return invariant_stress(F, inv, self().partials(inv).d);
+  }
+
+  Mat9<S> stress_derivative(const Mat3<S>& F, const Element&, Definiteness definiteness) const {
+    const SignedSvd<S> svd = signed_svd(F);
+    return isotropic_stress_derivative(svd, principal_from_invariants(svd.sigma, self().partials(invariants(svd.sigma))),
+                                       definiteness);
+  }
+
+ private:
+  const Derived& self() const { return static_cast<const Derived&>(*this); }
+};
+
 }  // namespace simsr::physics

@@ -13,10 +13,8 @@ namespace simsr::physics {
 /// and ln J extended below J0 (isotropic.hpp). Small-strain shear modulus μ = 2(μ10 + μ01), bulk
 /// modulus κ.
 template <class S = Scalar>
-class MooneyRivlin {
+class MooneyRivlin : public InvariantMaterial<MooneyRivlin<S>, S> {
  public:
-  using scalar_type = S;
-  using Element = NoElementData;
 
   /// Defaults: PhysBAM's face flesh μ10 = 6e4 Pa, μ01 = 2e4 Pa (μ = 1.6e5 Pa); κ = 1.6e6 Pa = 10μ,
   /// i.e. small-strain Poisson ratio ν = (3κ − 2μ)/(6κ + 2μ) ≈ 0.452: nearly incompressible
@@ -37,19 +35,6 @@ class MooneyRivlin {
   S mu01() const { return mu01_; }
   S kappa() const { return kappa_; }
   S inversion_threshold() const { return j0_; }
-
-  S energy(const Mat3<S>& F, const Element& = {}) const { return partials(invariants(F)).psi; }
-
-  Mat3<S> stress(const Mat3<S>& F, const Element& = {}) const {
-    const Invariants<S> inv = invariants(F);
-    return invariant_stress(F, inv, partials(inv).d);
-  }
-
-  Mat9<S> stress_derivative(const Mat3<S>& F, const Element&, Definiteness definiteness) const {
-    const SignedSvd<S> svd = signed_svd(F);
-    return isotropic_stress_derivative(svd, principal_from_invariants(svd.sigma, partials(invariants(svd.sigma))),
-                                       definiteness);
-  }
 
   /// Ψ(I1, I2, J) and its partials.
   InvariantPartials<S> partials(const Invariants<S>& inv) const {

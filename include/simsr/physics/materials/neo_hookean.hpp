@@ -11,10 +11,8 @@ namespace simsr::physics {
 /// ψ = μ/2 (I1 − 3) − μ ln J + λ/2 (ln J)²  [Pa = J/m³], ln J extended below J0 (isotropic.hpp).
 /// Linearizes at F = I to linear elasticity with Lamé parameters μ, λ.
 template <class S = Scalar>
-class NeoHookean {
+class NeoHookean : public InvariantMaterial<NeoHookean<S>, S> {
  public:
-  using scalar_type = S;
-  using Element = NoElementData;
 
   /// Default inversion threshold J0: the exact law holds down to 10 % of the rest volume, far
   /// beyond any physical compression of nearly incompressible flesh, while the extension's
@@ -36,19 +34,6 @@ class NeoHookean {
   S mu() const { return mu_; }
   S lambda() const { return lambda_; }
   S inversion_threshold() const { return j0_; }
-
-  S energy(const Mat3<S>& F, const Element& = {}) const { return partials(invariants(F)).psi; }
-
-  Mat3<S> stress(const Mat3<S>& F, const Element& = {}) const {
-    const Invariants<S> inv = invariants(F);
-    return invariant_stress(F, inv, partials(inv).d);
-  }
-
-  Mat9<S> stress_derivative(const Mat3<S>& F, const Element&, Definiteness definiteness) const {
-    const SignedSvd<S> svd = signed_svd(F);
-    return isotropic_stress_derivative(svd, principal_from_invariants(svd.sigma, partials(invariants(svd.sigma))),
-                                       definiteness);
-  }
 
   /// Ψ(I1, I2, J) and its partials.
   InvariantPartials<S> partials(const Invariants<S>& inv) const {
