@@ -19,15 +19,15 @@ Ld dot(const L3& u, const L3& v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2
 
 /// Plain-loop reference in long double: the loss (torch 1.13's clamped cosine, see the header) and
 /// its gradient w.r.t. pred, scattered corner by corner.
-struct Reference {
+struct NormalLossReference {
   Ld loss = 0;
   std::vector<Ld> grad;
 };
 template <class S>
-Reference reference(const Matrix<double>& rest, const Tris& F, const Matrix<S>& P, const Matrix<S>& T, bool mean, Ld scale = 1,
+NormalLossReference normal_loss_reference(const Matrix<double>& rest, const Tris& F, const Matrix<S>& P, const Matrix<S>& T, bool mean, Ld scale = 1,
                     Ld eps = 1e-8L) {
   const Index M = rest.rows(), B = P.rows() / M;
-  Reference out;
+  NormalLossReference out;
   out.grad.assign(std::size_t(P.size()), 0);
   const Ld norm = mean ? Ld(B * F.rows()) : 1;
   for (Index b = 0; b < B; ++b)
@@ -106,7 +106,7 @@ TEST_CASE("nn::FaceNormalLoss: value and gradient against a long-double referenc
       const Matrix<double> P = random_matrix(rng, B * M, 3, -0.08, 0.08), T = random_matrix(rng, B * M, 3, -0.08, 0.08);
       Matrix<double> d;
       const double l = loss.value_and_gradient(exec::seq, P, T, &d, 2.5);
-      const Reference ref = reference(rest, sphere.F, P, T, mean, 2.5L);
+      const NormalLossReference ref = normal_loss_reference(rest, sphere.F, P, T, mean, 2.5L);
       CHECK(l == doctest::Approx(double(ref.loss)).epsilon(1e-13));
       CHECK(l > 0);
       CHECK(rel_error(d, ref.grad) < 1e-12);
@@ -137,7 +137,7 @@ TEST_CASE("nn::FaceNormalLoss: random triangles (shared vertices, all orientatio
   const Matrix<double> P = random_matrix(rng, 2 * M, 3, -0.2, 0.2), T = random_matrix(rng, 2 * M, 3, -0.2, 0.2);
   Matrix<double> d;
   const double l = loss.value_and_gradient(P, T, &d, -0.7);
-  const Reference ref = reference(rest, faces, P, T, false, -0.7L);
+  const NormalLossReference ref = normal_loss_reference(rest, faces, P, T, false, -0.7L);
   CHECK(l == doctest::Approx(double(ref.loss)).epsilon(1e-13));
   CHECK(rel_error(d, ref.grad) < 1e-12);
   CHECK(fd_error(loss, P, T, -0.7) < 1e-6);

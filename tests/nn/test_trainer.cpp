@@ -54,7 +54,7 @@ Toy make_toy(std::uint64_t seed, Index F = 10) {
 std::vector<double> train_values(const Toy& toy, Index epochs, std::uint64_t seed, bool omp) {
   nn::Rng init(7);
   nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
-  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = epochs, .seed = seed, .progress = false});
+  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = epochs, .seed = seed, .progress = false, .on_epoch = {}});
   if (omp)
     tr.run(exec::omp);
   else
@@ -72,7 +72,7 @@ TEST_CASE("nn::Trainer: the loss falls on a learnable toy problem; held-out erro
   const Toy toy = make_toy(1);
   nn::Rng init(3);
   nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
-  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 60, .seed = 5, .progress = false});
+  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 60, .seed = 5, .progress = false, .on_epoch = {}});
   tr.set_holdout(toy.frames);
   const double before = tr.holdout_error(exec::seq);
   tr.run(exec::omp);
@@ -100,14 +100,14 @@ TEST_CASE("nn::Trainer: a seed fixes the run, seq == omp bitwise, and a checkpoi
   {
     nn::Rng init(7);
     nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
-    nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 4, .seed = 11, .progress = false});
+    nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 4, .seed = 11, .progress = false, .on_epoch = {}});
     tr.run_epoch(exec::seq);
     tr.run_epoch(exec::seq);
     tr.save_checkpoint(dir / "ckpt.npz", md);
   }
   nn::Rng other(99);  // different initial weights: the checkpoint must overwrite them all
   nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, other);
-  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 4, .seed = 0, .progress = false});
+  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 4, .seed = 0, .progress = false, .on_epoch = {}});
   tr.load_checkpoint(dir / "ckpt.npz");
   CHECK(tr.epoch() == 2);
   CHECK(tr.steps() == 6);
