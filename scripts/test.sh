@@ -17,7 +17,7 @@ cmake --build "$build" -j "$jobs"
 echo "simsr: build took $(( $(date +%s) - start )) s"
 (cd "$build" && ctest --output-on-failure -j "$jobs" --timeout 900)
 
-fuzz_seconds=${SIMSR_FUZZ_SECONDS:-10}
+fuzz_seconds=${SIMSR_FUZZ_SECONDS:-5}
 if (( fuzz_seconds > 0 )); then
   bash scripts/fuzz.sh "$fuzz_seconds"
 fi
