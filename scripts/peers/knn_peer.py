@@ -15,11 +15,13 @@ Bench mode (peer timings beside benchmarks/bench_neighbors.cpp, same sizes as th
 Prints the median and min of `--repeats` timed runs after one warm-up.
 """
 import argparse
-import statistics
+import os
 import sys
-import time
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from timing import report, timed  # noqa: E402
 
 
 def query(args):
@@ -32,21 +34,6 @@ def query(args):
     dist, idx = cKDTree(points).query(queries, k=[i + 1 for i in range(args.k)])
     np.save(args.indices, np.ascontiguousarray(idx, dtype=np.int64))
     np.save(args.distances, np.ascontiguousarray(dist, dtype=np.float64))
-
-
-def timed(fn, repeats):
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), min(times)
-
-
-def report(name, med_min):
-    med, best = med_min
-    print(f"{name:<52s} median {med * 1e3:9.2f} ms   min {best * 1e3:9.2f} ms", flush=True)
 
 
 def bench(args):

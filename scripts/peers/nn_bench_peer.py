@@ -29,7 +29,6 @@ OpenBLAS to a slower kernel on this machine).
 """
 import argparse
 import os
-import statistics
 import sys
 import time
 
@@ -37,6 +36,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import official_model as om  # noqa: E402
+from timing import report, timed  # noqa: E402
 
 N_LR, N_HR, UPK = 15872, 35637, 20
 
@@ -65,35 +65,24 @@ def paper_geometry(knn=5, upk=UPK):
     return lr, hr, graph.astype(np.int64), up.astype(np.int64), dist.astype(np.float64)
 
 
-def timed(fn, repeats):
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), min(times)
-
-
-def report(name, med_min):
-    med, best = med_min
-    print(f"{name:<58s} median {med * 1e3:10.1f} ms   min {best * 1e3:10.1f} ms", flush=True)
-
-
 def encode(model, ldx):
     B = ldx.shape[0]
     h0 = torch.cat((ldx, model.pos_emb.unsqueeze(0).expand(B, -1, -1)), dim=-1)
     return torch.cat((h0, model.net_feat_emb(h0)), dim=-1)
 
 
-def bench_forward(args):
+def paper_model(train):
+    """The official network at the paper's sizes (upK 20) and one seeded input frame (B = 1)."""
     lr, hr, graph, up, dist = paper_geometry()
-    cfg = dict(om.OFFICIAL_CONFIG, upK=UPK)
     torch.manual_seed(0)
-    model = om.OfficialSuperRes(lr, hr, graph, up, dist, cfg)
-    model.eval()
+    model = om.OfficialSuperRes(lr, hr, graph, up, dist, dict(om.OFFICIAL_CONFIG, upK=UPK))
+    model.train(train)
     gen = torch.Generator().manual_seed(7)
-    ldx = 0.3 * torch.randn(1, N_LR, 3, generator=gen)
+    return model, 0.3 * torch.randn(1, N_LR, 3, generator=gen)
+
+
+def bench_forward(args):
+    model, ldx = paper_model(train=False)
     idx = model.net_upscale.indices
     with torch.no_grad():
         report("forward paper size, official (f_theta every call)", timed(lambda: model(ldx), args.slow_repeats))
@@ -120,13 +109,7 @@ def bench_forward(args):
 
 
 def bench_train_mode(args):
-    lr, hr, graph, up, dist = paper_geometry()
-    cfg = dict(om.OFFICIAL_CONFIG, upK=UPK)
-    torch.manual_seed(0)
-    model = om.OfficialSuperRes(lr, hr, graph, up, dist, cfg)
-    model.train()
-    gen = torch.Generator().manual_seed(7)
-    ldx = 0.3 * torch.randn(1, N_LR, 3, generator=gen)
+    model, ldx = paper_model(train=True)
     report("forward paper size, train mode (autograd on), B=1", timed(lambda: model(ldx), args.slow_repeats))
 
 
