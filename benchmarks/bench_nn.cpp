@@ -19,6 +19,8 @@
 /// PyTorch peer: scripts/peers/nn_bench_peer.py.
 #include <benchmark/benchmark.h>
 
+#include "bench_data.hpp"
+
 #include <simsr/io/npz.hpp>
 #include <simsr/io/npy.hpp>
 #include <simsr/io/obj.hpp>
@@ -40,13 +42,6 @@ namespace {
 
 constexpr Index kLr = 15872, kHr = 35637, kUpK = 20;
 
-std::filesystem::path data_dir() {
-#ifdef SIMSR_DATA_DIR
-  return std::filesystem::path(SIMSR_DATA_DIR);
-#else
-  return std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared" / "data";
-#endif
-}
 
 /// The synthetic geometry of the file comment (knn columns of LR graph, upK HR→LR neighbours).
 nn::NetworkGeometry paper_geometry(Index knn, Index up_k) {

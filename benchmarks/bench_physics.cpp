@@ -52,6 +52,8 @@
 // --benchmark_filter=-cholesky leaves them out.
 #include <benchmark/benchmark.h>
 
+#include "bench_data.hpp"
+
 #include <simsr/discretize/bcc_lattice.hpp>
 #include <simsr/discretize/embedding.hpp>
 #include <simsr/io/obj.hpp>
@@ -92,13 +94,6 @@ struct Controls {
 constexpr Controls kFrameA{0.10, 0.10, 0.0};
 constexpr Controls kFrameB{0.12, 0.15, 0.0005};
 
-std::filesystem::path data_dir() {
-#ifdef SIMSR_DATA_DIR
-  return std::filesystem::path(SIMSR_DATA_DIR);
-#else
-  return std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared" / "data";
-#endif
-}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -7,20 +7,14 @@ embedded variant and every linear solver, and bad input mapped to exit codes (64
 
 Exit 0: all checks passed; 1: a check failed."""
 import json
+import os
 import subprocess
 import sys
+import tempfile
+
+from checks import check, finish
 
 EXE = sys.argv[1]
-failures = []
-checks = 0
-
-
-def check(cond, what):
-    global checks
-    checks += 1
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
 
 
 def run(*args):
@@ -54,8 +48,6 @@ check(finer["relative_error"] < coarse["relative_error"] / 2, f"refinement: {coa
 same = result("--cells", "4", "--solver", "pcg-jacobi")
 check(abs(same["tip_deflection"] - finer["tip_deflection"]) < 1e-6 * eb, "PCG-Jacobi and PCG-block-Jacobi agree")
 
-import os
-import tempfile
 vtu = os.path.join(tempfile.mkdtemp(), "beam.vtu")
 embedded = result("--cells", "2", "--embedded", "--vtu", vtu)
 with open(vtu, "rb") as f:
@@ -80,5 +72,4 @@ check(rc == 64, f"unknown solver is a usage error (rc {rc})")
 rc, out, err = run("--young", "-1")
 check(rc == 5 and "cantilever:" in err, f"negative Young's modulus: exit 5 (rc {rc}: {err.strip()})")
 
-print(f"{checks - len(failures)}/{checks} checks passed")
-sys.exit(1 if failures else 0)
+finish()

@@ -14,6 +14,8 @@ import os
 import subprocess
 import sys
 
+from checks import check, finish
+
 try:
     import numpy as np
 except ImportError as e:  # peer missing: skip, do not pass silently
@@ -26,16 +28,6 @@ except ImportError:
 
 SIMSR, WORK = sys.argv[1], sys.argv[2]
 os.makedirs(WORK, exist_ok=True)
-failures = []
-checks = 0
-
-
-def check(cond, what):
-    global checks
-    checks += 1
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
 
 
 def simsr(*args, expect=0):
@@ -173,5 +165,4 @@ check("float32 or float64" in p.stderr, f"integer dtype message: {p.stderr}")
 eval_json(path("truth.npz"), path("truth.npz"), "--frames-key", "lowres", expect=5)  # no such array
 simsr("eval", "--pred", path("truth.npz"), expect=64)
 
-print(f"{checks - len(failures)} passed, {len(failures)} failed")
-sys.exit(1 if failures else 0)
+finish()

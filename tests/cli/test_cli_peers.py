@@ -13,6 +13,8 @@ import shutil
 import subprocess
 import sys
 
+from checks import check, finish
+
 try:
     import numpy as np
     import meshio
@@ -22,16 +24,6 @@ except ImportError as e:  # peer missing: skip, do not pass silently
 
 SIMSR, WORK, DATA = sys.argv[1], sys.argv[2], sys.argv[3]
 os.makedirs(WORK, exist_ok=True)
-failures = []
-checks = 0
-
-
-def check(cond, what):
-    global checks
-    checks += 1
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
 
 
 def simsr(*args, expect=0):
@@ -197,5 +189,4 @@ simsr("info", os.path.join(WORK, "missing.obj"), expect=2)
 simsr("info", os.path.join(WORK, "x.unknown"), expect=5)
 simsr("convert", src, expect=64)
 
-print(f"{checks - len(failures)} passed, {len(failures)} failed")
-sys.exit(1 if failures else 0)
+finish()
