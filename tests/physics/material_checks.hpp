@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <string>
@@ -69,30 +70,34 @@ inline std::vector<Sample> deformation_samples(unsigned seed, bool include_flip_
   return r;
 }
 
-/// Central differences of ψ: ∂ψ/∂F.
-template <class M>
-Mat3d fd_stress(const M& m, const Mat3d& F, const typename M::Element& e, double h) {
-  Mat3d P;
+/// Central differences of f along each of F's 9 entries (column-major k ↔ F(k % 3, k / 3)).
+template <class Fn>
+auto fd_over_entries(const Mat3d& F, double h, Fn&& f) {
+  std::array<std::decay_t<decltype(f(F))>, 9> d;
   for (int k = 0; k < 9; ++k) {
     Mat3d Fp = F, Fm = F;
     Fp(k % 3, k / 3) += h;
     Fm(k % 3, k / 3) -= h;
-    P(k % 3, k / 3) = (m.energy(Fp, e) - m.energy(Fm, e)) / (2 * h);
+    d[std::size_t(k)] = (f(Fp) - f(Fm)) / (2 * h);
   }
+  return d;
+}
+
+/// Central differences of ψ: ∂ψ/∂F.
+template <class M>
+Mat3d fd_stress(const M& m, const Mat3d& F, const typename M::Element& e, double h) {
+  const auto d = fd_over_entries(F, h, [&](const Mat3d& G) { return m.energy(G, e); });
+  Mat3d P;
+  for (int k = 0; k < 9; ++k) P(k % 3, k / 3) = d[std::size_t(k)];
   return P;
 }
 
 /// Central differences of P: ∂vec(P)/∂vec(F).
 template <class M>
 Mat9d fd_stress_derivative(const M& m, const Mat3d& F, const typename M::Element& e, double h) {
+  const auto d = fd_over_entries(F, h, [&](const Mat3d& G) -> Mat3d { return m.stress(G, e); });
   Mat9d D;
-  for (int k = 0; k < 9; ++k) {
-    Mat3d Fp = F, Fm = F;
-    Fp(k % 3, k / 3) += h;
-    Fm(k % 3, k / 3) -= h;
-    const Mat3d dP = (m.stress(Fp, e) - m.stress(Fm, e)) / (2 * h);
-    D.col(k) = Eigen::Map<const Vec9<double>>(dP.data());
-  }
+  for (int k = 0; k < 9; ++k) D.col(k) = Eigen::Map<const Vec9<double>>(d[std::size_t(k)].data());
   return D;
 }
 

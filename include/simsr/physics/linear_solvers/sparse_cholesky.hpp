@@ -56,7 +56,8 @@ class SparseCholesky {
     x = ldlt_->solve(b);
     LinearSolveInfo info;
     const S bn = b.norm();
-    info.relative_residual = bn > S(0) ? double((b - (*A_) * x).norm() / bn) : 0.0;
+    Ax_.noalias() = (*A_) * x;  // into a kept buffer: no allocation per Newton iteration
+    info.relative_residual = bn > S(0) ? double((b - Ax_).norm() / bn) : 0.0;
     info.converged = std::isfinite(info.relative_residual);
     return info;
   }
@@ -67,6 +68,7 @@ class SparseCholesky {
   using Factorization = Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>, Eigen::Lower, Eigen::AMDOrdering<int>>;
   std::unique_ptr<Factorization> ldlt_;
   const SparseMatrix<S>* A_ = nullptr;
+  VecX<S> Ax_;
   bool analyzed_ = false;
   std::uint64_t version_ = 0;
   Index rows_ = 0, nnz_ = 0;
