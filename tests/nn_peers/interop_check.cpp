@@ -22,6 +22,8 @@
 #include <cstdio>
 #include <iostream>
 #include <set>
+#include <string>
+#include <vector>
 #include <span>
 #include <utility>
 
@@ -37,12 +39,19 @@ struct Report {
   /// is compared by its absolute error, at the precision's rounding level.
   double floor = 1e-12;
   bool ok = true;
+  /// Names of the comparisons that failed, so the driver can print them in one line.
+  std::vector<std::string> failed;
+
+  void fail(const std::string& what) {
+    ok = false;
+    failed.push_back(what);
+  }
 
   template <class A, class B>
   void compare(const std::string& what, const A& ours, const B& ref) {
     if (ours.size() != ref.size()) {
       j[what] = {{"error", "size " + std::to_string(ours.size()) + " vs " + std::to_string(ref.size())}};
-      ok = false;
+      fail(what);
       return;
     }
     double diff = 0, scale = 0;
@@ -52,12 +61,12 @@ struct Report {
     }
     const double rel = diff / std::max(scale, floor);
     j[what] = {{"max_abs", diff}, {"rel", rel}, {"scale", scale}};
-    if (!(rel <= tol)) ok = false;
+    if (!(rel <= tol)) fail(what);
   }
   void scalar(const std::string& what, double ours, double ref) {
     const double rel = std::abs(ours - ref) / std::max(std::abs(ref), 1e-30);
     j[what] = {{"ours", ours}, {"torch", ref}, {"rel", rel}};
-    if (!(rel <= tol)) ok = false;
+    if (!(rel <= tol)) fail(what);
   }
 };
 
@@ -65,6 +74,48 @@ template <class S>
 Matrix<S> as_matrix(const io::NpyArray& a, Index cols) {
   const auto v = a.template to_vector<S>();
   return Eigen::Map<const Matrix<S>>(v.data(), Index(v.size()) / cols, cols);
+}
+
+/// How our dynamic feature graph (block 1) agrees with PyTorch's, row by row. A row may differ
+/// only at a near-tie: every index in the symmetric difference of the two neighbour sets lies
+/// within tol·H of the row's k-th distance (distances in double from our block-1 input features,
+/// H = their largest magnitude in the item). Float32 rounding on another CPU swaps such pairs: on
+/// the bunny the closest k-th/(k+1)-th gap is 2.8e-6·H, and features agree to ~1e-7·H per entry.
+struct GraphAgreement {
+  Index equal = 0, tied = 0, differ = 0;
+};
+
+template <class S>
+GraphAgreement graph_agreement(const Matrix<S>& h, const nn::GraphIndices& ours, const std::vector<std::int64_t>& ref, Index n_points,
+                               double tol) {
+  GraphAgreement a;
+  const Index k = ours.cols();
+  for (Index r = 0; r < ours.rows(); ++r) {
+    const std::set<std::int64_t> mine(ours.row(r).data(), ours.row(r).data() + k);
+    const std::set<std::int64_t> theirs(ref.begin() + r * k, ref.begin() + (r + 1) * k);
+    if (mine == theirs) {
+      ++a.equal;
+      continue;
+    }
+    const Index first = (r / n_points) * n_points;
+    const auto item = h.middleRows(first, n_points).template cast<double>();
+    const double H = item.cwiseAbs().maxCoeff();
+    auto dist = [&](std::int64_t j) { return (item.row(r - first) - item.row(Index(j))).norm(); };
+    double dk = 0;
+    for (const auto j : mine) dk = std::max(dk, dist(j));
+    bool tie = true;
+    for (const auto& [from, other] : {std::pair{&mine, &theirs}, std::pair{&theirs, &mine}})
+      for (const auto j : *from)
+        if (!other->count(j) && !(j >= 0 && j < n_points && std::abs(dist(j) - dk) <= tol * H)) tie = false;
+    ++(tie ? a.tied : a.differ);
+  }
+  return a;
+}
+
+nn::GraphIndices as_graph(const std::vector<std::int64_t>& v, Index k) {
+  nn::GraphIndices g(Index(v.size()) / k, k);
+  for (Index i = 0; i < g.size(); ++i) g.data()[i] = VIndex(v[std::size_t(i)]);
+  return g;
 }
 
 /// Everything above in precision S; `grad_tol` bounds the gradients and the post-Adam weights.
@@ -103,22 +154,24 @@ int check(const std::string& model, const std::string& state, const std::string&
   rep.compare("input/hdx", hdx, as_matrix<S>(fx.at("hdx"), 3));
   rep.compare("input/up_query", net.upsampling().query(), as_matrix<S>(fx.at("up_query"), 7));
 
-  // eval forward
+  // eval forward. Where the two feature graphs differ only at near-ties, PyTorch's graph is
+  // given to block 1 and the forward repeated, so what follows compares the same computation.
   Matrix<S> pred, pred_inf;
+  auto& edge1 = net.feature_embedding().block(1).edge_conv();
+  const Index k1 = edge1.k();
+  auto check_graph = [&](const std::string& what) {
+    const auto ref = fx.at(what + "/feature_graph").template to_vector<std::int64_t>();
+    const GraphAgreement a = graph_agreement(net.feature_embedding().block_output(0), edge1.graph(), ref, N, tol);
+    rep.j[what + "/feature_graph_rows_equal"] = a.equal;
+    rep.j[what + "/feature_graph_rows_tied"] = a.tied;
+    rep.j[what + "/feature_graph_rows"] = edge1.graph().rows();
+    if (a.differ) rep.fail(what + "/feature_graph");
+    if (a.tied) edge1.set_graph(as_graph(ref, k1), N);
+    return a.tied > 0;
+  };
   net.forward(nn::Mode::eval, ldx, pred);
+  if (check_graph("eval")) net.forward(nn::Mode::eval, ldx, pred);
   rep.compare("eval/z_lr", net.code(), as_matrix<S>(fx.at("eval/z_lr"), net.latent_dim()));
-  {
-    const auto& g = net.feature_embedding().block(1).edge_conv().graph();
-    const auto ref = fx.at("eval/feature_graph").to_vector<std::int64_t>();
-    Index same = 0;
-    for (Index r = 0; r < g.rows(); ++r) {
-      std::set<std::int64_t> a(g.row(r).data(), g.row(r).data() + g.cols()), b(ref.begin() + r * g.cols(), ref.begin() + (r + 1) * g.cols());
-      same += a == b;
-    }
-    rep.j["eval/feature_graph_rows_equal"] = same;
-    rep.j["eval/feature_graph_rows"] = g.rows();
-    if (same != g.rows()) rep.ok = false;
-  }
   rep.compare("eval/up_weights", net.upsampling().weights(), as_matrix<S>(fx.at("eval/up_weights"), net.config().up_k).topRows(M));
   rep.compare("eval/z_hr", net.hr_code(), as_matrix<S>(fx.at("eval/z_hr"), net.latent_dim()));
   rep.compare("eval/hdx_pred", pred, as_matrix<S>(fx.at("eval/hdx_pred"), 3));
@@ -134,14 +187,21 @@ int check(const std::string& model, const std::string& state, const std::string&
     rep.scalar("eval/loss_total", t.total, fx.at("eval/loss_total").item<double>());
   }
 
-  // one training step from the exported state
-  nn::load_state(net.store(), io::read_npz(state));
-  net.parameters_changed();
+  // one training step from the exported state (repeated from that state with PyTorch's graph
+  // where the train-mode graphs differ only at near-ties: the forward moves BatchNorm's statistics)
+  const io::NpzArrays start = io::read_npz(state);
   nn::SuperResolutionLoss<S> loss(net.config(), net.hr_rest_normalized(), data.hr_faces);
   nn::Adam<S> adam(net.store(), {.lr = net.config().lr});
   Matrix<S> d_pred, d_z;
+  edge1.use_dynamic_graph(N);
+  auto train_forward = [&] {
+    nn::load_state(net.store(), start);
+    net.parameters_changed();
+    net.forward(nn::Mode::train, ldx, pred, exec::omp);
+  };
+  train_forward();
+  if (check_graph("train")) train_forward();
   net.store().zero_grad();
-  net.forward(nn::Mode::train, ldx, pred, exec::omp);
   const auto t = loss.evaluate(exec::omp, pred, hdx, net.code(), 0, &d_pred, &d_z);
   net.backward(d_pred, &d_z, exec::omp);
   rep.compare("train/z_lr", net.code(), as_matrix<S>(fx.at("train/z_lr"), net.latent_dim()));
@@ -158,14 +218,14 @@ int check(const std::string& model, const std::string& state, const std::string&
     one.tol = grad_tol;
     one.floor = sizeof(S) == 4 ? 1e-6 : 1e-12;
     one.compare(name, Eigen::Map<const nn::Vector<S>>(ours.data(), Index(ours.size())), Eigen::Map<const nn::Vector<S>>(ref.data(), Index(ref.size())));
-    if (!one.ok) rep.ok = false;
-    return one.j[name];
+    return std::pair{one.j[name], one.ok};
   };
   double worst_grad = 0, worst_after = 0;
   std::string worst_name;
   for (const auto& e : net.store().entries()) {
     if (e.kind != nn::TensorEntry::Kind::parameter) continue;
-    const auto r = compare_tensor("train/grad/", e.name, net.store().gradient(e));
+    const auto [r, ok] = compare_tensor("train/grad/", e.name, net.store().gradient(e));
+    if (!ok) rep.fail("train/grad/" + e.name);
     rep.j["train/grad"][e.name] = r;
     if (r.value("rel", 1.0) > worst_grad) worst_grad = r.value("rel", 1.0), worst_name = e.name;
   }
@@ -173,20 +233,28 @@ int check(const std::string& model, const std::string& state, const std::string&
   adam.step(exec::omp);
   // Adam's first update is lr·g/(|g| + eps), about lr·sign(g): where float32 rounding leaves a
   // gradient entry at noise level (the BatchNorm-projected layers above) its sign, hence the
-  // update, may flip. So in float32 the weights after the step are held to that bound, |Δ| ≤ 2·lr;
-  // the float64 run holds them to grad_tol (relative), which proves the step itself.
+  // update, may flip. So in float32 a parameter after the step is held to that bound, |Δ| ≤ 2·lr,
+  // plus the float32 rounding of the weights themselves (tol·max|w|: a flipped step on a weight
+  // of size 4 adds an ulp of 4.8e-7 to 2·lr = 4e-4, which a bare 2·lr·(1 + 1e-3) did not allow);
+  // buffers (BatchNorm running statistics) are not stepped and are held to tol relative. The
+  // float64 run holds everything to grad_tol (relative), which proves the step itself.
   const bool float_run = sizeof(S) == 4;
   const double lr = net.config().lr;
   for (const auto& e : net.store().entries()) {
-    const bool saved_ok = rep.ok;
-    const auto r = compare_tensor("train/after/", e.name, std::as_const(net.store()).values(e));
-    const bool ok = float_run ? r.value("max_abs", 1.0) <= 2 * lr * (1 + 1e-3) : r.value("rel", 1.0) <= grad_tol;
-    rep.ok = saved_ok && ok;
-    worst_after = std::max(worst_after, float_run ? r.value("max_abs", 1.0) / (2 * lr) : r.value("rel", 1.0));
-    if (!ok) rep.j["train/after_failed"][e.name] = r;
+    const auto [r, rel_ok] = compare_tensor("train/after/", e.name, std::as_const(net.store()).values(e));
+    const bool stepped = e.kind == nn::TensorEntry::Kind::parameter;
+    const double bound = (stepped ? 2 * lr : 0.0) + tol * r.value("scale", 0.0);
+    const bool ok = float_run ? r.value("max_abs", 1.0) <= bound : rel_ok;
+    if (!ok) {
+      rep.fail("train/after/" + e.name);
+      rep.j["train/after_failed"][e.name] = r;
+    }
+    const double measure = float_run ? (stepped ? r.value("max_abs", 1.0) / bound : 0.0) : r.value("rel", 1.0);
+    if (measure > worst_after) worst_after = measure, rep.j["train/after_worst"] = {{"name", e.name}, {"entry", r}};
   }
-  rep.j["train/after_worst_rel"] = worst_after;  // float32: max |Δ| / (2·lr); float64: relative
+  rep.j["train/after_worst_rel"] = worst_after;  // float32: max |Δ| / its bound; float64: relative
   rep.j["ok"] = rep.ok;
+  rep.j["failed"] = rep.failed;
   std::cout << rep.j.dump(1) << "\n";
   return rep.ok ? 0 : 1;
 }
