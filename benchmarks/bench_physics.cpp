@@ -243,9 +243,30 @@ void scene_counters(benchmark::State& state) {
   state.counters["h_mm"] = 1e3 * s.h;
 }
 
+/// The multigrid levels of the scene's lattice (built once per mesh, like the gather lists: not
+/// timed; the time it takes is printed).
+const LatticeHierarchy<>& hierarchy() {
+  static const LatticeHierarchy<> levels = [] {
+    const auto t0 = std::chrono::steady_clock::now();
+    LatticeHierarchy<> out = lattice_hierarchy(scene().mesh);
+    std::fprintf(stderr, "multigrid levels:");
+    for (Index l = 0; l < out.num_levels(); ++l) std::fprintf(stderr, " %lld", (long long)out.vertices[std::size_t(l)].rows());
+    std::fprintf(stderr, " vertices (built in %.2f s)\n", seconds_since(t0));
+    return out;
+  }();
+  return levels;
+}
+
+template <class Linear>
+constexpr bool uses_multigrid = false;
+template <class P>
+constexpr bool uses_multigrid<ConjugateGradient<Multigrid<>, P>> = true;
+
 template <class Linear>
 Linear make_linear() {
-  if constexpr (requires { Linear(ConjugateGradientOptions{}); })
+  if constexpr (uses_multigrid<Linear>)
+    return Linear(ConjugateGradientOptions{.tolerance = kCgTolerance}, Multigrid<>(hierarchy().prolongations));
+  else if constexpr (requires { Linear(ConjugateGradientOptions{}); })
     return Linear(ConjugateGradientOptions{.tolerance = kCgTolerance});
   else
     return Linear{};
@@ -294,6 +315,8 @@ template <class P>
 using PcgBlockJacobi = ConjugateGradient<BlockJacobi<>, P>;
 template <class P>
 using PcgIncompleteCholesky = ConjugateGradient<IncompleteCholesky<>, P>;
+template <class P>
+using PcgMultigrid = ConjugateGradient<Multigrid<>, P>;
 
 BENCHMARK_TEMPLATE(BM_frame, Cholesky, exec::seq_t)->Name("BM_frame_73k/cholesky/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK_TEMPLATE(BM_frame, Cholesky, exec::omp_t)->Name("BM_frame_73k/cholesky/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
@@ -303,6 +326,8 @@ BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi<exec::seq_t>, exec::seq_t)->Name("BM
 BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_ichol/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 // ---------------------------------------------------------------------------------------------
 // Kernels, at frame A's solution with frame B's controls (the start of a timed frame).
@@ -437,6 +462,8 @@ BENCHMARK_TEMPLATE(BM_linear, PcgJacobi<exec::omp_t>, false)->Name("BM_linear_73
 BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi<exec::seq_t>, false)->Name("BM_linear_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi<exec::omp_t>, false)->Name("BM_linear_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_linear, PcgIncompleteCholesky<exec::seq_t>, false)->Name("BM_linear_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid<exec::seq_t>, false)->Name("BM_linear_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid<exec::omp_t>, false)->Name("BM_linear_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 }  // namespace
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// Preconditioned conjugate gradients under an execution policy, with Jacobi (1/A_ii) or
-/// block-Jacobi (the inverse 3×3 vertex blocks) preconditioning. Products and dot products run
+/// Preconditioned conjugate gradients under an execution policy, with Jacobi (1/A_ii),
+/// block-Jacobi (the inverse 3×3 vertex blocks) or Multigrid (multigrid.hpp) preconditioning. Products and dot products run
 /// under the policy with fixed chunking, so seq and omp iterate identically.
 ///
 ///     physics::ConjugateGradient<physics::BlockJacobi<>, exec::omp_t> pcg({.tolerance = 1e-6});
@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -18,6 +19,7 @@
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
 #include "linear_solver.hpp"
+#include "sparse_ops.hpp"
 
 namespace simsr::physics {
 
@@ -88,8 +90,12 @@ class ConjugateGradient {
   using scalar_type = S;
   ConjugateGradient() = default;
   explicit ConjugateGradient(ConjugateGradientOptions options, Policy policy = {}) : options_(options), policy_(policy) {}
+  /// With a preconditioner that needs more than the matrix (Multigrid: its prolongations).
+  ConjugateGradient(ConjugateGradientOptions options, Preconditioner preconditioner, Policy policy = {})
+      : options_(options), policy_(policy), preconditioner_(std::move(preconditioner)) {}
 
   ConjugateGradientOptions& options() { return options_; }
+  Preconditioner& preconditioner() { return preconditioner_; }
 
   void compute(const SparseMatrix<S>& A, std::uint64_t /*pattern_version*/ = 0) {
     if (A.rows() != A.cols()) throw ShapeError("ConjugateGradient: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
@@ -142,20 +148,8 @@ class ConjugateGradient {
   }
 
  private:
-  S dot(const VecX<S>& a, const VecX<S>& b) const {
-    return exec::parallel_reduce(policy_, a.size(), S(0), [&](Index i) { return a[i] * b[i]; }, [](S u, S v) { return u + v; });
-  }
-  void multiply(const VecX<S>& v, VecX<S>& out) const {
-    const SparseMatrix<S>& A = *A_;
-    const int* outer = A.outerIndexPtr();
-    const int* inner = A.innerIndexPtr();
-    const S* val = A.valuePtr();
-    exec::parallel_for(policy_, A.rows(), [&](Index r) {
-      S s = 0;
-      for (int k = outer[r]; k < outer[r + 1]; ++k) s += val[k] * v[inner[k]];
-      out[r] = s;
-    });
-  }
+  S dot(const VecX<S>& a, const VecX<S>& b) const { return physics::dot(policy_, a, b); }
+  void multiply(const VecX<S>& v, VecX<S>& out) const { sparse_multiply(policy_, *A_, v, out); }
 
   ConjugateGradientOptions options_;
   Policy policy_;

@@ -1,0 +1,396 @@
+#pragma once
+/// \file
+/// A multigrid V-cycle as the preconditioner of ConjugateGradient, for the Newton systems of a
+/// tet mesh. Geometric prolongations, algebraic coarse operators:
+///
+/// - The levels are BCC lattices of cell size 2h, 4h, … covering the mesh (discretize::bcc_lattice,
+///   the same lattices the LR simulator uses). Level ℓ's vertices are embedded barycentrically in
+///   level ℓ+1's tets, so the prolongation P interpolates linearly: it reproduces every affine
+///   displacement, rigid motions included — the near-null space of elasticity that coarse levels
+///   must carry. (Vertices of a coarse level that no finer vertex uses are dropped.)
+/// - The coarse matrices are Galerkin products A_{ℓ+1} = Pᵀ A_ℓ P, recomputed at every compute(),
+///   so whatever is in the Hessian (materials, springs, contact, bones) is in them too. Rows of
+///   Dirichlet DOFs (the identity rows BlockHessian::assemble writes) are left out of P: the
+///   coarse levels never move a fixed DOF.
+/// - Smoothing is damped block-Jacobi, x ← x + ω B⁻¹(b − A x) with B the 3×3 vertex blocks and
+///   ω = 4 / (3 λ_max(B⁻¹A)) from a few power iterations per level (the usual safe choice: ω·λ_max
+///   = 4/3 < 2 keeps every sweep a contraction in the A-norm). Pre- and post-smoothing use the same
+///   sweep count, so the V-cycle is a symmetric positive definite operator, as PCG requires.
+/// - The coarsest level is solved exactly (Eigen's sparse LDLᵀ).
+///
+///     auto levels = physics::lattice_hierarchy(mesh);                 // once per mesh
+///     using Pcg = physics::ConjugateGradient<physics::Multigrid<>, exec::omp_t>;
+///     physics::QuasistaticSolver<Pcg, exec::omp_t> newton(mesh.num_vertices(), mesh.T, {},
+///         Pcg({.tolerance = 1e-4}, physics::Multigrid<>(levels.prolongations), exec::omp), exec::omp);
+///
+/// Why: block-Jacobi PCG needs ~400 iterations per Newton system on the 73k-tet face lattice
+/// (its error in smooth, long-wavelength modes decays slowly); the V-cycle removes those modes on
+/// the coarse levels (benchmarks/bench_physics.cpp compares the two).
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include "../../core/error.hpp"
+#include "../../core/parallel.hpp"
+#include "../../core/types.hpp"
+#include "../../discretize/bcc_lattice.hpp"
+#include "../../discretize/embedding.hpp"
+#include "../../mesh/tet_mesh.hpp"
+#include "../hessian.hpp"
+#include "conjugate_gradient.hpp"
+#include "sparse_ops.hpp"
+
+namespace simsr::physics {
+
+/// Options of lattice_hierarchy.
+struct LatticeHierarchyOptions {
+  double h = 0;                    ///< cell size of the first coarse lattice; 0: 2 × the mesh's mean edge length
+  Index max_coarse_vertices = 1500;  ///< stop coarsening once a level has at most this many vertices
+  int max_levels = 8;              ///< at most this many coarse levels
+};
+
+/// The levels of a multigrid hierarchy: `vertices[0]` is the mesh's, `vertices[ℓ]` (ℓ ≥ 1) those of
+/// the ℓ-th coarse lattice; `prolongations[ℓ]` maps level ℓ+1's DOFs to level ℓ's (scalar,
+/// DOF-level: P(3v+d, 3c+d) = w_vc, the barycentric weight of vertex v on coarse vertex c).
+template <class S = Scalar>
+struct LatticeHierarchy {
+  std::vector<SparseMatrix<S>> prolongations;
+  std::vector<Points<S>> vertices;
+  std::vector<double> cell_sizes;  ///< h of each coarse lattice (cell_sizes[ℓ] for level ℓ+1)
+  Index num_levels() const { return Index(vertices.size()); }
+};
+
+/// BCC lattices of cell size h, 2h, 4h, … covering a tet mesh, and the prolongations between
+/// them (see the file comment and LatticeHierarchy). Stops at `max_coarse_vertices`, at
+/// `max_levels`, or when a level would not shrink below 60 % of the one before. Throws
+/// ArgumentError for an empty mesh or a bad h.
+template <class S>
+LatticeHierarchy<S> lattice_hierarchy(const TetMesh<S>& mesh, const LatticeHierarchyOptions& options = {}) {
+  if (mesh.num_vertices() == 0 || mesh.num_tets() == 0) throw ArgumentError("lattice_hierarchy: the mesh has no tets");
+  double h = options.h;
+  if (h == 0) {
+    double sum = 0;
+    Index count = 0;
+    static constexpr int edges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    for (Index t = 0; t < mesh.num_tets(); ++t)
+      for (const auto& e : edges) sum += double((mesh.V.row(mesh.T(t, e[0])) - mesh.V.row(mesh.T(t, e[1]))).norm()), ++count;
+    h = 2 * sum / double(count);
+  }
+  if (!(h > 0) || !std::isfinite(h)) throw ArgumentError("lattice_hierarchy: cell size h = " + std::to_string(h) + " must be positive and finite");
+
+  LatticeHierarchy<S> out;
+  out.vertices.push_back(mesh.V);
+  TetMesh<S> current = mesh;
+  for (int level = 0; level < options.max_levels && current.num_vertices() > options.max_coarse_vertices; ++level, h *= 2) {
+    const TetMesh<S> lattice = discretize::bcc_lattice(current, h).mesh;
+    const Embedding<S> emb = embed(exec::seq, lattice, current.V);
+    // keep only the lattice vertices some finer vertex uses (with a nonzero weight)
+    std::vector<VIndex> renumber(std::size_t(lattice.num_vertices()), VIndex(-1));
+    Index used = 0;
+    for (Index q = 0; q < emb.size(); ++q)
+      for (int k = 0; k < 4; ++k)
+        if (emb.weights(q, k) != S(0) && renumber[std::size_t(lattice.T(emb.tet[q], k))] < 0)
+          renumber[std::size_t(lattice.T(emb.tet[q], k))] = VIndex(used++);
+    if (double(used) > 0.6 * double(current.num_vertices())) break;
+    std::vector<Eigen::Triplet<S, int>> entries;
+    entries.reserve(std::size_t(emb.size()) * 12);
+    for (Index q = 0; q < emb.size(); ++q)
+      for (int k = 0; k < 4; ++k) {
+        const S w = emb.weights(q, k);
+        if (w == S(0)) continue;
+        const Index c = renumber[std::size_t(lattice.T(emb.tet[q], k))];
+        for (int d = 0; d < 3; ++d) entries.emplace_back(int(3 * q + d), int(3 * c + d), w);
+      }
+    SparseMatrix<S> P(3 * current.num_vertices(), 3 * used);
+    P.setFromTriplets(entries.begin(), entries.end());
+    out.prolongations.push_back(std::move(P));
+    out.cell_sizes.push_back(h);
+    // the next level coarsens the used part of this lattice: its vertices, and the tets that touch them
+    TetMesh<S> next;
+    next.V.resize(used, 3);
+    for (Index v = 0; v < lattice.num_vertices(); ++v)
+      if (renumber[std::size_t(v)] >= 0) next.V.row(renumber[std::size_t(v)]) = lattice.V.row(v);
+    std::vector<Index> keep;
+    for (Index t = 0; t < lattice.num_tets(); ++t) {
+      bool all = true;
+      for (int k = 0; k < 4; ++k) all = all && renumber[std::size_t(lattice.T(t, k))] >= 0;
+      if (all) keep.push_back(t);
+    }
+    next.T.resize(Index(keep.size()), 4);
+    for (std::size_t i = 0; i < keep.size(); ++i)
+      for (int k = 0; k < 4; ++k) next.T(Index(i), k) = renumber[std::size_t(lattice.T(keep[i], k))];
+    out.vertices.push_back(next.V);
+    if (next.num_tets() == 0) break;  // too coarse to go on: the last P stands, its level is the coarsest
+    current = std::move(next);
+  }
+  return out;
+}
+
+/// Options of Multigrid.
+struct MultigridOptions {
+  int smoothing_sweeps = 2;    ///< damped block-Jacobi sweeps before and after each coarse correction
+  double damping = 0;          ///< ω; 0: 4 / (3 λ_max(B⁻¹A)) estimated per level at compute()
+  int power_iterations = 12;   ///< for that estimate
+};
+
+/// The V-cycle preconditioner (see the file comment). Movable; keeps its buffers between calls.
+template <class S = Scalar>
+class Multigrid {
+ public:
+  Multigrid() = default;
+  /// `prolongations[ℓ]` maps level ℓ+1 to level ℓ (lattice_hierarchy). An empty list gives a
+  /// one-level method: a direct solve of A (useful as a check, costly at scale).
+  explicit Multigrid(std::vector<SparseMatrix<S>> prolongations, MultigridOptions options = {}) : options_(options) {
+    if (options.smoothing_sweeps < 1) throw ArgumentError("Multigrid: smoothing_sweeps must be at least 1");
+    if (options.damping < 0 || !(options.damping < 2)) throw ArgumentError("Multigrid: damping must be in [0, 2) (0: automatic)");
+    for (std::size_t l = 0; l < prolongations.size(); ++l) {
+      if (prolongations[l].rows() % 3 || prolongations[l].cols() % 3)
+        throw ShapeError("Multigrid: prolongation " + std::to_string(l) + " (3 DOFs per vertex)", {-1, -1},
+                         {prolongations[l].rows(), prolongations[l].cols()});
+      if (l > 0 && prolongations[l].rows() != prolongations[l - 1].cols())
+        throw ShapeError("Multigrid: prolongation " + std::to_string(l) + " rows (the columns of the one before)",
+                         {prolongations[l - 1].cols(), -1}, {prolongations[l].rows(), prolongations[l].cols()});
+    }
+    levels_.resize(prolongations.size() + 1);
+    for (std::size_t l = 0; l < prolongations.size(); ++l) levels_[l].P_geometric = std::move(prolongations[l]);
+  }
+
+  Index num_levels() const { return Index(levels_.size()); }
+  /// DOFs of level ℓ (after compute()).
+  Index level_size(Index l) const { return Index(levels_.at(std::size_t(l)).b.size()); }
+  /// ω used on level ℓ by the last compute().
+  double damping(Index l) const { return levels_.at(std::size_t(l)).omega; }
+
+  /// Galerkin coarse operators, smoothers and the coarsest factorization for A. The structures
+  /// of the products and the coarsest symbolic factorization are kept while A's pattern stays.
+  /// A coarse operator that is not positive definite (A is not) is a ConvergenceError, the
+  /// signal QuasistaticSolver takes to fall back from the exact to the projected Hessian.
+  template <exec::HostPolicy P>
+  void compute(P policy, const SparseMatrix<S>& A) {
+    if (levels_.empty()) levels_.resize(1);
+    if (A.rows() != A.cols()) throw ShapeError("Multigrid: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
+    if (levels_.size() > 1 && levels_[0].P_geometric.rows() != A.rows())
+      throw ShapeError("Multigrid: matrix (rows of the first prolongation)", {levels_[0].P_geometric.rows(), levels_[0].P_geometric.rows()},
+                       {A.rows(), A.cols()});
+    levels_[0].A_ref = &A;
+    for (std::size_t l = 0; l < levels_.size(); ++l) {
+      Level& L = levels_[l];
+      const SparseMatrix<S>& Al = L.matrix();
+      const Index n = Al.rows();
+      if (L.b.size() != n) {
+        L.b.setZero(n);
+        L.x.setZero(n);
+        L.r.setZero(n);
+        L.t.setZero(n);
+        L.v.resize(0);
+      }
+      if (l + 1 == levels_.size()) {
+        factorize_coarsest(Al, l > 0 ? levels_[l - 1].galerkin.structure_version() : ++direct_version_, l > 0);
+        break;
+      }
+      L.smoother.compute(policy, Al);
+      L.omega = options_.damping > 0 ? options_.damping : 4.0 / (3.0 * lambda_max(policy, L));
+      galerkin(policy, l);
+    }
+  }
+
+  /// z = one V-cycle applied to r (z ≈ A⁻¹ r).
+  template <exec::HostPolicy P>
+  void apply(P policy, const VecX<S>& r, VecX<S>& z) {
+    if (levels_.empty() || levels_[0].b.size() != r.size())
+      throw Error("Multigrid::apply before compute, or with a vector of another size");
+    levels_[0].b = r;
+    cycle(policy, 0);
+    z = levels_[0].x;
+  }
+
+ private:
+  struct Level {
+    SparseMatrix<S> P_geometric;  ///< to this level from the next coarser one (empty on the coarsest)
+    SparseMatrix<S> P, Pt;        ///< P_geometric with Dirichlet rows zeroed, and its transpose
+    std::vector<Index> pt_source;  ///< Pt's entry k is P's entry pt_source[k]
+    SparseProduct<S> ap, galerkin;  ///< A·P, then Pᵀ·(A·P) = the next level's matrix
+    std::vector<char> decoupled;
+    const SparseMatrix<S>* A_ref = nullptr;  ///< the caller's matrix (level 0)
+    const SparseMatrix<S>* A_coarse = nullptr;  ///< the previous level's Galerkin product (levels ≥ 1)
+    BlockJacobi<S> smoother;
+    double omega = 1;
+    VecX<S> b, x, r, t, v;  ///< v: the power iteration's vector, kept as the next compute's start
+    const SparseMatrix<S>& matrix() const { return A_ref ? *A_ref : *A_coarse; }
+  };
+
+  /// A_{l+1} = Pᵀ A_l P with the rows of decoupled (Dirichlet) DOFs of P zeroed.
+  template <exec::HostPolicy P>
+  void galerkin(P policy, std::size_t l) {
+    Level& L = levels_[l];
+    const SparseMatrix<S>& A = L.matrix();
+    if (L.P.nonZeros() != L.P_geometric.nonZeros()) {  // first call: P's structure, Pt and its source map
+      L.P = L.P_geometric;
+      SparseMatrix<S> ids = L.P_geometric;
+      for (Index k = 0; k < ids.nonZeros(); ++k) ids.valuePtr()[k] = S(k);
+      L.Pt = ids.transpose();
+      L.pt_source.resize(std::size_t(L.Pt.nonZeros()));
+      for (Index k = 0; k < L.Pt.nonZeros(); ++k) L.pt_source[std::size_t(k)] = Index(L.Pt.valuePtr()[k]);
+    }
+    decoupled_rows(A, L.decoupled);
+    const S* geo = L.P_geometric.valuePtr();
+    S* pv = L.P.valuePtr();
+    const auto* po = L.P.outerIndexPtr();
+    exec::parallel_for(policy, L.P.rows(), [&](Index r) {
+      for (auto k = po[r]; k < po[r + 1]; ++k) pv[k] = L.decoupled[std::size_t(r)] ? S(0) : geo[k];
+    });
+    S* ptv = L.Pt.valuePtr();
+    exec::parallel_for(policy, L.Pt.nonZeros(), [&](Index k) { ptv[k] = pv[L.pt_source[std::size_t(k)]]; });
+    const SparseMatrix<S>& AP = L.ap.compute(policy, A, L.P);
+    L.galerkin.compute(policy, L.Pt, AP);
+    SparseMatrix<S>& Ac = L.galerkin.result();
+    // a coarse DOF all of whose fine DOFs are fixed has a zero row: make it an identity row
+    for (Index r = 0; r < Ac.rows(); ++r) {
+      S* diag = nullptr;
+      bool zero_row = true;
+      for (typename SparseMatrix<S>::InnerIterator it(Ac, r); it; ++it) {
+        if (it.col() == r) diag = &it.valueRef();
+        zero_row = zero_row && it.value() == S(0);
+      }
+      if (!diag) throw Error("Multigrid: coarse level " + std::to_string(l + 1) + " has no diagonal entry at DOF " + std::to_string(r) +
+                             " (does A store its diagonal?)");
+      if (zero_row) *diag = S(1);
+      else if (!(*diag > S(0)))
+        throw ConvergenceError("Multigrid: coarse level " + std::to_string(l + 1) + " has a non-positive diagonal at DOF " +
+                                   std::to_string(r) + ": A is not positive definite",
+                               0, std::numeric_limits<double>::quiet_NaN());
+    }
+    levels_[l + 1].A_coarse = &Ac;
+  }
+
+  /// Sparse LDLᵀ of the coarsest matrix; the symbolic analysis only when its structure changed.
+  /// Near the mesh's boundary a coarse vertex can be used by a single fine vertex, so P's columns
+  /// can be linearly dependent and PᵀAP only semidefinite: the factorization gets a diagonal shift
+  /// of 1e-10 × the largest diagonal entry (none when A itself is the coarsest level). Directions in P's null space never reach the fine
+  /// level (P maps them to 0), so the shift changes nothing else; an indefinite A still shows up
+  /// as a negative pivot.
+  void factorize_coarsest(const SparseMatrix<S>& A, std::uint64_t structure, bool galerkin_level) {
+    coarse_matrix_ = A;
+    if (!coarse_solver_ || structure != coarse_structure_) {
+      coarse_solver_ = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>>>();
+      coarse_solver_->analyzePattern(coarse_matrix_);
+      coarse_structure_ = structure;
+    }
+    coarse_solver_->setShift(galerkin_level ? S(1e-10) * coarse_matrix_.diagonal().cwiseAbs().maxCoeff() : S(0));
+    coarse_solver_->factorize(coarse_matrix_);
+    if (coarse_solver_->info() != Eigen::Success || !(coarse_solver_->vectorD().array() > S(0)).all())
+      throw ConvergenceError("Multigrid: the coarsest level (" + std::to_string(A.rows()) + " DOFs) is not positive definite, so neither is A",
+                             0, std::numeric_limits<double>::quiet_NaN());
+  }
+
+  /// Rows whose off-diagonal entries are all zero (the identity rows of Dirichlet DOFs).
+  static void decoupled_rows(const SparseMatrix<S>& A, std::vector<char>& out) {
+    out.assign(std::size_t(A.rows()), 1);
+    for (Index r = 0; r < A.rows(); ++r)
+      for (typename SparseMatrix<S>::InnerIterator it(A, r); it; ++it)
+        if (it.col() != r && it.value() != S(0)) {
+          out[std::size_t(r)] = 0;
+          break;
+        }
+  }
+
+  /// λ_max(B⁻¹A) by power iteration (B⁻¹A is self-adjoint in the B inner product). The first
+  /// compute starts from a fixed vector and runs `power_iterations`; later ones start from the
+  /// last vector (the Hessian changes little between Newton iterations) and run a third as many.
+  template <exec::HostPolicy P>
+  double lambda_max(P policy, Level& L) {
+    const SparseMatrix<S>& A = L.matrix();
+    VecX<S>& v = L.v;
+    VecX<S>& w = L.t;
+    int iterations = std::max(1, options_.power_iterations / 3);
+    if (v.size() != A.rows()) {
+      v.resize(A.rows());
+      for (Index i = 0; i < v.size(); ++i) v[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
+      iterations = options_.power_iterations;
+    }
+    double lambda = 1;
+    for (int k = 0; k < iterations; ++k) {
+      sparse_multiply(policy, A, v, w);
+      L.smoother.apply(policy, w, L.r);  // r = B⁻¹ A v
+      const double num = double(dot(policy, v, w));                          // vᵀ A v
+      const double den = double(dot(policy, v, smoother_b(policy, L, v)));  // vᵀ B v
+      if (den > 0) lambda = std::max(lambda, num / den);
+      const S norm = std::sqrt(dot(policy, L.r, L.r));
+      if (!(norm > S(0))) break;
+      v = L.r / norm;
+    }
+    // a Rayleigh quotient is a lower bound of λ_max: pad it so ω·λ_max stays well below 2
+    return std::max(1.0, 1.1 * lambda);
+  }
+
+  /// B v for the block diagonal B (used by the Rayleigh quotient); written into L.b.
+  template <exec::HostPolicy P>
+  const VecX<S>& smoother_b(P policy, Level& L, const VecX<S>& v) {
+    const SparseMatrix<S>& A = L.matrix();
+    const auto* outer = A.outerIndexPtr();
+    const auto* inner = A.innerIndexPtr();
+    const S* val = A.valuePtr();
+    exec::parallel_for(policy, A.rows(), [&](Index row) {
+      const Index block = row / 3;
+      S s = 0;
+      for (auto k = outer[row]; k < outer[row + 1]; ++k)
+        if (Index(inner[k]) / 3 == block) s += val[k] * v[inner[k]];
+      L.b[row] = s;
+    });
+    return L.b;
+  }
+
+  /// One V-cycle from level l: x_l ≈ A_l⁻¹ b_l, starting from x_l = 0.
+  template <exec::HostPolicy P>
+  void cycle(P policy, std::size_t l) {
+    Level& L = levels_[l];
+    if (l + 1 == levels_.size()) {
+      L.x = coarse_solver_->solve(L.b);
+      return;
+    }
+    const SparseMatrix<S>& A = L.matrix();
+    L.x.setZero();
+    auto smooth = [&](bool first) {
+      if (first)
+        L.r = L.b;
+      else
+        residual(policy, A, L);
+      L.smoother.apply(policy, L.r, L.t);
+      const S w = S(L.omega);
+      exec::parallel_for(policy, L.x.size(), [&](Index i) { L.x[i] += w * L.t[i]; });
+    };
+    for (int s = 0; s < options_.smoothing_sweeps; ++s) smooth(s == 0);
+    residual(policy, A, L);
+    Level& C = levels_[l + 1];
+    sparse_multiply(policy, L.Pt, L.r, C.b);
+    cycle(policy, l + 1);
+    sparse_multiply(policy, L.P, C.x, L.t);
+    exec::parallel_for(policy, L.x.size(), [&](Index i) { L.x[i] += L.t[i]; });
+    for (int s = 0; s < options_.smoothing_sweeps; ++s) smooth(false);
+  }
+
+  /// L.r = L.b − A L.x
+  template <exec::HostPolicy P>
+  static void residual(P policy, const SparseMatrix<S>& A, Level& L) {
+    sparse_multiply(policy, A, L.x, L.r);
+    exec::parallel_for(policy, L.r.size(), [&](Index i) { L.r[i] = L.b[i] - L.r[i]; });
+  }
+
+  MultigridOptions options_;
+  std::vector<Level> levels_;
+  std::uint64_t coarse_structure_ = 0, direct_version_ = 0;
+  Eigen::SparseMatrix<S, Eigen::ColMajor, int> coarse_matrix_;
+  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>>> coarse_solver_;
+};
+
+}  // namespace simsr::physics
