@@ -55,7 +55,7 @@ namespace simsr::physics {
 /// Options of lattice_hierarchy.
 struct LatticeHierarchyOptions {
   double h = 0;                    ///< cell size of the first coarse lattice; 0: 2 × the mesh's mean edge length
-  Index max_coarse_vertices = 1500;  ///< stop coarsening once a level has at most this many vertices
+  Index max_coarse_vertices = 400;   ///< stop coarsening once a level has at most this many vertices
   int max_levels = 8;              ///< at most this many coarse levels
 };
 
@@ -138,9 +138,10 @@ LatticeHierarchy<S> lattice_hierarchy(const TetMesh<S>& mesh, const LatticeHiera
 
 /// Options of Multigrid.
 struct MultigridOptions {
-  int smoothing_sweeps = 2;    ///< damped block-Jacobi sweeps before and after each coarse correction
+  int smoothing_sweeps = 1;    ///< damped block-Jacobi sweeps before and after each coarse correction
   double damping = 0;          ///< ω; 0: 4 / (3 λ_max(B⁻¹A)) estimated per level at compute()
-  int power_iterations = 12;   ///< for that estimate
+  int power_iterations = 12;   ///< for that estimate, at the first compute()
+  int warm_power_iterations = 2;  ///< at later ones, started from the last estimate's vector
 };
 
 /// The V-cycle preconditioner (see the file comment). Movable; keeps its buffers between calls.
@@ -152,6 +153,8 @@ class Multigrid {
   /// one-level method: a direct solve of A (useful as a check, costly at scale).
   explicit Multigrid(std::vector<SparseMatrix<S>> prolongations, MultigridOptions options = {}) : options_(options) {
     if (options.smoothing_sweeps < 1) throw ArgumentError("Multigrid: smoothing_sweeps must be at least 1");
+    if (options.power_iterations < 1 || options.warm_power_iterations < 1)
+      throw ArgumentError("Multigrid: power_iterations and warm_power_iterations must be at least 1");
     if (options.damping < 0 || !(options.damping < 2)) throw ArgumentError("Multigrid: damping must be in [0, 2) (0: automatic)");
     for (std::size_t l = 0; l < prolongations.size(); ++l) {
       if (prolongations[l].rows() % 3 || prolongations[l].cols() % 3)
@@ -306,13 +309,14 @@ class Multigrid {
 
   /// λ_max(B⁻¹A) by power iteration (B⁻¹A is self-adjoint in the B inner product). The first
   /// compute starts from a fixed vector and runs `power_iterations`; later ones start from the
-  /// last vector (the Hessian changes little between Newton iterations) and run a third as many.
+  /// last vector (the Hessian changes little between Newton iterations) and run
+  /// `warm_power_iterations`.
   template <exec::HostPolicy P>
   double lambda_max(P policy, Level& L) {
     const SparseMatrix<S>& A = L.matrix();
     VecX<S>& v = L.v;
     VecX<S>& w = L.t;
-    int iterations = std::max(1, options_.power_iterations / 3);
+    int iterations = options_.warm_power_iterations;
     if (v.size() != A.rows()) {
       v.resize(A.rows());
       for (Index i = 0; i < v.size(); ++i) v[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
