@@ -258,13 +258,8 @@ const LatticeHierarchy<>& hierarchy() {
 }
 
 template <class Linear>
-constexpr bool uses_multigrid = false;
-template <class P>
-constexpr bool uses_multigrid<ConjugateGradient<Multigrid<>, P>> = true;
-
-template <class Linear>
 Linear make_linear() {
-  if constexpr (uses_multigrid<Linear>)
+  if constexpr (is_multigrid_pcg<Linear>)
     return Linear(ConjugateGradientOptions{.tolerance = kCgTolerance}, Multigrid<>(hierarchy().prolongations));
   else if constexpr (requires { Linear(ConjugateGradientOptions{}); })
     return Linear(ConjugateGradientOptions{.tolerance = kCgTolerance});

@@ -30,6 +30,7 @@ template <class Policy>
 CantileverResult solve_with(const std::string& solver, const CantileverOptions& o, Policy policy) {
   if (solver == "cholesky") return solve_cantilever<SparseCholesky<>, Policy>(o, policy);
   if (solver == "pcg-jacobi") return solve_cantilever<ConjugateGradient<Jacobi<>, Policy>, Policy>(o, policy);
+  if (solver == "pcg-multigrid") return solve_cantilever<ConjugateGradient<Multigrid<>, Policy>, Policy>(o, policy);
   return solve_cantilever<ConjugateGradient<BlockJacobi<>, Policy>, Policy>(o, policy);
 }
 
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::PositiveNumber);
   app.add_flag("--embedded", embedded, "BCC embedded lattice instead of the conforming box mesh");
   app.add_option("--solver", solver, "linear solver")->capture_default_str()
-      ->check(CLI::IsMember({"cholesky", "pcg-jacobi", "pcg-block-jacobi"}));
+      ->check(CLI::IsMember({"cholesky", "pcg-jacobi", "pcg-block-jacobi", "pcg-multigrid"}));
   app.add_flag("--omp", omp, "assemble (and run PCG) with OpenMP threads");
   app.add_flag("--progress", progress, "print each Newton iteration on stderr");
   app.add_option("--vtu", vtu, "write the deformed beam (point data: displacement; cell data: volume ratio J) for ParaView");

@@ -47,6 +47,8 @@ finer = result("--cells", "4", "--solver", "pcg-block-jacobi", "--omp")
 check(finer["relative_error"] < coarse["relative_error"] / 2, f"refinement: {coarse['relative_error']} → {finer['relative_error']}")
 same = result("--cells", "4", "--solver", "pcg-jacobi")
 check(abs(same["tip_deflection"] - finer["tip_deflection"]) < 1e-6 * eb, "PCG-Jacobi and PCG-block-Jacobi agree")
+mg = result("--cells", "4", "--solver", "pcg-multigrid", "--omp")
+check(abs(mg["tip_deflection"] - finer["tip_deflection"]) < 1e-6 * eb and mg["solver"] == "pcg-multigrid", "PCG-multigrid agrees")
 
 vtu = os.path.join(tempfile.mkdtemp(), "beam.vtu")
 embedded = result("--cells", "2", "--embedded", "--vtu", vtu)

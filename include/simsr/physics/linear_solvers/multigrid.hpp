@@ -397,4 +397,23 @@ class Multigrid {
   std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>>> coarse_solver_;
 };
 
+/// Whether a linear solver is PCG preconditioned by Multigrid (it needs the mesh to be built:
+/// see make_linear_solver).
+template <class L>
+inline constexpr bool is_multigrid_pcg = false;
+template <class S, exec::HostPolicy P>
+inline constexpr bool is_multigrid_pcg<ConjugateGradient<Multigrid<S>, P, S>> = true;
+
+/// A linear solver for Newton on `mesh`: Linear{} (with `options` where Linear is a
+/// ConjugateGradient), or, for PCG with Multigrid, one with the mesh's lattice hierarchy.
+template <LinearSolver Linear, class S>
+Linear make_linear_solver(const TetMesh<S>& mesh, const ConjugateGradientOptions& options = {}, const LatticeHierarchyOptions& levels = {}) {
+  if constexpr (is_multigrid_pcg<Linear>)
+    return Linear(options, Multigrid<typename Linear::scalar_type>(lattice_hierarchy(mesh, levels).prolongations));
+  else if constexpr (requires { Linear(options); })
+    return Linear(options);
+  else
+    return Linear{};
+}
+
 }  // namespace simsr::physics

@@ -20,6 +20,7 @@
 #include "../forces/bone_attachment.hpp"
 #include "../forces/gravity.hpp"
 #include "../materials/neo_hookean.hpp"
+#include "../linear_solvers/multigrid.hpp"
 #include "../quasistatic.hpp"
 
 namespace simsr::physics {
@@ -63,7 +64,7 @@ inline double euler_bernoulli_tip_deflection(const CantileverOptions& o) {
   return q * std::pow(o.length, 4) / (8 * o.young * I);
 }
 
-/// Builds, solves (Newton + sparse Cholesky, from rest) and measures the beam.
+/// Builds, solves (Newton from rest; sparse Cholesky unless Linear says otherwise) and measures the beam.
 template <LinearSolver Linear = SparseCholesky<Scalar>, exec::HostPolicy Policy = exec::seq_t>
 CantileverResult solve_cantilever(const CantileverOptions& o, Policy policy = {}) {
   if (o.cells_through_height < 1) throw ArgumentError("solve_cantilever: cells_through_height must be ≥ 1");
@@ -91,7 +92,7 @@ CantileverResult solve_cantilever(const CantileverOptions& o, Policy policy = {}
   for (Index k = 0; k < tip.size(); ++k) tip_rest.row(k) = box.V.row(tip[k]);
   const auto emb = embed(mesh, tip_rest);
 
-  QuasistaticSolver<Linear, Policy> newton(mesh.num_vertices(), mesh.T, o.newton, Linear{}, policy);
+  QuasistaticSolver<Linear, Policy> newton(mesh.num_vertices(), mesh.T, o.newton, make_linear_solver<Linear>(mesh), policy);
   Points<> x = mesh.V;
   const NewtonReport rep = newton.solve(x, clamp.boundary(), elastic, gravity);
   const Points<> tip_now = deform(emb, mesh.T, x);
