@@ -33,7 +33,8 @@
 //       and gradient under exec::omp), pcg_jacobi, pcg_block_jacobi, pcg_ichol (ConjugateGradient
 //       with relative tolerance kCgTolerance, products/dots under the policy; incomplete Cholesky
 //       is Eigen's, sequential setup and triangular solves). Counters:
-//       newton_iterations, linear_iterations (PCG iterations summed over the frame), fps.
+//       newton_iterations, linear_iterations (PCG iterations summed over the frame), projected
+//       (Newton iterations whose exact Hessian was not positive definite: assembled twice), fps.
 //   BM_kernel_73k/energy+gradient/<policy>   E(x) and ∂E/∂x of the elastic energy
 //   BM_kernel_73k/hessian/<policy>           projected element Hessians (Newton tries the exact
 //       one first; same cost: both go through the signed SVD) gathered into the
@@ -300,6 +301,7 @@ void BM_frame(benchmark::State& state) {
   scene_counters(state);
   state.counters["newton_iterations"] = double(report.iterations);
   state.counters["linear_iterations"] = double(report.linear_iterations);
+  state.counters["projected"] = double(std::count_if(report.history.begin(), report.history.end(), [](const NewtonIteration& it) { return it.projected; }));
   state.counters["fps"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
 }
 
