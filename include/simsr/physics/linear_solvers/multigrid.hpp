@@ -115,7 +115,7 @@ LatticeHierarchy<S> lattice_hierarchy(const TetMesh<S>& mesh, const LatticeHiera
     P.setFromTriplets(entries.begin(), entries.end());
     out.prolongations.push_back(std::move(P));
     out.cell_sizes.push_back(h);
-    // the next level coarsens the used part of this lattice: its vertices, and the tets that touch them
+    // the next level coarsens the used part of this lattice: its used vertices, and the tets made of them only
     TetMesh<S> next;
     next.V.resize(used, 3);
     for (Index v = 0; v < lattice.num_vertices(); ++v)
