@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// Preconditioned conjugate gradients under an execution policy, with Jacobi (1/A_ii),
-/// block-Jacobi (the inverse 3×3 vertex blocks) or Multigrid (multigrid.hpp) preconditioning. Products and dot products run
-/// under the policy with fixed chunking, so seq and omp iterate identically.
+/// block-Jacobi (the inverse 3×3 vertex blocks), incomplete Cholesky or Multigrid (multigrid.hpp)
+/// preconditioning. Products and dot products run under the policy with fixed chunking, so seq
+/// and omp iterate identically.
 ///
 ///     physics::ConjugateGradient<physics::BlockJacobi<>, exec::omp_t> pcg({.tolerance = 1e-6});
 

@@ -19,8 +19,8 @@
 #include "../elastic_energy.hpp"
 #include "../forces/bone_attachment.hpp"
 #include "../forces/gravity.hpp"
-#include "../materials/neo_hookean.hpp"
 #include "../linear_solvers/multigrid.hpp"
+#include "../materials/neo_hookean.hpp"
 #include "../quasistatic.hpp"
 
 namespace simsr::physics {
