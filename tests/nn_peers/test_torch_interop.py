@@ -16,8 +16,8 @@ scripts/torch_to_simsr.py, loads into simsr and gives PyTorch's outputs.
             two float32 summation orders differ there; observed worst 2e-3 to 8e-3, varying with
             torch's own run-to-run reduction order), post-Adam weights within
             2·lr + 1e-5·max|w| absolute (Adam's first step is ~lr·sign(g), a noise-level g may
-            flip its sign, and the weights themselves round at float32: CI once saw a flipped
-            step exceed a bare 2·lr·(1 + 1e-3)), BatchNorm running statistics within 1e-5;
+            flip its sign, and the weights themselves round at float32: runs here measured
+            0.99-1.00 of a bare 2·lr·(1 + 1e-3)), BatchNorm running statistics within 1e-5;
    float64: everything, gradients and post-Adam weights included, within 1e-5.
 5. With SIMSR_EXE: `simsr infer --model MODEL.npz` on the exported frames gives PyTorch's HR
    positions (rest + σ·prediction) within 1e-5 of the largest displacement.
@@ -112,6 +112,7 @@ def main():
             print("FAIL %s (details in %s):" % (dtype, os.path.join(work, "interop_%s.json" % dtype)))
             for name in rep.get("failed", []):
                 print("     %s: %s" % (name, json.dumps(lookup(rep, name))))
+            failures[-1] += " (" + ", ".join(rep.get("failed", [])) + ")"
         else:
             print("ok   %s" % dtype)
     if len(sys.argv) > 4 and os.path.exists(sys.argv[4]):
@@ -136,6 +137,8 @@ def main():
                 "ok  " if ok else "FAIL", rel, p.stdout.strip()))
             if not ok:
                 failures.append("simsr infer")
+    if failures:  # last, so a log cut in the middle still shows it
+        print("FAILED: " + "; ".join(failures))
     return 1 if failures else 0
 
 
