@@ -239,11 +239,13 @@ class Multigrid {
     const SparseMatrix<S>& A = L.matrix();
     if (L.P.nonZeros() != L.P_geometric.nonZeros()) {  // first call: P's structure, Pt and its source map
       L.P = L.P_geometric;
-      SparseMatrix<S> ids = L.P_geometric;
-      for (Index k = 0; k < ids.nonZeros(); ++k) ids.valuePtr()[k] = S(k);
-      L.Pt = ids.transpose();
-      L.pt_source.resize(std::size_t(L.Pt.nonZeros()));
-      for (Index k = 0; k < L.Pt.nonZeros(); ++k) L.pt_source[std::size_t(k)] = Index(L.Pt.valuePtr()[k]);
+      L.Pt = L.P_geometric.transpose();
+      // entry numbers carried through the same transpose (in double: exact for any S)
+      Eigen::SparseMatrix<double, Eigen::RowMajor, int> ids = L.P_geometric.template cast<double>();
+      for (Index k = 0; k < ids.nonZeros(); ++k) ids.valuePtr()[k] = double(k);
+      const Eigen::SparseMatrix<double, Eigen::RowMajor, int> ids_t = ids.transpose();
+      L.pt_source.resize(std::size_t(ids_t.nonZeros()));
+      for (Index k = 0; k < ids_t.nonZeros(); ++k) L.pt_source[std::size_t(k)] = Index(ids_t.valuePtr()[k]);
     }
     decoupled_rows(A, L.decoupled);
     const S* geo = L.P_geometric.valuePtr();
