@@ -244,28 +244,22 @@ void scene_counters(benchmark::State& state) {
   state.counters["h_mm"] = 1e3 * s.h;
 }
 
-/// The multigrid levels of the scene's lattice (built once per mesh, like the gather lists: not
-/// timed; the time it takes is printed).
-const LatticeHierarchy<>& hierarchy() {
-  static const LatticeHierarchy<> levels = [] {
-    const auto t0 = std::chrono::steady_clock::now();
-    LatticeHierarchy<> out = lattice_hierarchy(scene().mesh);
-    std::fprintf(stderr, "multigrid levels:");
-    for (Index l = 0; l < out.num_levels(); ++l) std::fprintf(stderr, " %lld", (long long)out.vertices[std::size_t(l)].rows());
-    std::fprintf(stderr, " vertices (built in %.2f s)\n", seconds_since(t0));
-    return out;
-  }();
-  return levels;
-}
-
+/// The case's linear solver, built for the scene's mesh (PCG + multigrid builds its lattice
+/// levels here, once per mesh like the gather lists: not timed).
 template <class Linear>
 Linear make_linear() {
-  if constexpr (is_multigrid_pcg<Linear>)
-    return Linear(ConjugateGradientOptions{.tolerance = kCgTolerance}, Multigrid<>(hierarchy().prolongations));
-  else if constexpr (requires { Linear(ConjugateGradientOptions{}); })
-    return Linear(ConjugateGradientOptions{.tolerance = kCgTolerance});
-  else
-    return Linear{};
+  return make_linear_solver<Linear>(scene().mesh, {.tolerance = kCgTolerance});
+}
+
+/// The multigrid levels' sizes as counters (vertices of level 1 and of the coarsest level).
+template <class Linear>
+void multigrid_counters(benchmark::State& state, Linear& linear) {
+  if constexpr (is_multigrid_pcg<Linear>) {
+    const auto& mg = linear.preconditioner();
+    state.counters["mg_levels"] = double(mg.num_levels());
+    if (mg.num_levels() > 1) state.counters["mg_level1_vertices"] = double(mg.level_size(1) / 3);
+    state.counters["mg_coarsest_vertices"] = double(mg.level_size(mg.num_levels() - 1) / 3);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -303,6 +297,7 @@ void BM_frame(benchmark::State& state) {
   state.counters["linear_iterations"] = double(report.linear_iterations);
   state.counters["projected"] = double(std::count_if(report.history.begin(), report.history.end(), [](const NewtonIteration& it) { return it.projected; }));
   state.counters["fps"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
+  multigrid_counters(state, newton.linear_solver());
 }
 
 using Cholesky = SparseCholesky<>;
@@ -451,6 +446,7 @@ void BM_linear(benchmark::State& state) {
   state.counters["nnz"] = double(sys.A.nonZeros());
   state.counters["linear_iterations"] = double(info.iterations);
   state.counters["rel_residual"] = info.relative_residual;
+  multigrid_counters(state, linear);
 }
 BENCHMARK_TEMPLATE(BM_linear, Cholesky, false)->Name("BM_linear_73k/cholesky")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK_TEMPLATE(BM_linear, Cholesky, true)->Name("BM_linear_73k/cholesky_symbolic")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);

@@ -7,40 +7,20 @@
 #include <Eigen/Dense>
 #include <random>
 
-#include "stvk_material.hpp"
+#include "stiffness_system.hpp"
 
 using namespace simsr;
 using namespace simsr::physics;
 
 namespace {
 
-/// An SPD system from a real stiffness matrix: a StVK block at rest with its x = 0 face fixed.
-struct System {
-  BlockHessian<> H;
-  std::vector<char> fixed;
-  VecX<> b;
-};
-
-System make_system(unsigned seed) {
-  const auto mesh = box_tet_mesh<double>(4, 2, 2, Vec3<>(0, 0, 0), Vec3<>(2, 1, 1));
-  ElasticEnergy<simsr_test::StVK> E(mesh, {1.0, 2.0});
-  System s{BlockHessian<>(mesh.num_vertices(), mesh.T), std::vector<char>(std::size_t(3 * mesh.num_vertices()), 0), {}};
-  s.H.set_zero();
-  E.add_hessian(mesh.V, s.H);
-  for (Index v = 0; v < mesh.num_vertices(); ++v)
-    if (mesh.V(v, 0) == 0.0)
-      for (int c = 0; c < 3; ++c) s.fixed[std::size_t(3 * v + c)] = 1;
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> N;
-  s.b.resize(3 * mesh.num_vertices());
-  for (Index i = 0; i < s.b.size(); ++i) s.b[i] = s.fixed[std::size_t(i)] ? 0.0 : N(rng);
-  return s;
-}
+/// An SPD system from a real stiffness matrix: a 4×2×2-cell StVK beam with its x = 0 end fixed.
+simsr_test::StiffnessSystem make_system(unsigned seed) { return simsr_test::stiffness_system(4, 2, seed); }
 
 template <class L>
 void check_solver(L solver, double tol) {
   for (unsigned seed = 1; seed <= 4; ++seed) {
-    System s = make_system(seed);
+    auto s = make_system(seed);
     const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
     const Eigen::MatrixXd Ad(A);
     const VecX<> ref = Ad.ldlt().solve(s.b);
@@ -71,7 +51,7 @@ TEST_CASE("SparseCholesky and PCG (Jacobi, block-Jacobi; seq, omp) solve stiffne
 }
 
 TEST_CASE("PCG: block-Jacobi needs no more iterations than Jacobi, incomplete Cholesky fewer still; seq and omp iterate identically") {
-  System s = make_system(9);
+  auto s = make_system(9);
   const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
   ConjugateGradient<Jacobi<>, exec::seq_t> jac({.tolerance = 1e-8});
   ConjugateGradient<BlockJacobi<>, exec::seq_t> blk({.tolerance = 1e-8});
@@ -93,7 +73,7 @@ TEST_CASE("PCG: block-Jacobi needs no more iterations than Jacobi, incomplete Ch
 }
 
 TEST_CASE("PCG reports non-convergence; Cholesky of a singular matrix is a ConvergenceError; b = 0 gives x = 0") {
-  System s = make_system(3);
+  auto s = make_system(3);
   const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
   ConjugateGradient<Jacobi<>, exec::seq_t> pcg({.tolerance = 1e-12, .max_iterations = 3});
   pcg.compute(A);

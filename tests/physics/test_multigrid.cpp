@@ -12,40 +12,12 @@
 #include <Eigen/Dense>
 #include <random>
 
-#include "stvk_material.hpp"
+#include "stiffness_system.hpp"
 
 using namespace simsr;
 using namespace simsr::physics;
 
-namespace {
-
-/// A beam's stiffness matrix (StVK at rest), its x = 0 end fixed, and a random load on the free DOFs.
-struct Beam {
-  TetMesh<double> mesh;
-  BlockHessian<> H;
-  std::vector<char> fixed;
-  VecX<> b;
-  const SparseMatrix<>& A() { return H.assemble(exec::seq, fixed); }
-};
-
-Beam make_beam(Index nx, Index ny, unsigned seed) {
-  Beam s{box_tet_mesh<double>(nx, ny, ny, Vec3<>(0, 0, 0), Vec3<>(double(nx) / double(ny), 1, 1)), {}, {}, {}};
-  ElasticEnergy<simsr_test::StVK> E(s.mesh, {1.0, 2.0});
-  s.H = BlockHessian<>(s.mesh.num_vertices(), s.mesh.T);
-  s.H.set_zero();
-  E.add_hessian(s.mesh.V, s.H);
-  s.fixed.assign(std::size_t(3 * s.mesh.num_vertices()), 0);
-  for (Index v = 0; v < s.mesh.num_vertices(); ++v)
-    if (s.mesh.V(v, 0) == 0.0)
-      for (int c = 0; c < 3; ++c) s.fixed[std::size_t(3 * v + c)] = 1;
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> N;
-  s.b.resize(3 * s.mesh.num_vertices());
-  for (Index i = 0; i < s.b.size(); ++i) s.b[i] = s.fixed[std::size_t(i)] ? 0.0 : N(rng);
-  return s;
-}
-
-}  // namespace
+using simsr_test::stiffness_system;
 
 TEST_CASE("lattice_hierarchy: levels shrink, weights sum to 1 and reproduce affine fields exactly") {
   for (const bool lattice_mesh : {false, true}) {
@@ -84,7 +56,7 @@ TEST_CASE("lattice_hierarchy: levels shrink, weights sum to 1 and reproduce affi
 }
 
 TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG's requirement); seq == omp bitwise") {
-  Beam s = make_beam(16, 4, 3);
+  auto s = stiffness_system(16, 4, 3);
   const SparseMatrix<>& A = s.A();
   Multigrid<> mg(lattice_hierarchy(s.mesh, {.max_coarse_vertices = 40}).prolongations);
   mg.compute(exec::seq, A);
@@ -118,7 +90,7 @@ TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG
 
 TEST_CASE("PCG + multigrid solves stiffness systems like a dense LDLT, in far fewer iterations than block-Jacobi") {
   for (unsigned seed = 1; seed <= 3; ++seed) {
-    Beam s = make_beam(24, 4, seed);
+    auto s = stiffness_system(24, 4, seed);
     const SparseMatrix<>& A = s.A();
     const Eigen::MatrixXd Ad(A);
     const VecX<> ref = Ad.ldlt().solve(s.b);
@@ -137,7 +109,7 @@ TEST_CASE("PCG + multigrid solves stiffness systems like a dense LDLT, in far fe
     MESSAGE("beam 24x4x4, seed ", seed, ": PCG iterations multigrid ", i_mg.iterations, ", block-Jacobi ", i_bj.iterations);
   }
   // no coarse level: the "V-cycle" is the exact solve, PCG converges in one iteration
-  Beam s = make_beam(4, 2, 5);
+  auto s = stiffness_system(4, 2, 5);
   ConjugateGradient<Multigrid<>, exec::seq_t> direct({.tolerance = 1e-10}, Multigrid<>(std::vector<SparseMatrix<>>{}));
   direct.compute(s.A());
   VecX<> x;
@@ -167,7 +139,7 @@ TEST_CASE("Newton with multigrid PCG reaches Cholesky's equilibrium (hanging neo
 }
 
 TEST_CASE("Multigrid: bad input is a typed error") {
-  Beam s = make_beam(8, 2, 1);
+  auto s = stiffness_system(8, 2, 1);
   auto P = lattice_hierarchy(s.mesh, {.max_coarse_vertices = 10}).prolongations;
   REQUIRE(P.size() >= 1);
   CHECK_THROWS_AS(Multigrid<>(P, {.smoothing_sweeps = 0}), ArgumentError);
@@ -180,7 +152,7 @@ TEST_CASE("Multigrid: bad input is a typed error") {
   Multigrid<> mg(P);
   VecX<> z;
   CHECK_THROWS_AS(mg.apply(exec::seq, s.b, z), Error);
-  Beam other = make_beam(4, 2, 1);
+  auto other = stiffness_system(4, 2, 1);
   CHECK_THROWS_AS(mg.compute(exec::seq, other.A()), ShapeError);
   // an indefinite matrix is the ConvergenceError QuasistaticSolver takes as "project the Hessian"
   SparseMatrix<> negative = -s.A();

@@ -31,13 +31,12 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
 #include "../../core/error.hpp"
@@ -48,6 +47,7 @@
 #include "../../mesh/tet_mesh.hpp"
 #include "../hessian.hpp"
 #include "conjugate_gradient.hpp"
+#include "sparse_cholesky.hpp"
 #include "sparse_ops.hpp"
 
 namespace simsr::physics {
@@ -66,7 +66,6 @@ template <class S = Scalar>
 struct LatticeHierarchy {
   std::vector<SparseMatrix<S>> prolongations;
   std::vector<Points<S>> vertices;
-  std::vector<double> cell_sizes;  ///< h of each coarse lattice (cell_sizes[ℓ] for level ℓ+1)
   Index num_levels() const { return Index(vertices.size()); }
 };
 
@@ -114,7 +113,6 @@ LatticeHierarchy<S> lattice_hierarchy(const TetMesh<S>& mesh, const LatticeHiera
     SparseMatrix<S> P(3 * current.num_vertices(), 3 * used);
     P.setFromTriplets(entries.begin(), entries.end());
     out.prolongations.push_back(std::move(P));
-    out.cell_sizes.push_back(h);
     // the next level coarsens the used part of this lattice: its used vertices, and the tets made of them only
     TetMesh<S> next;
     next.V.resize(used, 3);
@@ -198,7 +196,7 @@ class Multigrid {
         L.v.resize(0);
       }
       if (l + 1 == levels_.size()) {
-        factorize_coarsest(Al, l > 0 ? levels_[l - 1].galerkin.structure_version() : ++direct_version_, l > 0);
+        factorize_coarsest(Al, l > 0 ? levels_[l - 1].galerkin.structure_version() : ++direct_version_);
         break;
       }
       L.smoother.compute(policy, Al);
@@ -247,7 +245,7 @@ class Multigrid {
       L.pt_source.resize(std::size_t(ids_t.nonZeros()));
       for (Index k = 0; k < ids_t.nonZeros(); ++k) L.pt_source[std::size_t(k)] = Index(ids_t.valuePtr()[k]);
     }
-    decoupled_rows(A, L.decoupled);
+    decoupled_rows(policy, A, L.decoupled);
     const S* geo = L.P_geometric.valuePtr();
     S* pv = L.P.valuePtr();
     const auto* po = L.P.outerIndexPtr();
@@ -278,82 +276,58 @@ class Multigrid {
     levels_[l + 1].A_coarse = &Ac;
   }
 
-  /// Sparse LDLᵀ of the coarsest matrix; the symbolic analysis only when its structure changed.
-  /// Near the mesh's boundary a coarse vertex can be used by a single fine vertex, so P's columns
-  /// can be linearly dependent and PᵀAP only semidefinite: the factorization gets a diagonal shift
-  /// of 1e-10 × the largest diagonal entry (none when A itself is the coarsest level). Directions in P's null space never reach the fine
-  /// level (P maps them to 0), so the shift changes nothing else; an indefinite A still shows up
-  /// as a negative pivot.
-  void factorize_coarsest(const SparseMatrix<S>& A, std::uint64_t structure, bool galerkin_level) {
-    coarse_matrix_ = A;
-    if (!coarse_solver_ || structure != coarse_structure_) {
-      coarse_solver_ = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>>>();
-      coarse_solver_->analyzePattern(coarse_matrix_);
-      coarse_structure_ = structure;
-    }
-    coarse_solver_->setShift(galerkin_level ? S(1e-10) * coarse_matrix_.diagonal().cwiseAbs().maxCoeff() : S(0));
-    coarse_solver_->factorize(coarse_matrix_);
-    if (coarse_solver_->info() != Eigen::Success || !(coarse_solver_->vectorD().array() > S(0)).all())
+  /// Sparse LDLᵀ of the coarsest matrix (SparseCholesky: the symbolic analysis only when its
+  /// structure changed). Near the mesh's boundary a coarse vertex can be used by a single fine
+  /// vertex, so P's columns can be linearly dependent and PᵀAP only semidefinite: Galerkin levels
+  /// are factorized with a diagonal shift of 1e-10 × the largest diagonal entry. Directions in P's
+  /// null space never reach the fine level (P maps them to 0), so the shift changes nothing else;
+  /// an indefinite A still shows up as a negative pivot.
+  void factorize_coarsest(const SparseMatrix<S>& A, std::uint64_t structure) {
+    if (!coarse_solver_) coarse_solver_.emplace(levels_.size() > 1 ? 1e-10 : 0.0);
+    coarse_solver_->compute(A, structure);
+    if (!coarse_solver_->positive_definite())
       throw ConvergenceError("Multigrid: the coarsest level (" + std::to_string(A.rows()) + " DOFs) is not positive definite, so neither is A",
                              0, std::numeric_limits<double>::quiet_NaN());
   }
 
   /// Rows whose off-diagonal entries are all zero (the identity rows of Dirichlet DOFs).
-  static void decoupled_rows(const SparseMatrix<S>& A, std::vector<char>& out) {
-    out.assign(std::size_t(A.rows()), 1);
-    for (Index r = 0; r < A.rows(); ++r)
-      for (typename SparseMatrix<S>::InnerIterator it(A, r); it; ++it)
-        if (it.col() != r && it.value() != S(0)) {
-          out[std::size_t(r)] = 0;
-          break;
-        }
+  template <exec::HostPolicy P>
+  static void decoupled_rows(P policy, const SparseMatrix<S>& A, std::vector<char>& out) {
+    out.resize(std::size_t(A.rows()));
+    exec::parallel_for(policy, A.rows(), [&](Index r) {
+      char decoupled = 1;
+      for (typename SparseMatrix<S>::InnerIterator it(A, r); it && decoupled; ++it) decoupled = !(it.col() != r && it.value() != S(0));
+      out[std::size_t(r)] = decoupled;
+    });
   }
 
-  /// λ_max(B⁻¹A) by power iteration (B⁻¹A is self-adjoint in the B inner product). The first
+  /// λ_max(B⁻¹A) by power iteration on AB⁻¹ (same eigenvalues): u ← A B⁻¹ u / ‖·‖, with the
+  /// B-Rayleigh quotient of v = B⁻¹u, vᵀAv / vᵀBv = vᵀ(Av) / vᵀu, which needs B⁻¹ only. The first
   /// compute starts from a fixed vector and runs `power_iterations`; later ones start from the
   /// last vector (the Hessian changes little between Newton iterations) and run
   /// `warm_power_iterations`.
   template <exec::HostPolicy P>
   double lambda_max(P policy, Level& L) {
     const SparseMatrix<S>& A = L.matrix();
-    VecX<S>& v = L.v;
-    VecX<S>& w = L.t;
+    VecX<S>& u = L.v;
     int iterations = options_.warm_power_iterations;
-    if (v.size() != A.rows()) {
-      v.resize(A.rows());
-      for (Index i = 0; i < v.size(); ++i) v[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
+    if (u.size() != A.rows()) {
+      u.resize(A.rows());
+      for (Index i = 0; i < u.size(); ++i) u[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
       iterations = options_.power_iterations;
     }
     double lambda = 1;
     for (int k = 0; k < iterations; ++k) {
-      sparse_multiply(policy, A, v, w);
-      L.smoother.apply(policy, w, L.r);  // r = B⁻¹ A v
-      const double num = double(dot(policy, v, w));                          // vᵀ A v
-      const double den = double(dot(policy, v, smoother_b(policy, L, v)));  // vᵀ B v
-      if (den > 0) lambda = std::max(lambda, num / den);
-      const S norm = std::sqrt(dot(policy, L.r, L.r));
+      L.smoother.apply(policy, u, L.r);   // v = B⁻¹ u
+      sparse_multiply(policy, A, L.r, L.t);  // A v
+      const double vBv = double(dot(policy, L.r, u));
+      if (vBv > 0) lambda = std::max(lambda, double(dot(policy, L.r, L.t)) / vBv);
+      const S norm = std::sqrt(dot(policy, L.t, L.t));
       if (!(norm > S(0))) break;
-      v = L.r / norm;
+      u = L.t / norm;
     }
     // a Rayleigh quotient is a lower bound of λ_max: pad it so ω·λ_max stays well below 2
     return std::max(1.0, 1.1 * lambda);
-  }
-
-  /// B v for the block diagonal B (used by the Rayleigh quotient); written into L.b.
-  template <exec::HostPolicy P>
-  const VecX<S>& smoother_b(P policy, Level& L, const VecX<S>& v) {
-    const SparseMatrix<S>& A = L.matrix();
-    const auto* outer = A.outerIndexPtr();
-    const auto* inner = A.innerIndexPtr();
-    const S* val = A.valuePtr();
-    exec::parallel_for(policy, A.rows(), [&](Index row) {
-      const Index block = row / 3;
-      S s = 0;
-      for (auto k = outer[row]; k < outer[row + 1]; ++k)
-        if (Index(inner[k]) / 3 == block) s += val[k] * v[inner[k]];
-      L.b[row] = s;
-    });
-    return L.b;
   }
 
   /// One V-cycle from level l: x_l ≈ A_l⁻¹ b_l, starting from x_l = 0.
@@ -361,7 +335,7 @@ class Multigrid {
   void cycle(P policy, std::size_t l) {
     Level& L = levels_[l];
     if (l + 1 == levels_.size()) {
-      L.x = coarse_solver_->solve(L.b);
+      coarse_solver_->solve(L.b, L.x);
       return;
     }
     const SparseMatrix<S>& A = L.matrix();
@@ -394,9 +368,8 @@ class Multigrid {
 
   MultigridOptions options_;
   std::vector<Level> levels_;
-  std::uint64_t coarse_structure_ = 0, direct_version_ = 0;
-  Eigen::SparseMatrix<S, Eigen::ColMajor, int> coarse_matrix_;
-  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>>> coarse_solver_;
+  std::uint64_t direct_version_ = 0;  ///< without coarse levels A's pattern is unknown here: analyze every time
+  std::optional<SparseCholesky<S>> coarse_solver_;
 };
 
 /// Whether a linear solver is PCG preconditioned by Multigrid (it needs the mesh to be built:

@@ -26,6 +26,11 @@ class SparseCholesky {
  public:
   using scalar_type = S;
 
+  SparseCholesky() = default;
+  /// Factorizes A + relative_shift·max|A_ii|·I instead of A (Multigrid's coarsest level, which
+  /// may be only semidefinite).
+  explicit SparseCholesky(double relative_shift) : relative_shift_(relative_shift) {}
+
   /// Throws ConvergenceError (0 iterations, residual NaN) when the factorization breaks down
   /// (a zero pivot: the matrix is singular, e.g. rigid motions left unconstrained).
   void compute(const SparseMatrix<S>& A, std::uint64_t pattern_version = 0) {
@@ -41,6 +46,7 @@ class SparseCholesky {
       rows_ = A.rows();
       nnz_ = A.nonZeros();
     }
+    if (relative_shift_ != 0) ldlt_->setShift(S(relative_shift_) * A.diagonal().cwiseAbs().maxCoeff());
     ldlt_->factorize(Ac);
     if (ldlt_->info() != Eigen::Success)
       throw ConvergenceError("SparseCholesky (LDLT factorization: singular matrix)", 0, std::numeric_limits<double>::quiet_NaN());
@@ -72,6 +78,7 @@ class SparseCholesky {
   bool analyzed_ = false;
   std::uint64_t version_ = 0;
   Index rows_ = 0, nnz_ = 0;
+  double relative_shift_ = 0;
 };
 
 }  // namespace simsr::physics
