@@ -25,15 +25,49 @@ std::vector<double> random_values(Index n, unsigned seed) {
 TEST_CASE("chunk_range covers [0, n) exactly once in order") {
   for (Index n : {0, 1, 5, 63, 64, 65, 1000, 12345})
     for (Index req : {1, 3, 16, 64, 100000}) {
-      const Index nc = exec::detail::chunk_count(n, req);
+      const Index nc = exec::chunk_count(n, req);
       Index next = 0;
       for (Index c = 0; c < nc; ++c) {
-        auto [b, e] = exec::detail::chunk_range(n, nc, c);
+        auto [b, e] = exec::chunk_range(n, nc, c);
         CHECK(b == next);
         CHECK(e >= b);
         next = e;
       }
       CHECK(next == n);
+    }
+}
+
+TEST_CASE("for_chunks: every chunk once, per-worker ranges, the same chunks under seq and omp") {
+  for (Index n : {0, 1, 7, 64, 1000, 4097})
+    for (Index req : {1, 5, 64}) {
+      const Index nc = exec::chunk_count(n, req);
+      CHECK(exec::worker_count(exec::seq, nc) == 1);
+      const Index wo = exec::worker_count(exec::omp, nc);
+      CHECK(wo >= 1);
+      CHECK(wo <= nc);
+      for (Index workers : {Index(1), wo}) {
+        std::vector<int> seen(std::size_t(nc), 0);
+        std::vector<Index> covered(std::size_t(n), 0);
+        std::vector<std::pair<Index, Index>> ranges(static_cast<std::size_t>(nc));
+        std::vector<Index> worker(static_cast<std::size_t>(nc), -1);
+        auto body = [&](Index w, Index c, Index b, Index e) {  // no doctest macro here: it runs on workers
+          worker[std::size_t(c)] = w;
+          ++seen[std::size_t(c)];
+          ranges[std::size_t(c)] = {b, e};
+          for (Index i = b; i < e; ++i) ++covered[std::size_t(i)];
+        };
+        if (workers == 1)
+          exec::for_chunks(exec::seq, n, nc, workers, body);
+        else
+          exec::for_chunks(exec::omp, n, nc, workers, body);
+        for (Index c = 0; c < nc; ++c) {
+          CHECK(seen[std::size_t(c)] == 1);
+          CHECK(worker[std::size_t(c)] == c % workers);  // worker w takes chunks w, w + workers, …
+          CHECK((ranges[std::size_t(c)] == exec::chunk_range(n, nc, c)));
+          CHECK(ranges[std::size_t(c)].second - ranges[std::size_t(c)].first <= exec::max_chunk_size(n, nc));
+        }
+        for (Index i = 0; i < n; ++i) CHECK(covered[std::size_t(i)] == 1);
+      }
     }
 }
 

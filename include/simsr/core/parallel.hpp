@@ -8,6 +8,9 @@
 ///
 /// seq and omp give bitwise-identical results (fixed chunking); cuda is available under nvcc.
 
+#include <algorithm>
+#include <type_traits>
+
 #include "exec/omp.hpp"
 #include "exec/policy.hpp"
 #include "exec/seq.hpp"
@@ -33,3 +36,30 @@ auto parallel_for_accumulate(cuda_t, Index, Make&& make, Body&&, Merge&&, Index 
 }
 }  // namespace simsr::exec
 #endif
+
+namespace simsr::exec {
+
+/// Workers a chunked loop uses under `policy` for `chunks` chunks: 1 under seq (no thread is
+/// started), min(chunks, OpenMP threads) under omp.
+template <ExecutionPolicy Policy>
+Index worker_count(Policy, Index chunks) {
+  if constexpr (std::is_same_v<std::remove_cvref_t<Policy>, omp_t>)
+    return std::max<Index>(1, std::min<Index>(chunks, omp_max_threads()));
+  else
+    return 1;
+}
+
+/// Calls body(worker, chunk, begin, end) for each of the `chunks` ranges of [0, n) (chunk_range);
+/// worker w takes chunks w, w + workers, … so per-worker scratch can be indexed by `worker`. A
+/// chunk's arithmetic never depends on its worker: results are the same under seq and omp.
+template <HostPolicy Policy, class Body>
+void for_chunks(Policy policy, Index n, Index chunks, Index workers, Body&& body) {
+  parallel_for(policy, workers, [&](Index w) {
+    for (Index c = w; c < chunks; c += workers) {
+      const auto [b, e] = chunk_range(n, chunks, c);
+      body(w, c, b, e);
+    }
+  });
+}
+
+}  // namespace simsr::exec

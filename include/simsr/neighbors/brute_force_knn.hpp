@@ -177,7 +177,7 @@ class BruteForceKnn {
     for (Index w = 0; w < workers; ++w) ws_[static_cast<std::size_t>(w)].reserve(qb, pb, d_, cap);
     exec::parallel_for(policy, workers, [&](Index w) {
       Workspace& ws = ws_[static_cast<std::size_t>(w)];
-      const auto [b0, b1] = exec::detail::chunk_range(blocks, workers, w);
+      const auto [b0, b1] = exec::chunk_range(blocks, workers, w);
       for (Index b = b0; b < b1; ++b) block(Q, b * qb, std::min(qb, nq - b * qb), k, cap, exclude_self, ws, out, where);
     });
   }

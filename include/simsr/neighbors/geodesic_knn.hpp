@@ -114,7 +114,7 @@ class GeodesicKnn {
     for (Index w = 0; w < workers; ++w) ws_[static_cast<std::size_t>(w)].reserve(n);
     exec::parallel_for(policy, workers, [&](Index w) {
       Workspace& ws = ws_[static_cast<std::size_t>(w)];
-      const auto [s0, s1] = exec::detail::chunk_range(n, workers, w);
+      const auto [s0, s1] = exec::chunk_range(n, workers, w);
       for (Index s = s0; s < s1; ++s) dijkstra(static_cast<VIndex>(s), k, ws, out, where);
     });
   }

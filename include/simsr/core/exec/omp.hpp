@@ -76,13 +76,13 @@ void parallel_for(omp_t, Index n, Body&& body) {
 template <class T, class Map, class Combine>
 T parallel_reduce(omp_t, Index n, T identity, Map&& map, Combine&& combine, Index chunks = default_chunks) {
 #if defined(_OPENMP)
-  const Index nc = detail::chunk_count(n, chunks);
+  const Index nc = chunk_count(n, chunks);
   std::vector<T> parts(static_cast<std::size_t>(nc), identity);
   detail::FirstException error;
 #pragma omp parallel for schedule(dynamic, 1)
   for (Index c = 0; c < nc; ++c) {
     error.run([&] {
-      auto [b, e] = detail::chunk_range(n, nc, c);
+      auto [b, e] = chunk_range(n, nc, c);
       T part = identity;
       for (Index i = b; i < e; ++i) part = combine(part, map(i));
       parts[static_cast<std::size_t>(c)] = std::move(part);
@@ -103,7 +103,7 @@ T parallel_reduce(omp_t, Index n, T identity, Map&& map, Combine&& combine, Inde
 template <class Make, class Body, class Merge>
 auto parallel_for_accumulate(omp_t, Index n, Make&& make, Body&& body, Merge&& merge, Index chunks = 16) {
 #if defined(_OPENMP)
-  const Index nc = detail::chunk_count(n, chunks);
+  const Index nc = chunk_count(n, chunks);
   using Acc = decltype(make());
   std::vector<Acc> accs;
   accs.reserve(static_cast<std::size_t>(nc));
@@ -112,7 +112,7 @@ auto parallel_for_accumulate(omp_t, Index n, Make&& make, Body&& body, Merge&& m
 #pragma omp parallel for schedule(dynamic, 1)
   for (Index c = 0; c < nc; ++c) {
     error.run([&] {
-      auto [b, e] = detail::chunk_range(n, nc, c);
+      auto [b, e] = chunk_range(n, nc, c);
       for (Index i = b; i < e; ++i) body(i, accs[static_cast<std::size_t>(c)]);
     });
   }

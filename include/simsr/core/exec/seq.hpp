@@ -20,10 +20,10 @@ void parallel_for(seq_t, Index n, Body&& body) {
 /// order. The chunking is the omp backend's, so the two round identically.
 template <class T, class Map, class Combine>
 T parallel_reduce(seq_t, Index n, T identity, Map&& map, Combine&& combine, Index chunks = default_chunks) {
-  const Index nc = detail::chunk_count(n, chunks);
+  const Index nc = chunk_count(n, chunks);
   T total = identity;
   for (Index c = 0; c < nc; ++c) {
-    auto [b, e] = detail::chunk_range(n, nc, c);
+    auto [b, e] = chunk_range(n, nc, c);
     T part = identity;
     for (Index i = b; i < e; ++i) part = combine(part, map(i));
     total = combine(total, part);
@@ -36,10 +36,10 @@ T parallel_reduce(seq_t, Index n, T identity, Map&& map, Combine&& combine, Inde
 /// order into the first. Used for FEM assembly (gradients, triplets) without atomics.
 template <class Make, class Body, class Merge>
 auto parallel_for_accumulate(seq_t, Index n, Make&& make, Body&& body, Merge&& merge, Index chunks = 16) {
-  const Index nc = detail::chunk_count(n, chunks);
+  const Index nc = chunk_count(n, chunks);
   auto total = make();
   for (Index c = 0; c < nc; ++c) {
-    auto [b, e] = detail::chunk_range(n, nc, c);
+    auto [b, e] = chunk_range(n, nc, c);
     if (c == 0) {
       for (Index i = b; i < e; ++i) body(i, total);
     } else {
