@@ -143,7 +143,7 @@ template <class P>
 void BM_EmbeddedApply(benchmark::State& state) {
   static const interp::Embedded<> method = [] {
     interp::Embedded<> e;
-    e.fit(lattice(), surface_points());
+    e.fit(exec::omp, lattice(), surface_points());
     return e;
   }();
   std::mt19937 rng(4);

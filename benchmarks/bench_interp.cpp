@@ -92,7 +92,7 @@ void run_apply(benchmark::State& state, I& method, Policy policy, const Upsampli
 }
 
 IDW<>& idw() {
-  static IDW<> m = [] { IDW<> x; x.fit(paper_problem()); return x; }();
+  static IDW<> m = [] { IDW<> x; x.fit(exec::seq, paper_problem()); return x; }();
   return m;
 }
 MLS<>& mls(MlsBasis b) {

@@ -16,6 +16,7 @@ enum ExitCode : int {
   exit_shape = 4,        ///< ShapeError: arrays of mismatching shapes
   exit_argument = 5,     ///< ArgumentError: a parameter out of range
   exit_convergence = 6,  ///< ConvergenceError
+  exit_numerical = 7,    ///< NumericalError: a non-finite loss, gradient, weight or prediction
   exit_usage = 64,       ///< bad command line (EX_USAGE)
 };
 
@@ -38,6 +39,9 @@ inline int run_guarded(const std::function<int()>& body, const char* program = "
   } catch (const ConvergenceError& e) {
     std::fprintf(stderr, "%s: no convergence: %s\n", program, e.what());
     return exit_convergence;
+  } catch (const NumericalError& e) {
+    std::fprintf(stderr, "%s: numerical failure: %s\n", program, e.what());
+    return exit_numerical;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: error: %s\n", program, e.what());
     return exit_error;

@@ -51,21 +51,21 @@ TEST_CASE("every interpolator's warm apply allocates nothing (bunny, seq and omp
   Points<> hr(b.problem.num_hr(), 3);
 
   Embedded<> embedded;
-  embedded.fit(b.problem);
+  embedded.fit(exec::seq, b.problem);
   check_no_allocation("Embedded", embedded, lr, hr);
   IDW<> idw;
-  idw.fit(b.problem);
+  idw.fit(exec::seq, b.problem);
   check_no_allocation("IDW", idw, lr, hr);
   for (const auto basis : {MlsBasis::per_coordinate, MlsBasis::linear_3d}) {
     MLS<> mls(MLSOptions{.basis = basis});
-    mls.fit(b.problem);
+    mls.fit(exec::seq, b.problem);
     check_no_allocation(basis == MlsBasis::per_coordinate ? "MLS as written" : "MLS 3-D linear", mls, lr, hr);
   }
   for (const auto solver : {RbfSolver::dense, RbfSolver::sparse}) {
     RBFOptions o;
     o.solver = solver;
     RBF<> rbf(o);
-    rbf.fit(b.problem);
+    rbf.fit(exec::seq, b.problem);
     check_no_allocation(solver == RbfSolver::dense ? "RBF dense" : "RBF sparse", rbf, lr, hr);
   }
   {  // dense LU kept and solved per frame (operator larger than the budget)
@@ -73,16 +73,21 @@ TEST_CASE("every interpolator's warm apply allocates nothing (bunny, seq and omp
     o.solver = RbfSolver::dense;
     o.max_operator_bytes = 0;
     RBF<> rbf(o);
-    rbf.fit(b.problem);
+    rbf.fit(exec::seq, b.problem);
     check_no_allocation("RBF dense, per-frame LU solves", rbf, lr, hr);
   }
-  std::vector<double> train_lr, train_hr;
-  for (std::size_t f = 0; f < b.lr_frames.size(); ++f) {
-    train_lr.insert(train_lr.end(), b.lr_frames[f].data(), b.lr_frames[f].data() + b.lr_frames[f].size());
-    train_hr.insert(train_hr.end(), b.hr_frames[f].data(), b.hr_frames[f].data() + b.hr_frames[f].size());
+  data::PairedFrames<> train;
+  const Index nf = Index(b.lr_frames.size());
+  train.lowres.resize(nf, b.lr_frames[0].size());
+  train.highres.resize(nf, b.hr_frames[0].size());
+  train.controls.resize(nf, 0);
+  for (Index f = 0; f < nf; ++f) {
+    train.lowres.row(f) = Eigen::Map<const Eigen::RowVectorXd>(b.lr_frames[std::size_t(f)].data(), b.lr_frames[std::size_t(f)].size());
+    train.highres.row(f) = Eigen::Map<const Eigen::RowVectorXd>(b.hr_frames[std::size_t(f)].data(), b.hr_frames[std::size_t(f)].size());
+    train.ids.push_back(f);
   }
   Ridge<> ridge;
-  ridge.fit(b.problem);
-  ridge.train(train_lr, train_hr, Index(b.lr_frames.size()));
+  ridge.fit(exec::seq, b.problem);
+  ridge.train(exec::seq, train, {});
   check_no_allocation("Ridge", ridge, lr, hr);
 }

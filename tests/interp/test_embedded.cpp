@@ -16,7 +16,8 @@ using namespace simsr;
 using interp::Embedded;
 
 static_assert(interp::assert_interpolator<Embedded<>>());
-static_assert(interp::Interpolator<Embedded<float, exec::omp_t>>);
+static_assert(interp::Interpolator<Embedded<float>>);
+static_assert(!interp::needs_neighborhoods_v<Embedded<>>);
 
 namespace {
 
@@ -37,7 +38,7 @@ TEST_CASE("Embedded reproduces affine displacement fields exactly at inside and 
   std::mt19937 rng(21);
   auto p = box_problem(rng);
   Embedded<> e;
-  e.fit(p);
+  e.fit(exec::seq, p);
   CHECK(e.num_lr() == p.lr.num_vertices());
   CHECK(e.num_hr() == p.hr.num_vertices());
   REQUIRE(e.embedding().num_outside() > 100);
@@ -48,7 +49,7 @@ TEST_CASE("Embedded reproduces affine displacement fields exactly at inside and 
     const Points<> lr_disp = (p.lr.V * A.transpose()).rowwise() + b;
     const Points<> expect = (p.hr.V * A.transpose()).rowwise() + b;
     Points<> hr_disp(p.hr.V.rows(), 3);
-    e.apply(lr_disp, hr_disp);
+    e.apply(exec::seq, lr_disp, hr_disp);
     CHECK((hr_disp - expect).cwiseAbs().maxCoeff() < 1e-12);
     Points<> hr_omp(p.hr.V.rows(), 3);
     e.apply(exec::omp, lr_disp, hr_omp);
@@ -57,33 +58,33 @@ TEST_CASE("Embedded reproduces affine displacement fields exactly at inside and 
   // A nonlinear field is not reproduced (the test above can fail).
   Points<> lr_sq = p.lr.V.array().square().matrix();
   Points<> hr_disp(p.hr.V.rows(), 3);
-  e.apply(lr_sq, hr_disp);
+  e.apply(exec::seq, lr_sq, hr_disp);
   CHECK((hr_disp - Points<>(p.hr.V.array().square().matrix())).cwiseAbs().maxCoeff() > 1e-3);
 }
 
 TEST_CASE("Embedded under omp and with clamped outside weights") {
   std::mt19937 rng(22);
   auto p = box_problem(rng);
-  Embedded<double, exec::omp_t> eo;
-  eo.fit(p);
+  Embedded<> eo;
+  eo.fit(exec::omp, p);
   Embedded<> es;
-  es.fit(p);
+  es.fit(exec::seq, p);
   CHECK(eo.embedding().tet == es.embedding().tet);
   CHECK(eo.embedding().weights == es.embedding().weights);
   const Points<> lr_disp = Points<>::Random(p.lr.V.rows(), 3);
   Points<> a(p.hr.V.rows(), 3), b(p.hr.V.rows(), 3);
-  eo.apply(lr_disp, a);
-  es.apply(lr_disp, b);
+  eo.apply(exec::omp, lr_disp, a);
+  es.apply(exec::seq, lr_disp, b);
   CHECK(a == b);
   CHECK((a - deform(es.embedding(), p.lr.T, lr_disp)).cwiseAbs().maxCoeff() == 0);
 
   EmbeddingOptions o;
   o.outside = OutsideMode::clamp;
   Embedded<> ec(o);
-  ec.fit(p);
+  ec.fit(exec::seq, p);
   // Identity displacement (= rest positions): clamped outside points land on the mesh, at `distance`.
   Points<> pos(p.hr.V.rows(), 3);
-  ec.apply(p.lr.V, pos);
+  ec.apply(exec::seq, p.lr.V, pos);
   const auto& emb = ec.embedding();
   for (Index q = 0; q < pos.rows(); ++q) {
     if (emb.inside[q])
@@ -99,23 +100,23 @@ TEST_CASE("Embedded checks shapes and fails on bad meshes") {
   Embedded<> e;
   Points<> lr(p.lr.V.rows(), 3), hr(50, 3);
   lr.setZero();
-  CHECK_THROWS_AS(e.apply(lr, hr), ShapeError);  // not fitted
-  e.fit(p);
-  e.apply(lr, hr);
+  CHECK_THROWS_AS(e.apply(exec::seq, lr, hr), ShapeError);  // not fitted
+  e.fit(exec::seq, p);
+  e.apply(exec::seq, lr, hr);
   CHECK(hr.cwiseAbs().maxCoeff() == 0);
   Points<> hr_short(49, 3), lr_short(p.lr.V.rows() - 1, 3);
-  CHECK_THROWS_AS(e.apply(lr, hr_short), ShapeError);
-  CHECK_THROWS_AS(e.apply(lr_short, hr), ShapeError);
+  CHECK_THROWS_AS(e.apply(exec::seq, lr, hr_short), ShapeError);
+  CHECK_THROWS_AS(e.apply(exec::seq, lr_short, hr), ShapeError);
   Eigen::MatrixXd lr2(p.lr.V.rows(), 2);
-  CHECK_THROWS_AS(e.apply(lr2, hr), ShapeError);
+  CHECK_THROWS_AS(e.apply(exec::seq, lr2, hr), ShapeError);
 
   auto bad = p;
   bad.lr.T.row(3) << bad.lr.T(3, 0), bad.lr.T(3, 0), bad.lr.T(3, 1), bad.lr.T(3, 2);
-  CHECK_THROWS_AS(Embedded<>{}.fit(bad), MeshError);
+  CHECK_THROWS_AS(Embedded<>{}.fit(exec::seq, bad), MeshError);
   auto nan = p;
   nan.hr.V(17, 1) = std::nan("");
   try {
-    Embedded<>{}.fit(nan);
+    Embedded<>{}.fit(exec::seq, nan);
     FAIL("no ArgumentError");
   } catch (const ArgumentError& err) {
     CHECK(std::string(err.what()).find("point 17") != std::string::npos);
@@ -131,8 +132,8 @@ TEST_CASE("bunny: Embedded baseline on the official paired frames") {
   interp::UpsamplingProblem<> p{io::read_obj_tets(dir / "lrestshape.obj"), io::read_obj_triangles(dir / "hrestshape.obj"), {}};
   REQUIRE(p.lr.num_tets() == 4896);
   REQUIRE(p.hr.num_vertices() == 2503);
-  Embedded<double, exec::omp_t> e;
-  e.fit(p);
+  Embedded<> e;
+  e.fit(exec::omp, p);
   const auto& emb = e.embedding();
   const double h = 0.0125;  // lattice spacing of the LR mesh (data README)
   const double diag = (p.hr.V.colwise().maxCoeff() - p.hr.V.colwise().minCoeff()).norm();
@@ -148,7 +149,7 @@ TEST_CASE("bunny: Embedded baseline on the official paired frames") {
                             Eigen::Matrix3d::Identity();
   const Eigen::RowVector3d b(0.01, -0.02, 0.03);
   Points<> hr_disp(p.hr.V.rows(), 3);
-  e.apply(Points<>((p.lr.V * A.transpose()).rowwise() + b), hr_disp);
+  e.apply(exec::omp, Points<>((p.lr.V * A.transpose()).rowwise() + b), hr_disp);
   CHECK((hr_disp - (Points<>((p.hr.V * A.transpose()).rowwise() + b))).cwiseAbs().maxCoeff() < 1e-12 * diag);
 
   const io::NpzArrays z = io::read_npz(dir / "train_frames.npz");
@@ -160,7 +161,7 @@ TEST_CASE("bunny: Embedded baseline on the official paired frames") {
   std::ostringstream table;
   for (Index f = 0; f < low.num_frames(); ++f) {
     const Points<> lf = low.frame_points(f), hf = high.frame_points(f);
-    e.apply(Points<>(lf - p.lr.V), hr_disp);
+    e.apply(exec::omp, Points<>(lf - p.lr.V), hr_disp);
     const VecX<> err = (p.hr.V + hr_disp - hf).rowwise().norm() / diag;
     const VecX<> rest = (p.hr.V - hf).rowwise().norm() / diag;
     sum_emb += err.mean();

@@ -44,7 +44,7 @@ TEST_CASE("IDW: weights sum to 1, constants exact, exact hits, and the direct fo
   p = make_problem(p.lr.V, p.hr.V, 20);
   for (const double power : {1.0, 2.0, 3.5}) {
     IDW<> idw(IDWOptions{.power = power});
-    idw.fit(p);
+    idw.fit(exec::seq, p);
     for (Index j = 0; j < p.num_hr(); ++j) {
       CHECK(idw.weights().row(j).sum() == doctest::Approx(1.0).epsilon(1e-14));
       CHECK(idw.weights().row(j).minCoeff() >= 0);
@@ -53,7 +53,7 @@ TEST_CASE("IDW: weights sum to 1, constants exact, exact hits, and the direct fo
     CHECK(idw.weights()(4, 0) == 1.0);
     CHECK(idw.weights().row(4).tail(19).cwiseAbs().maxCoeff() == 0.0);
     Points<> dX = random_points(p.num_lr(), -1, 1, rng), dx(p.num_hr(), 3);
-    idw.apply(dX, dx);
+    idw.apply(exec::seq, dX, dx);
     CHECK((dx.row(4) - dX.row(17)).norm() == 0.0);
     for (Index j = 0; j < p.num_hr(); ++j) {
       if (j == 4) continue;
@@ -68,7 +68,7 @@ TEST_CASE("IDW: weights sum to 1, constants exact, exact hits, and the direct fo
       CHECK((dx.row(j) - num / den).norm() < 1e-13);
     }
     dX.rowwise() = Eigen::RowVector3d(-0.7, 0.1, 3.0);
-    idw.apply(dX, dx);
+    idw.apply(exec::seq, dX, dx);
     for (Index j = 0; j < p.num_hr(); ++j) CHECK((dx.row(j) - Eigen::RowVector3d(-0.7, 0.1, 3.0)).norm() < 1e-14);
   }
 }
@@ -77,16 +77,16 @@ TEST_CASE("IDW: seq and omp identical bits; errors") {
   std::mt19937 rng(32);
   auto p = make_problem(random_points(200, 0, 1, rng), random_points(500, 0, 1, rng), 20);
   IDW<> idw;
-  idw.fit(p);
+  idw.fit(exec::seq, p);
   Points<> dX = random_points(p.num_lr(), -1, 1, rng), a(p.num_hr(), 3), b(p.num_hr(), 3);
   idw.apply(exec::seq, dX, a);
   idw.apply(exec::omp, dX, b);
   CHECK((a.array() == b.array()).all());
   Points<> wrong(3, 3);
-  CHECK_THROWS_AS(idw.apply(wrong, a), ShapeError);
-  CHECK_THROWS_AS(idw.apply(dX, wrong), ShapeError);
-  CHECK_THROWS_AS(IDW<>(IDWOptions{.power = 0}).fit(p), ArgumentError);
-  CHECK_THROWS_AS(IDW<>(IDWOptions{.k = 21}).fit(p), ArgumentError);
+  CHECK_THROWS_AS(idw.apply(exec::seq, wrong, a), ShapeError);
+  CHECK_THROWS_AS(idw.apply(exec::seq, dX, wrong), ShapeError);
+  CHECK_THROWS_AS(IDW<>(IDWOptions{.power = 0}).fit(exec::seq, p), ArgumentError);
+  CHECK_THROWS_AS(IDW<>(IDWOptions{.k = 21}).fit(exec::seq, p), ArgumentError);
 }
 
 TEST_CASE("IDW on the bunny beats the rest shape") {
@@ -107,7 +107,7 @@ TEST_CASE("IDW on the bunny beats the rest shape") {
   const auto lo = z.read("lowres").to_vector<double>(), hi = z.read("highres").to_vector<double>();
   const Index n = p.num_lr(), m = p.num_hr();
   IDW<> idw;
-  idw.fit(p);
+  idw.fit(exec::seq, p);
   Points<> dx(m, 3);
   double mean = 0, worst = 0, rest = 0;
   const std::vector<Index> frames{10, 100, 200, 250};

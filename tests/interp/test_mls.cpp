@@ -92,11 +92,11 @@ TEST_CASE("MLS (as written, Eq. 12-16) reproduces constants and fields linear/qu
   std::mt19937 rng(7);
   auto p = point_problem(jittered_lattice(7, 6, 5, 1.0, 0.3, rng), random_points(300, 0.5, 4.5, rng), 20);
   MLS<> mls;
-  mls.fit(p);
+  mls.fit(exec::seq, p);
   CHECK(mls.info().systems_at_degree[2] == 3 * p.num_hr());  // no fallback on a jittered lattice
   Points<> dX(p.num_lr(), 3), dx(p.num_hr(), 3);
   dX.rowwise() = Eigen::RowVector3d(0.3, -1.2, 2.5);
-  mls.apply(dX, dx);
+  mls.apply(exec::seq, dX, dx);
   for (Index j = 0; j < p.num_hr(); ++j) CHECK((dx.row(j) - Eigen::RowVector3d(0.3, -1.2, 2.5)).norm() < 1e-12);
   // Δx depends on x only (quadratic), Δy on y, Δz on z: exact for r = 2 (the basis is 1-D per component)
   const auto field = [](const Points<>& X) {
@@ -108,11 +108,11 @@ TEST_CASE("MLS (as written, Eq. 12-16) reproduces constants and fields linear/qu
     return F;
   };
   dX = field(p.lr.V);
-  mls.apply(dX, dx);
+  mls.apply(exec::seq, dX, dx);
   CHECK((dx - field(p.hr.V)).cwiseAbs().maxCoeff() < 1e-10);
   // a field mixing coordinates is not reproduced by the per-coordinate basis (the test can fail)
   for (Index i = 0; i < p.num_lr(); ++i) dX.row(i) << p.lr.V(i, 1), 0, 0;
-  mls.apply(dX, dx);
+  mls.apply(exec::seq, dX, dx);
   double worst = 0;
   for (Index j = 0; j < p.num_hr(); ++j) worst = std::max(worst, std::abs(dx(j, 0) - p.hr.V(j, 1)));
   CHECK(worst > 1e-3);
@@ -122,13 +122,13 @@ TEST_CASE("MLS 3-D linear reproduces linear fields exactly") {
   std::mt19937 rng(8);
   auto p = point_problem(jittered_lattice(6, 6, 6, 0.5, 0.3, rng), random_points(200, 0.2, 2.3, rng), 20);
   MLS<> mls(MLSOptions{.basis = MlsBasis::linear_3d});
-  mls.fit(p);
+  mls.fit(exec::seq, p);
   CHECK(mls.info().rank_deficient == 0);
   Eigen::Matrix3d G;
   G << 0.1, -0.4, 0.2, 0.3, 0.0, -0.7, 1.1, 0.5, 0.2;
   const Eigen::RowVector3d t(0.5, -0.25, 2.0);
   Points<> dX = (p.lr.V * G.transpose()).rowwise() + t, dx(p.num_hr(), 3);
-  mls.apply(dX, dx);
+  mls.apply(exec::seq, dX, dx);
   const Points<> expect = (p.hr.V * G.transpose()).rowwise() + t;
   CHECK((dx - expect).cwiseAbs().maxCoeff() < 1e-11);
 }
@@ -145,8 +145,8 @@ TEST_CASE("MLS equals the weighted least-squares problem solved directly per fra
       o.degree = r;
       o.sigma = 1.3;
       MLS<> mls(o);
-      mls.fit(p);
-      mls.apply(dX, dx);
+      mls.fit(exec::seq, p);
+      mls.apply(exec::seq, dX, dx);
       const Points<> ref = direct_mls(p, dX, o.sigma, lin, r, 20);
       INFO("linear_3d = ", lin, ", r = ", r);
       CHECK((dx - ref).cwiseAbs().maxCoeff() < 1e-10);
@@ -161,18 +161,18 @@ TEST_CASE("MLS on a flat lattice layer: singular moment matrices fall back, neve
   H.col(2).setConstant(0.5);
   auto p = point_problem(L, H, 20);
   MLS<> mls;
-  mls.fit(p);
+  mls.fit(exec::seq, p);
   // z: all t = 0 → degree 0 for every vertex; x and y keep degree 2
   CHECK(mls.info().systems_at_degree[0] == p.num_hr());
   CHECK(mls.info().systems_at_degree[2] == 2 * p.num_hr());
   MLS<> lin(MLSOptions{.basis = MlsBasis::linear_3d});
-  lin.fit(p);
+  lin.fit(exec::seq, p);
   CHECK(lin.info().rank_deficient == p.num_hr());
   // in-plane linear field: exact also for the rank-deficient systems (HR vertices in the plane)
   Points<> dX(p.num_lr(), 3), dx(p.num_hr(), 3);
   for (Index i = 0; i < p.num_lr(); ++i) dX.row(i) << 1 + 0.2 * L(i, 0) - 0.3 * L(i, 1), 0.1 * L(i, 1), 2.0;
   for (auto* m : {&mls, &lin}) {
-    m->apply(dX, dx);
+    m->apply(exec::seq, dX, dx);
     CHECK(dx.allFinite());
     for (Index j = 0; j < p.num_hr(); ++j) {
       CHECK(dx(j, 1) == doctest::Approx(0.1 * H(j, 1)).epsilon(1e-9));
@@ -184,7 +184,7 @@ TEST_CASE("MLS on a flat lattice layer: singular moment matrices fall back, neve
   for (Index i = 0; i < L2.rows(); ++i) L2(i, 2) = (i % 2) ? 0.5 : 1.5;
   auto p2 = point_problem(L2, H, 20);
   MLS<> m2;
-  m2.fit(p2);
+  m2.fit(exec::seq, p2);
   CHECK(m2.info().systems_at_degree[1] == p2.num_hr());
 }
 
@@ -202,13 +202,13 @@ TEST_CASE("MLS: seq and omp give identical bits; shapes and options are checked"
     CHECK((a.array() == b.array()).all());
   }
   MLS<> m;
-  m.fit(p);
+  m.fit(exec::seq, p);
   Points<> wrong(p.num_hr() - 1, 3);
-  CHECK_THROWS_AS(m.apply(dX, wrong), ShapeError);
-  CHECK_THROWS_AS(MLS<>(MLSOptions{.degree = 4}).fit(p), ArgumentError);
-  CHECK_THROWS_AS(MLS<>(MLSOptions{.k = 30}).fit(p), ArgumentError);
+  CHECK_THROWS_AS(m.apply(exec::seq, dX, wrong), ShapeError);
+  CHECK_THROWS_AS(MLS<>(MLSOptions{.degree = 4}).fit(exec::seq, p), ArgumentError);
+  CHECK_THROWS_AS(MLS<>(MLSOptions{.k = 30}).fit(exec::seq, p), ArgumentError);
   UpsamplingProblem<> bare{p.lr, p.hr, std::nullopt};
-  CHECK_THROWS_WITH_AS(MLS<>().fit(bare), doctest::Contains("ensure_neighborhoods"), ArgumentError);
+  CHECK_THROWS_WITH_AS(MLS<>().fit(exec::seq, bare), doctest::Contains("ensure_neighborhoods"), ArgumentError);
 }
 
 using simsr::test::Bunny;

@@ -110,7 +110,7 @@ UpsamplingProblem<> surface_problem(std::mt19937& rng, int nu = 30, int nv = 14)
   UpsamplingProblem<> p;
   p.lr = lattice_tets(5, 5, 3, 1.0, 0.2, rng);
   p.hr = torus(nu, nv, 2.0, 1.2, Eigen::RowVector3d(2, 2, 1));
-  p.ensure_neighborhoods(20);
+  p.ensure_neighborhoods(exec::seq, 20);
   return p;
 }
 
@@ -176,9 +176,9 @@ TEST_CASE("RBF (Euclidean) matches scipy.interpolate.RBFInterpolator to 1e-8") {
     o.sigma = sigma;
     o.degree = degree;
     RBF<> rbf(o);
-    rbf.fit(p);
+    rbf.fit(exec::seq, p);
     Points<> dx(p.num_hr(), 3);
-    rbf.apply(values, dx);
+    rbf.apply(exec::seq, values, dx);
     INFO("degree ", degree, ", rcond ", rbf.info().rcond);
     const double err = max_abs(dx, ref);
     MESSAGE("RBF vs scipy (N = 60, M = 45, degree ", degree, "): max |difference| ", err, " (values up to ",
@@ -202,10 +202,10 @@ TEST_CASE("RBF reproduces constants (degree 0) and linear fields (degree 1), and
     o.distance = dist;
     o.degree = 0;
     RBF<> rbf(o);
-    rbf.fit(q);
+    rbf.fit(exec::seq, q);
     Points<> cX(q.num_lr(), 3), cx(q.num_hr(), 3);
     cX.rowwise() = Eigen::RowVector3d(0.4, -2.0, 1.5);
-    rbf.apply(cX, cx);
+    rbf.apply(exec::seq, cX, cx);
     CHECK(max_abs(cx.rowwise() - Eigen::RowVector3d(0.4, -2.0, 1.5), Points<>::Zero(q.num_hr(), 3)) < 1e-9);
   }
   Eigen::Matrix3d G;
@@ -215,23 +215,23 @@ TEST_CASE("RBF reproduces constants (degree 0) and linear fields (degree 1), and
   o.distance = RbfDistance::euclidean;
   o.degree = 1;
   RBF<> lin(o);
-  lin.fit(p);
-  lin.apply(dX, dx);
+  lin.fit(exec::seq, p);
+  lin.apply(exec::seq, dX, dx);
   CHECK(max_abs(dx, (p.hr.V * G.transpose()).rowwise() + Eigen::RowVector3d(1, 2, 3)) < 1e-9);
   // without a tail the paper's RBF does not reproduce constants between centres (the test can fail)
   o.degree = -1;
   RBF<> plain(o);
-  plain.fit(p);
+  plain.fit(exec::seq, p);
   dX.rowwise() = Eigen::RowVector3d(1, 1, 1);
-  plain.apply(dX, dx);
+  plain.apply(exec::seq, dX, dx);
   CHECK(max_abs(dx, Points<>::Ones(m, 3)) > 1e-3);
   // centres: exact at the coincident HR vertices for random values, every degree
   dX = random_points(n, -1, 1, rng);
   for (const int degree : {-1, 0, 1}) {
     o.degree = degree;
     RBF<> r(o);
-    r.fit(p);
-    r.apply(dX, dx);
+    r.fit(exec::seq, p);
+    r.apply(exec::seq, dX, dx);
     for (const Index i : {0, 7, 33}) CHECK((dx.row(i) - dX.row(i)).norm() < 1e-10);
   }
 }
@@ -261,23 +261,23 @@ TEST_CASE("RBF lr_mesh_geodesic equals the direct solve with Floyd-Warshall LR d
     o.distance = RbfDistance::lr_mesh_geodesic;
     o.sigma = sigma;
     RBF<> dense(o);  // precomputed M×N operator
-    dense.fit(p);
+    dense.fit(exec::seq, p);
     CHECK(dense.info().precomputed_operator);
-    dense.apply(dX, dx);
+    dense.apply(exec::seq, dX, dx);
     CHECK(max_abs(dx, ref) < 1e-10);
     o.max_operator_bytes = 0;  // keep the LU, solve per frame
     RBF<> solve(o);
-    solve.fit(p);
+    solve.fit(exec::seq, p);
     CHECK(!solve.info().precomputed_operator);
-    solve.apply(dX, dx);
+    solve.apply(exec::seq, dX, dx);
     CHECK(max_abs(dx, ref) < 1e-10);
     o.solver = RbfSolver::sparse;  // truncated Φ_LL, sparse LDLᵀ
     o.truncation = 1e-13;
     RBF<> sparse(o);
-    sparse.fit(p);
+    sparse.fit(exec::seq, p);
     CHECK(sparse.info().sparse);
     CHECK(sparse.info().lr_nonzeros < n * (n + 1) / 2);  // truncation dropped entries
-    sparse.apply(dX, dx);
+    sparse.apply(exec::seq, dX, dx);
     CHECK(max_abs(dx, ref) < 1e-8);
   }
 }
@@ -297,7 +297,7 @@ TEST_CASE("RBF geodesic: one surface metric - the dense solve with Floyd-Warshal
     spacing += nearest / double(n);
   }
   RBF<> def;
-  def.fit(p);
+  def.fit(exec::seq, p);
   CHECK(def.info().sigma == doctest::Approx(spacing).epsilon(1e-12));
   const double truncation = 1e-12;
   for (const double sigma : {spacing, 1.3 * spacing}) {
@@ -352,10 +352,10 @@ TEST_CASE("RBF geodesic: one surface metric - the dense solve with Floyd-Warshal
   RBFOptions o;
   o.distance = RbfDistance::lr_mesh_geodesic;
   RBF<> lr_mesh(o);
-  lr_mesh.fit(p);
+  lr_mesh.fit(exec::seq, p);
   const Points<> dX = random_points(n, -1, 1, rng);
   Points<> dx(m, 3);
-  lr_mesh.apply(dX, dx);
+  lr_mesh.apply(exec::seq, dX, dx);
   double at_centres = 0;
   for (Index i = 0; i < n; ++i) at_centres = std::max(at_centres, (dx.row(map[i]) - dX.row(i)).norm());
   CHECK(at_centres > 0.1);
@@ -365,7 +365,7 @@ TEST_CASE("RBF surface distances are the 20-neighbourhood distances bit for bit,
   std::mt19937 rng(26);
   auto p = surface_problem(rng);
   const auto& nb = *p.neighborhoods;
-  const auto g = neighbors::detail::surface_edge_graph(p.hr.V, p.hr.F);
+  const auto g = neighbors::surface_edge_graph(p.hr.V, p.hr.F);
   const std::span<const VIndex> map(nb.lr_to_hr.data(), std::size_t(nb.lr_to_hr.size()));
   const double radius = 1.5;  // a limit that cuts rows short
   std::vector<interp::detail::DistanceRow> seq_rows(std::size_t(p.num_lr())), omp_rows(seq_rows.size());
@@ -410,16 +410,16 @@ TEST_CASE("RBF: singular systems, shapes, options; seq and omp give identical bi
   {
     auto no_map = ps;
     no_map.neighborhoods->lr_to_hr.resize(0);
-    CHECK_THROWS_WITH_AS(RBF<>().fit(no_map), doctest::Contains("lr_to_hr"), ArgumentError);
+    CHECK_THROWS_WITH_AS(RBF<>().fit(exec::seq, no_map), doctest::Contains("lr_to_hr"), ArgumentError);
     auto two = ps;
     two.neighborhoods->lr_to_hr[3] = two.neighborhoods->lr_to_hr[4];
-    CHECK_THROWS_WITH_AS(RBF<>().fit(two), doctest::Contains("one-to-one"), ArgumentError);
+    CHECK_THROWS_WITH_AS(RBF<>().fit(exec::seq, two), doctest::Contains("one-to-one"), ArgumentError);
     auto flat = ps;
     flat.hr.F.resize(0, 3);
-    CHECK_THROWS_WITH_AS(RBF<>().fit(flat), doctest::Contains("no triangles"), ArgumentError);
+    CHECK_THROWS_WITH_AS(RBF<>().fit(exec::seq, flat), doctest::Contains("no triangles"), ArgumentError);
     auto none = ps;
     none.neighborhoods.reset();
-    CHECK_THROWS_AS(RBF<>().fit(none), ArgumentError);
+    CHECK_THROWS_AS(RBF<>().fit(exec::seq, none), ArgumentError);
   }
   dX = random_points(p.num_lr(), -1, 1, rng);
   a.resize(p.num_hr(), 3), b.resize(p.num_hr(), 3);
@@ -438,23 +438,23 @@ TEST_CASE("RBF: singular systems, shapes, options; seq and omp give identical bi
     CHECK((a.array() == b.array()).all());
   }
   RBF<> r;
-  r.fit(ps);
+  r.fit(exec::seq, ps);
   Points<> wrong(ps.num_lr() + 1, 3);
   a.resize(ps.num_hr(), 3);
-  CHECK_THROWS_AS(r.apply(wrong, a), ShapeError);
-  CHECK_THROWS_AS(RBF<>(RBFOptions{.degree = 2}).fit(p), ArgumentError);
+  CHECK_THROWS_AS(r.apply(exec::seq, wrong, a), ShapeError);
+  CHECK_THROWS_AS(RBF<>(RBFOptions{.degree = 2}).fit(exec::seq, p), ArgumentError);
   // a duplicated LR vertex makes two rows of Φ_LL equal (Euclidean: the duplicate is at distance 0)
   auto dup = p;
   dup.lr.V.row(5) = dup.lr.V.row(6);
   RBFOptions e;
   e.distance = RbfDistance::euclidean;
-  CHECK_THROWS_WITH_AS(RBF<>(e).fit(dup), doctest::Contains("numerically singular"), ArgumentError);
+  CHECK_THROWS_WITH_AS(RBF<>(e).fit(exec::seq, dup), doctest::Contains("numerically singular"), ArgumentError);
   e.solver = RbfSolver::sparse;
-  CHECK_THROWS_AS(RBF<>(e).fit(dup), ArgumentError);
+  CHECK_THROWS_AS(RBF<>(e).fit(exec::seq, dup), ArgumentError);
   // a far too wide Gaussian: Φ_LL is numerically rank deficient
   e.solver = RbfSolver::dense;
   e.sigma_scale = 40;
-  CHECK_THROWS_WITH_AS(RBF<>(e).fit(p), doctest::Contains("numerically singular"), ArgumentError);
+  CHECK_THROWS_WITH_AS(RBF<>(e).fit(exec::seq, p), doctest::Contains("numerically singular"), ArgumentError);
 }
 
 using simsr::test::Bunny;

@@ -33,6 +33,16 @@ std::vector<double> random_vector(std::size_t n, std::mt19937& rng) {
   return v;
 }
 
+/// F paired frames of displacements from flattened (frame, vertex, xyz) vectors.
+data::PairedFrames<> frames_of(const std::vector<double>& lr, const std::vector<double>& hr, Index frames) {
+  data::PairedFrames<> p;
+  p.lowres = Eigen::Map<const data::FrameMatrix<>>(lr.data(), frames, Index(lr.size()) / std::max<Index>(frames, 1));
+  p.highres = Eigen::Map<const data::FrameMatrix<>>(hr.data(), frames, Index(hr.size()) / std::max<Index>(frames, 1));
+  for (Index f = 0; f < frames; ++f) p.ids.push_back(f);
+  p.controls.resize(frames, 0);
+  return p;
+}
+
 }  // namespace
 
 TEST_CASE("Ridge kernel form equals the primal ridge solution (fixed λ, no residual)") {
@@ -41,12 +51,11 @@ TEST_CASE("Ridge kernel form equals the primal ridge solution (fixed λ, no resi
     const Index m = 3 + trial % 4, frames = 5 + trial;
     auto problem = tiny_problem(m, rng);
     const auto lr = random_vector(std::size_t(frames * 12), rng), hr = random_vector(std::size_t(frames * m * 3), rng);
-    interp::RidgeOptions o;
+    interp::RidgeTrainOptions o;
     o.lambda = 0.05 * (1 + trial % 3);
-    o.residual = false;
-    interp::Ridge<> ridge(o);
-    ridge.fit(problem);
-    ridge.train(lr, hr, frames);
+    interp::Ridge<> ridge(interp::RidgeOptions{.residual = false});
+    ridge.fit(exec::seq, problem);
+    ridge.train(exec::seq, frames_of(lr, hr, frames), o);
     // Primal: W = (XcᵀXc + λI)⁻¹ XcᵀYc, λ absolute as the kernel form used it.
     Eigen::MatrixXd X = Eigen::Map<const Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(lr.data(), frames, 12);
     Eigen::MatrixXd Y = Eigen::Map<const Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(hr.data(), frames, m * 3);
@@ -57,7 +66,7 @@ TEST_CASE("Ridge kernel form equals the primal ridge solution (fixed λ, no resi
     const Eigen::MatrixXd W = (X.transpose() * X + lam * Eigen::MatrixXd::Identity(12, 12)).ldlt().solve(X.transpose() * Y);
     const auto x = random_vector(12, rng);
     Points<> in = Eigen::Map<const Points<>>(x.data(), 4, 3), out(m, 3);
-    ridge.apply(in, out);
+    ridge.apply(exec::seq, in, out);
     const Eigen::RowVectorXd primal = ym + (Eigen::Map<const Eigen::RowVectorXd>(x.data(), 12) - xm) * W;
     CHECK((Eigen::Map<const Eigen::RowVectorXd>(out.data(), m * 3) - primal).cwiseAbs().maxCoeff() < 1e-10);
   }
@@ -68,39 +77,39 @@ TEST_CASE("Ridge over Embedded recovers an exact linear residual; GCV and degree
   const Index m = 6, frames = 40;
   auto problem = tiny_problem(m, rng);
   interp::Embedded<> embedded;
-  embedded.fit(problem);
+  embedded.fit(exec::seq, problem);
   Eigen::MatrixXd A = Eigen::MatrixXd::Random(12, m * 3);  // the hidden linear residual map
   std::vector<double> lr = random_vector(std::size_t(frames * 12), rng), hr(std::size_t(frames * m * 3));
   Points<> in(4, 3), out(m, 3);
   for (Index f = 0; f < frames; ++f) {
     in = Eigen::Map<const Points<>>(lr.data() + f * 12, 4, 3);
-    embedded.apply(in, out);
+    embedded.apply(exec::seq, in, out);
     const Eigen::RowVectorXd r = Eigen::Map<const Eigen::RowVectorXd>(lr.data() + f * 12, 12) * A;
     for (Index o = 0; o < m * 3; ++o) hr[std::size_t(f * m * 3 + o)] = out.data()[o] + r[o];
   }
   interp::Ridge<> ridge;  // λ by GCV
-  ridge.fit(problem);
-  ridge.train(exec::omp, lr, hr, frames);
+  ridge.fit(exec::seq, problem);
+  ridge.train(exec::omp, frames_of(lr, hr, frames), {});
   CHECK(ridge.info().lambda_relative <= 1e-6);  // noiseless linear data: GCV wants almost no shrinkage
   for (int t = 0; t < 10; ++t) {
     const auto x = random_vector(12, rng);
     in = Eigen::Map<const Points<>>(x.data(), 4, 3);
     Points<> truth(m, 3), pred(m, 3), pred_omp(m, 3);
-    embedded.apply(in, truth);
+    embedded.apply(exec::seq, in, truth);
     const Eigen::RowVectorXd r = Eigen::Map<const Eigen::RowVectorXd>(x.data(), 12) * A;
     Eigen::Map<Eigen::RowVectorXd>(truth.data(), m * 3) += r;
-    ridge.apply(in, pred);
+    ridge.apply(exec::seq, in, pred);
     ridge.apply(exec::omp, in, pred_omp);
     CHECK((pred - truth).cwiseAbs().maxCoeff() < 1e-8);
     CHECK(pred == pred_omp);
   }
   CHECK(ridge.info().rank == 12);  // 40 frames of 12-dimensional inputs
   // Effective degrees of freedom against an explicit hat matrix, at a λ where (K+λI) is well conditioned.
-  interp::RidgeOptions o;
+  interp::RidgeTrainOptions o;
   o.lambda = 1e-2;
-  interp::Ridge<> fixed(o);
-  fixed.fit(problem);
-  fixed.train(lr, hr, frames);
+  interp::Ridge<> fixed;
+  fixed.fit(exec::seq, problem);
+  fixed.train(exec::seq, frames_of(lr, hr, frames), o);
   Eigen::MatrixXd X = Eigen::Map<const Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(lr.data(), frames, 12);
   X.rowwise() -= X.colwise().mean().eval();
   const Eigen::MatrixXd K = X * X.transpose();
@@ -116,12 +125,12 @@ TEST_CASE("Ridge errors") {
   auto problem = tiny_problem(3, rng);
   interp::Ridge<> ridge;
   Points<> in(4, 3), out(3, 3);
-  CHECK_THROWS_AS(ridge.train({}, {}, 2), ArgumentError);  // before fit
-  ridge.fit(problem);
-  CHECK_THROWS_AS(ridge.apply(in, out), ArgumentError);  // before train
-  CHECK_THROWS_AS(ridge.train(std::vector<double>(24), std::vector<double>(17), 2), ShapeError);
-  CHECK_THROWS_AS(ridge.train(std::vector<double>(12), std::vector<double>(9), 1), ArgumentError);
-  CHECK_THROWS_AS(ridge.train(std::vector<double>(24, 1.0), std::vector<double>(18, 1.0), 2), ArgumentError);  // identical inputs
+  CHECK_THROWS_AS(ridge.train(exec::seq, frames_of(std::vector<double>(24), std::vector<double>(18), 2), {}), ArgumentError);  // before fit
+  ridge.fit(exec::seq, problem);
+  CHECK_THROWS_AS(ridge.apply(exec::seq, in, out), ArgumentError);  // before train
+  CHECK_THROWS_AS(ridge.train(exec::seq, frames_of(std::vector<double>(24), std::vector<double>(24), 2), {}), ShapeError);
+  CHECK_THROWS_AS(ridge.train(exec::seq, frames_of(std::vector<double>(12), std::vector<double>(9), 1), {}), ArgumentError);
+  CHECK_THROWS_AS(ridge.train(exec::seq, frames_of(std::vector<double>(24, 1.0), std::vector<double>(18, 1.0), 2), {}), ArgumentError);  // identical inputs
 }
 
 TEST_CASE("Ridge on the bunny: held-out frames (every 4th) against Embedded") {
@@ -146,8 +155,8 @@ TEST_CASE("Ridge on the bunny: held-out frames (every 4th) against Embedded") {
     hr_train.insert(hr_train.end(), dh.data(), dh.data() + dh.size());
   }
   interp::Ridge<> ridge;
-  ridge.fit(problem);
-  ridge.train(exec::omp, lr_train, hr_train, frames - Index(test.size()));
+  ridge.fit(exec::seq, problem);
+  ridge.train(exec::omp, frames_of(lr_train, hr_train, frames - Index(test.size())), {});
   eval::ErrorAccumulator e_ridge(problem.hr.V), e_emb(problem.hr.V);
   Points<> dl(n, 3), out(m, 3);
   for (Index f : test) {
@@ -155,7 +164,7 @@ TEST_CASE("Ridge on the bunny: held-out frames (every 4th) against Embedded") {
     const Points<> truth = high.frame_points<double>(f);
     ridge.apply(exec::omp, dl, out);
     e_ridge.add_frame(problem.hr.V + out, truth);
-    ridge.base().apply(dl, out);
+    ridge.base().apply(exec::seq, dl, out);
     e_emb.add_frame(problem.hr.V + out, truth);
   }
   const auto r = e_ridge.relative_statistics(), b = e_emb.relative_statistics();

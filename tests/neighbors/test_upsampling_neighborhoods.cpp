@@ -33,7 +33,7 @@ Points<> bcc_inside(Index count, double a, double b, double c) {
 
 /// k nearest sources by running one Dijkstra per source (the reference), ties by source id.
 GeodesicSources reference_sources(const Points<>& V, const Tris& F, const IndexVector& src, Index k) {
-  const auto g = neighbors::detail::surface_edge_graph(V, F);
+  const auto g = neighbors::surface_edge_graph(V, F);
   std::vector<std::vector<double>> D;
   for (Index s = 0; s < src.size(); ++s) D.push_back(neighbors::detail::dijkstra(g, src[s]));
   GeodesicSources r;

@@ -112,6 +112,26 @@ class ConvergenceError : public Error {
   double residual_;
 };
 
+/// A computation produced a non-finite value where none may appear (a training loss, a gradient,
+/// a weight, a prediction): names what (`tensor`) and when (`step`, −1 when not in a loop).
+class NumericalError : public Error {
+ public:
+  NumericalError(const std::string& where, const std::string& tensor, std::int64_t step, double value)
+      : Error(format(where, tensor, step, value)), tensor_(tensor), step_(step) {}
+  const std::string& tensor() const noexcept { return tensor_; }
+  std::int64_t step() const noexcept { return step_; }
+
+ private:
+  static std::string format(const std::string& where, const std::string& tensor, std::int64_t step, double value) {
+    std::ostringstream s;
+    s << where << ": " << tensor << " is not finite (" << value << ')';
+    if (step >= 0) s << " at step " << step;
+    return s.str();
+  }
+  std::string tensor_;
+  std::int64_t step_;
+};
+
 /// A parameter is outside its valid range (negative k, activation outside [0,1], ...).
 class ArgumentError : public Error {
  public:

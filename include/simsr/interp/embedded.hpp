@@ -5,9 +5,8 @@
 /// the LR displacements of the 4 vertices of its tet. Reproduces any affine displacement field
 /// exactly (also at extrapolated points outside the LR mesh).
 ///
-///     interp::Embedded<> e;  e.fit(problem);                 // problem.lr: TetMesh, problem.hr: TriMesh
-///     e.apply(lr_displacement, hr_displacement);             // N×3 → M×3, no allocation
-///     e.apply(exec::omp, lr_displacement, hr_displacement);
+///     interp::Embedded<> e;  e.fit(exec::omp, problem);      // problem.lr: TetMesh, problem.hr: TriMesh
+///     e.apply(exec::omp, lr_displacement, hr_displacement);  // N×3 → M×3, no allocation
 
 #include <string>
 
@@ -15,28 +14,33 @@
 #include "../core/parallel.hpp"
 #include "../core/types.hpp"
 #include "../discretize/embedding.hpp"
+#include "concepts.hpp"
 #include "problem.hpp"
 
 namespace simsr::interp {
 
-/// Barycentric-embedding interpolator. `S` the scalar, `Policy` the execution policy of fit and
-/// of the policy-less apply. Satisfies interp::Interpolator.
-template <class S = Scalar, exec::HostPolicy Policy = exec::seq_t>
+/// Barycentric-embedding interpolator (S = double or float). Satisfies interp::Interpolator; apply
+/// is const and may run concurrently.
+template <class S = Scalar>
 class Embedded {
  public:
   using scalar_type = S;
-  using policy_type = Policy;
+  /// fit reads only the rest shapes.
+  static constexpr bool needs_neighborhoods = false;
 
   explicit Embedded(const EmbeddingOptions& options = {}) : options_(options) {}
 
   /// Embeds problem.hr.V (M×3) in problem.lr (tets over N vertices). Throws MeshError for an
   /// empty or degenerate LR mesh, ArgumentError for non-finite HR vertices.
-  void fit(UpsamplingProblem<S>& problem) { fit(problem.lr, problem.hr.V); }
+  template <exec::HostPolicy Policy>
+  void fit(Policy policy, UpsamplingProblem<S>& problem) {
+    fit(policy, problem.lr, problem.hr.V);
+  }
 
   /// Embeds the points `hr_rest` (M×3) in the tet mesh `lr_rest`.
-  template <class DQ>
-  void fit(const TetMesh<S>& lr_rest, const Eigen::MatrixBase<DQ>& hr_rest) {
-    embedding_ = embed(Policy{}, lr_rest, hr_rest, options_);
+  template <exec::HostPolicy Policy, class DQ>
+  void fit(Policy policy, const TetMesh<S>& lr_rest, const Eigen::MatrixBase<DQ>& hr_rest) {
+    embedding_ = embed(policy, lr_rest, hr_rest, options_);
     const Index m = embedding_.size();
     ids_.resize(m, 4);
     for (Index q = 0; q < m; ++q) ids_.row(q) = lr_rest.T.row(embedding_.tet[q]);
@@ -61,12 +65,6 @@ class Embedded {
     });
   }
 
-  /// apply under the class's policy.
-  template <class DI, class DO>
-  void apply(const Eigen::MatrixBase<DI>& lr_displacement, Eigen::MatrixBase<DO>& hr_displacement) const {
-    apply(Policy{}, lr_displacement, hr_displacement);
-  }
-
   /// N, the LR vertex count fitted on (0 before fit).
   Index num_lr() const { return num_lr_; }
   /// M, the HR vertex count fitted on (0 before fit).
@@ -82,5 +80,8 @@ class Embedded {
   Tets ids_;
   Index num_lr_ = 0;
 };
+
+static_assert(assert_interpolator<Embedded<double>>());
+static_assert(assert_interpolator<Embedded<float>>());
 
 }  // namespace simsr::interp

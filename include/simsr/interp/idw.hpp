@@ -5,8 +5,8 @@
 /// one choice of w_ij in §3.2).
 ///
 ///     interp::UpsamplingProblem<> p{lr_rest, hr_rest};
-///     p.ensure_neighborhoods(20);
-///     interp::IDW<> idw;  idw.fit(p);
+///     p.ensure_neighborhoods(exec::omp, 20);
+///     interp::IDW<> idw;  idw.fit(exec::omp, p);
 ///     idw.apply(exec::omp, lr_displacement, hr_displacement);   // N×3 → M×3
 
 #include <algorithm>
@@ -32,13 +32,16 @@ template <class S = Scalar>
 class IDW {
  public:
   using scalar_type = S;
+  /// fit reads problem.neighborhoods.
+  static constexpr bool needs_neighborhoods = true;
 
   IDW() = default;
   explicit IDW(IDWOptions options) : options_(options) {}
 
   /// Weights from the first k neighbours of `problem.neighborhoods` (must be present).
   /// ArgumentError for p ≤ 0 or missing/too small neighbourhoods, ShapeError for a size mismatch.
-  void fit(UpsamplingProblem<S>& problem) {
+  template <exec::HostPolicy Policy>
+  void fit(Policy, UpsamplingProblem<S>& problem) {  // O(M·k): sequential under any policy
     if (!(options_.power > 0)) throw ArgumentError("IDW: power p = " + std::to_string(options_.power) + " must be > 0");
     const auto& nb = detail::neighborhoods_for(problem, options_.k, "IDW");
     const Index m = problem.num_hr(), k = options_.k;
@@ -67,9 +70,6 @@ class IDW {
   void apply(Policy policy, const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
     detail::check_apply_shapes("IDW::apply", n_, num_hr(), lr_displacement, hr_displacement);
     gather_.apply(policy, lr_displacement, hr_displacement);
-  }
-  void apply(const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
-    apply(exec::seq, lr_displacement, hr_displacement);
   }
 
   Index num_lr() const { return n_; }

@@ -13,7 +13,7 @@
 /// fit() computes the α once (M×3×k, resp. M×k); apply() is a sparse gather, no solve per frame.
 ///
 ///     interp::MLS<> mls;            // as written: r = 2, per coordinate
-///     mls.fit(problem);             // problem.neighborhoods present (k ≥ 20)
+///     mls.fit(exec::omp, problem);            // problem.neighborhoods present (k ≥ 20)
 ///     mls.apply(exec::omp, lr_displacement, hr_displacement);
 
 #include <algorithm>
@@ -68,6 +68,8 @@ template <class S = Scalar>
 class MLS {
  public:
   using scalar_type = S;
+  /// fit reads problem.neighborhoods.
+  static constexpr bool needs_neighborhoods = true;
 
   MLS() = default;
   explicit MLS(MLSOptions options) : options_(options) {}
@@ -117,7 +119,6 @@ class MLS {
     }
     n_ = problem.num_lr();
   }
-  void fit(UpsamplingProblem<S>& problem) { fit(exec::seq, problem); }
 
   /// hr_displacement (M×3, caller-sized) from lr_displacement (N×3): Δx_j^H = Σ_k α_jk ΔX_k^L
   /// (Eq. 16 per component). ShapeError for wrong sizes.
@@ -125,9 +126,6 @@ class MLS {
   void apply(Policy policy, const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
     detail::check_apply_shapes("MLS::apply", n_, num_hr(), lr_displacement, hr_displacement);
     gather_.apply(policy, lr_displacement, hr_displacement);
-  }
-  void apply(const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
-    apply(exec::seq, lr_displacement, hr_displacement);
   }
 
   Index num_lr() const { return n_; }

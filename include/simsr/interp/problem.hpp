@@ -5,7 +5,7 @@
 ///
 ///     interp::UpsamplingProblem<> p{lr_rest, hr_rest};          // neighbourhoods computed on demand
 ///     p.neighborhoods = neighbors::load_upsampling_neighborhoods("N.npz");   // or reuse saved ones
-///     interp::MLS<> mls;  mls.fit(p);  mls.apply(lr_displacement, hr_displacement);
+///     interp::MLS<> mls;  mls.fit(exec::omp, p);  mls.apply(exec::omp, lr_displacement, hr_displacement);
 
 #include <memory>
 #include <optional>
@@ -15,6 +15,8 @@
 #include "../core/types.hpp"
 #include "../mesh/tet_mesh.hpp"
 #include "../mesh/tri_mesh.hpp"
+#include "../data/network_neighborhoods.hpp"
+#include "../neighbors/geodesic_knn.hpp"
 #include "../neighbors/upsampling_neighborhoods.hpp"
 
 namespace simsr::interp {
@@ -27,14 +29,34 @@ struct UpsamplingProblem {
   TriMesh<S> hr;
   /// §3.2 neighbourhoods (M×k LR ids with geodesic distances); filled by `ensure_neighborhoods`.
   std::optional<neighbors::UpsamplingNeighborhoods> neighborhoods;
+  /// N×k LR geodesic graph (self first): the first EdgeConv's graph of the network (§3.1);
+  /// filled by `ensure_lr_graph` or from files by `use`.
+  std::optional<data::NeighborIndices> lr_graph;
+
+  /// Takes both neighbourhood sets from a network-neighbourhood source (the authors' files,
+  /// `simsr neighbors`, or computed), checked against this problem's sizes.
+  void use(const data::NetworkNeighborhoods& nb) {
+    data::check_network_neighborhoods(nb, num_lr(), num_hr());
+    neighborhoods = nb.upsampling;
+    lr_graph = nb.lr_graph;
+  }
+
+  /// The LR graph with at least k columns, computed (geodesic kNN over the LR mesh edges) if absent.
+  template <exec::HostPolicy Policy>
+  const data::NeighborIndices& ensure_lr_graph(Policy policy, Index k) {
+    if (!lr_graph) lr_graph = neighbors::geodesic_knn(policy, lr.V, lr.T, k).indices;
+    if (lr_graph->rows() != num_lr() || lr_graph->cols() < k)
+      throw ShapeError("upsampling problem: LR graph (N×≥k)", {num_lr(), k}, {lr_graph->rows(), lr_graph->cols()});
+    return *lr_graph;
+  }
 
   Index num_lr() const { return lr.num_vertices(); }
   Index num_hr() const { return hr.num_vertices(); }
 
   /// The neighbourhoods, computed with k neighbours (assignment + k-label Dijkstra) if absent.
   /// Throws ArgumentError when saved ones have a different k or size than asked.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  const neighbors::UpsamplingNeighborhoods& ensure_neighborhoods(Index k = 20, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  const neighbors::UpsamplingNeighborhoods& ensure_neighborhoods(Policy policy, Index k = 20) {
     if (!neighborhoods) {
       neighbors::UpsamplingOptions o;
       o.k = k;

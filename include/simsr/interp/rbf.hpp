@@ -32,7 +32,7 @@
 ///    frame, then the sparse Φ_HL product. Needs σ small against the mesh (the default is).
 ///
 ///     interp::RBF<> rbf;                      // geodesic, σ = mapped-centre spacing, no tail
-///     rbf.fit(problem);                       // problem.neighborhoods (with lr_to_hr), hr.F present
+///     rbf.fit(exec::omp, problem);                       // problem.neighborhoods (with lr_to_hr), hr.F present
 ///     rbf.apply(exec::omp, lr_displacement, hr_displacement);
 
 #include <algorithm>
@@ -117,6 +117,8 @@ template <class S = Scalar>
 class RBF {
  public:
   using scalar_type = S;
+  /// fit reads problem.neighborhoods.
+  static constexpr bool needs_neighborhoods = true;
 
   RBF() = default;
   explicit RBF(RBFOptions options) : options_(options) {}
@@ -143,10 +145,10 @@ class RBF {
     if (n_ < 1) throw ArgumentError("RBF: no LR vertices");
     info_ = {};
     std::span<const VIndex> lr_to_hr;
-    neighbors::detail::WeightedGraph surface_graph;
+    neighbors::WeightedGraph surface_graph;
     if (surface) {
       lr_to_hr = checked_lr_to_hr(problem);
-      surface_graph = neighbors::detail::surface_edge_graph(H, problem.hr.F);
+      surface_graph = neighbors::surface_edge_graph(H, problem.hr.F);
     }
     if (o.sigma > 0) {
       info_.sigma = o.sigma;
@@ -320,7 +322,6 @@ class RBF {
     work_.setZero(np, 3);
     weights_.setZero(np, 3);
   }
-  void fit(UpsamplingProblem<S>& problem) { fit(exec::seq, problem); }
 
   /// hr_displacement (M×3, caller-sized) from lr_displacement (N×3), Eq. 10–11. ShapeError for
   /// wrong sizes.
@@ -359,9 +360,6 @@ class RBF {
         for (int c = 0; c < 3; ++c) a[c] += double(poly[j * p + q]) * w[c * ld + n + q];
       for (int c = 0; c < 3; ++c) y[3 * j + c] = S(a[c]);
     });
-  }
-  void apply(const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
-    apply(exec::seq, lr_displacement, hr_displacement);
   }
 
   Index num_lr() const { return n_; }

@@ -13,13 +13,14 @@
 /// so fit stores X, Y and the F×F inverse, and apply costs O(F·(N + M)) per frame.
 /// λ is chosen by generalized cross-validation (GCV) over a log grid unless given.
 ///
-///     interp::Ridge<> ridge;                       // residual over interp::Embedded<>
-///     ridge.fit(problem);                           // the base interpolator's fit
-///     ridge.train(exec::omp, lowres_disp, highres_disp);   // F×N×3 and F×M×3 displacements
+///     interp::Ridge<> ridge;                                    // residual over interp::Embedded<>
+///     ridge.fit(exec::omp, problem);                            // the base interpolator's fit
+///     ridge.train(exec::omp, data::displacements(train, lr.V, hr.V), {});   // λ by GCV
 ///     ridge.apply(exec::omp, lr_displacement, hr_displacement);
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -28,13 +29,21 @@
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
 #include "../core/types.hpp"
+#include "../data/paired_frames.hpp"
+#include "concepts.hpp"
 #include "embedded.hpp"
 #include "problem.hpp"
 
 namespace simsr::interp {
 
-/// Options of Ridge.
+/// What the model is.
 struct RidgeOptions {
+  /// true: learn the residual over the base interpolator (SPEC §6); false: learn Δx^H itself.
+  bool residual = true;
+};
+
+/// How train chooses λ.
+struct RidgeTrainOptions {
   /// λ of the ridge penalty (in units of K's mean eigenvalue, so it is scale-free); < 0: by GCV.
   double lambda = -1;
   /// GCV grid: λ/mean eigenvalue from 10^lo to 10^hi, `steps` points.
@@ -42,8 +51,6 @@ struct RidgeOptions {
   int gcv_steps = 57;
   /// Eigenvalues of the frame kernel K below this fraction of the largest are treated as zero.
   double rank_tolerance = 1e-10;
-  /// true: learn the residual over the base interpolator (SPEC §6); false: learn Δx^H itself.
-  bool residual = true;
 };
 
 /// What training chose.
@@ -56,40 +63,49 @@ struct RidgeTrainInfo {
   Index rank = 0;             ///< eigenvalues of K kept (numerical rank of the centred inputs)
 };
 
-/// Ridge regression over a base interpolator. `Base` is any interp::Interpolator (default Embedded).
+/// Ridge regression over a base interpolator. `Base` is any interp::Interpolator of the same
+/// scalar (default Embedded). Satisfies interp::TrainableInterpolator.
 template <class S = Scalar, class Base = Embedded<S>>
 class Ridge {
+  static_assert(assert_interpolator<Base>());
+  static_assert(std::is_same_v<typename Base::scalar_type, S>, "interp::Ridge<S, Base>: Base must interpolate the same scalar type S");
+
  public:
   using scalar_type = S;
+  using train_options = RidgeTrainOptions;
   using Matrix = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  /// fit is the base's fit.
+  static constexpr bool needs_neighborhoods = needs_neighborhoods_v<Base>;
 
   Ridge() = default;
   explicit Ridge(RidgeOptions options, Base base = Base{}) : options_(options), base_(std::move(base)) {}
 
   /// Fits the base interpolator on the rest shapes; train() must follow before apply().
-  void fit(UpsamplingProblem<S>& problem) {
-    base_.fit(problem);
+  template <exec::HostPolicy Policy>
+  void fit(Policy policy, UpsamplingProblem<S>& problem) {
+    base_.fit(policy, problem);
     n_ = problem.num_lr();
     m_ = problem.num_hr();
     trained_ = false;
   }
 
-  /// Trains on F frames: `lr` F×N×3 and `hr` F×M×3 displacements from the rest shapes, flattened
-  /// row-major (frame, vertex, xyz) as in the frames .npz files.
+  /// Trains on F paired frames of displacements from the fitted rest shapes (data::displacements).
   template <exec::HostPolicy Policy>
-  void train(Policy policy, const std::vector<S>& lr, const std::vector<S>& hr, Index frames) {
+  void train(Policy policy, const data::PairedFrames<S>& frames_in, const RidgeTrainOptions& train_options) {
     if (n_ == 0 || m_ == 0) throw ArgumentError("Ridge::train before fit");
+    const Index frames = frames_in.num_frames();
     if (frames < 2) throw ArgumentError("Ridge::train needs at least 2 frames, got " + std::to_string(frames));
-    if (Index(lr.size()) != frames * n_ * 3) throw ShapeError("Ridge::train: LR displacements", {frames, n_, 3}, {Index(lr.size())});
-    if (Index(hr.size()) != frames * m_ * 3) throw ShapeError("Ridge::train: HR displacements", {frames, m_, 3}, {Index(hr.size())});
-    const Index din = 3 * n_, dout = 3 * m_;
-    X_ = Eigen::Map<const Matrix>(lr.data(), frames, din);
-    Y_ = Eigen::Map<const Matrix>(hr.data(), frames, dout);
+    if (frames_in.num_lr() != n_) throw ShapeError("Ridge::train: LR displacements", {frames, n_, 3}, {frames, frames_in.num_lr(), 3});
+    if (frames_in.num_hr() != m_) throw ShapeError("Ridge::train: HR displacements", {frames, m_, 3}, {frames, frames_in.num_hr(), 3});
+    const auto& options = train_options;
+    const Index dout = 3 * m_;
+    X_ = frames_in.lowres;
+    Y_ = frames_in.highres;
     if (!X_.allFinite() || !Y_.allFinite()) throw ArgumentError("Ridge::train: non-finite displacements");
     if (options_.residual) {
       Points<S> in(n_, 3), out(m_, 3);
       for (Index f = 0; f < frames; ++f) {  // residual over the base interpolator
-        in = Eigen::Map<const Points<S>>(lr.data() + f * din, n_, 3);
+        in = frames_in.lr(f);
         base_.apply(policy, in, out);
         Y_.row(f) -= Eigen::Map<const Eigen::Matrix<S, 1, Eigen::Dynamic>>(out.data(), dout);
       }
@@ -109,7 +125,7 @@ class Ridge {
     // eigenvectors are dropped from G (exact: X(x − x̄) has no component there).
     const double s_max = std::max(eig.eigenvalues().maxCoeff(), 0.0);
     Eigen::VectorXd s = eig.eigenvalues();
-    Eigen::VectorXd keep = (s.array() > options_.rank_tolerance * s_max).template cast<double>();
+    Eigen::VectorXd keep = (s.array() > options.rank_tolerance * s_max).template cast<double>();
     s = s.cwiseProduct(keep);
     const double mean_eig = s.sum() / double(frames);
     if (!(mean_eig > 0)) throw ArgumentError("Ridge::train: all LR training displacements are identical");
@@ -129,12 +145,12 @@ class Ridge {
       return denom > 0 ? double(frames) * rss / (denom * denom * double(dout)) : std::numeric_limits<double>::infinity();
     };
     double lam = 0, best = std::numeric_limits<double>::infinity(), dof = 0;
-    if (options_.lambda >= 0) {
-      lam = options_.lambda * mean_eig;
+    if (options.lambda >= 0) {
+      lam = options.lambda * mean_eig;
       best = gcv(lam, dof);
     } else {
-      for (int k = 0; k < options_.gcv_steps; ++k) {
-        const double t = options_.gcv_log10_lo + (options_.gcv_log10_hi - options_.gcv_log10_lo) * k / std::max(1, options_.gcv_steps - 1);
+      for (int k = 0; k < options.gcv_steps; ++k) {
+        const double t = options.gcv_log10_lo + (options.gcv_log10_hi - options.gcv_log10_lo) * k / std::max(1, options.gcv_steps - 1);
         double d = 0;
         const double g = gcv(std::pow(10.0, t) * mean_eig, d);
         if (g < best) best = g, lam = std::pow(10.0, t) * mean_eig, dof = d;
@@ -150,9 +166,6 @@ class Ridge {
     alpha_.resize(frames);
     trained_ = true;
   }
-
-  /// train() under exec::seq.
-  void train(const std::vector<S>& lr, const std::vector<S>& hr, Index frames) { train(exec::seq, lr, hr, frames); }
 
   /// Δx^H = base(x) + ȳ + Yᵀ G X (x − x̄) for one frame (N×3 → M×3). Not thread-safe per object
   /// (F-sized scratch vectors are reused; nothing is allocated).
@@ -181,10 +194,6 @@ class Ridge {
     });
   }
 
-  void apply(const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
-    apply(exec::seq, lr_displacement, hr_displacement);
-  }
-
   Index num_lr() const { return n_; }
   Index num_hr() const { return m_; }
   const RidgeTrainInfo& info() const { return info_; }
@@ -200,5 +209,8 @@ class Ridge {
   mutable Eigen::Matrix<S, Eigen::Dynamic, 1> kx_, alpha_;
   RidgeTrainInfo info_;
 };
+
+static_assert(assert_trainable_interpolator<Ridge<double>>());
+static_assert(assert_trainable_interpolator<Ridge<float>>());
 
 }  // namespace simsr::interp

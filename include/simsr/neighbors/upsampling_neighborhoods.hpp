@@ -50,7 +50,7 @@ GeodesicSources geodesic_k_nearest_sources(const Eigen::MatrixBase<DV>& V, const
     if (source_vertex[s] < 0 || source_vertex[s] >= nv)
       throw ArgumentError("geodesic_k_nearest_sources: source " + std::to_string(s) + " at vertex " +
                           std::to_string(source_vertex[s]) + " outside [0, " + std::to_string(nv) + ")");
-  const detail::WeightedGraph g = detail::surface_edge_graph(V, F);
+  const WeightedGraph g = surface_edge_graph(V, F);
   GeodesicSources out;
   out.indices.resize(nv, k);
   out.distances.resize(nv, k);

@@ -20,7 +20,7 @@
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
 #include "../../mesh/topology.hpp"
-#include "../../neighbors/detail/dijkstra_k_nearest_sources.hpp"
+#include "../../neighbors/surface_graph.hpp"
 
 namespace simsr::interp::detail {
 
@@ -113,11 +113,11 @@ void geodesic_rows(Policy policy, const RbfEdgeGraph& g, double radius, Sink&& s
 }
 
 /// For every LR vertex s (mapped onto HR vertex `lr_to_hr[s]`), the HR vertices within geodesic
-/// distance `radius` over the HR surface edge graph g (neighbors::detail::surface_edge_graph,
+/// distance `radius` over the HR surface edge graph g (neighbors::surface_edge_graph,
 /// rest lengths) and their distances, handed to `sink(s, row)` as dijkstra_rows does. These are
 /// the single-source distances the §3.2 neighbourhoods hold, bit for bit.
 template <exec::HostPolicy Policy, class Sink>
-void surface_rows(Policy policy, const neighbors::detail::WeightedGraph& g, std::span<const VIndex> lr_to_hr,
+void surface_rows(Policy policy, const neighbors::WeightedGraph& g, std::span<const VIndex> lr_to_hr,
                   double radius, Sink&& sink) {
   dijkstra_rows(policy, g, g.weights, Index(lr_to_hr.size()), [&](Index s) { return lr_to_hr[std::size_t(s)]; },
                 radius, sink);
@@ -128,7 +128,7 @@ void surface_rows(Policy policy, const neighbors::detail::WeightedGraph& g, std:
 /// search stops at the first other mapped vertex; a source that reaches none is skipped. 0 when
 /// no source reaches another.
 template <exec::HostPolicy Policy>
-double mean_nearest_source_distance(Policy policy, const neighbors::detail::WeightedGraph& g,
+double mean_nearest_source_distance(Policy policy, const neighbors::WeightedGraph& g,
                                     std::span<const VIndex> lr_to_hr) {
   const Index ns = Index(lr_to_hr.size()), nv = g.num_vertices();
   std::vector<char> mapped(static_cast<std::size_t>(nv), 0);

@@ -1,0 +1,120 @@
+#pragma once
+/// \file
+/// One function evaluates any interpolator on paired frames (SPEC §8; the paper's Table 1, Fig. 5):
+///
+///     interp::UpsamplingProblem<> problem{lr, hr, {}};
+///     interp::MLS<> mls;
+///     auto r = eval::run_method(exec::omp, mls, problem, train, test);   // fit (+ train) + evaluate
+///     auto r = eval::evaluate(exec::omp, fitted_method, lr.V, hr.V, test);   // a method already fitted
+///     r.errors.statistics();  r.errors.relative_statistics();  r.errors.frame_means();  r.seconds_per_frame;
+///
+/// Swapping the method is one type change: Embedded, IDW, RBF, MLS, Ridge, the β-VAE and the
+/// network (interp::Learned) all go through the same code. `train` and `test` are frames of
+/// absolute positions (as the files store them); the displacements every method consumes are
+/// taken from the problem's rest shapes here.
+
+#include <chrono>
+#include <functional>
+#include <string>
+#include <utility>
+
+#include "../core/error.hpp"
+#include "../core/parallel.hpp"
+#include "../data/paired_frames.hpp"
+#include "../interp/concepts.hpp"
+#include "error_statistics.hpp"
+
+namespace simsr::eval {
+
+/// What evaluate measured.
+struct Evaluation {
+  ErrorAccumulator errors;         ///< per-vertex errors of every frame: statistics, frame means, the last frame's errors
+  VecX<double> vertex_mean_error;  ///< M: each HR vertex's error averaged over the frames (a heatmap)
+  double seconds_per_frame = 0;    ///< wall time of apply per frame (warm: the first frame is timed too)
+  double fit_seconds = 0, train_seconds = 0;  ///< filled by run_method
+};
+
+/// Called with (frame row, predicted HR positions M×3) after every frame, e.g. to keep predictions.
+using FrameCallback = std::function<void(Index, const Points<Scalar>&)>;
+
+/// Applies the fitted `method` to every frame of `test` (absolute positions; LR and HR rest
+/// shapes give the displacements) and compares the predicted HR positions with test's highres.
+/// ShapeError when the sizes differ from the method's; ArgumentError (naming the frame) for a
+/// non-finite prediction.
+template <exec::HostPolicy Policy, interp::Interpolator I>
+Evaluation evaluate(Policy policy, const I& method, const Points<Scalar>& lr_rest, const Points<Scalar>& hr_rest,
+                    const data::PairedFrames<Scalar>& test, const FrameCallback& on_frame = {}) {
+  const Index n = lr_rest.rows(), m = hr_rest.rows();
+  if (method.num_lr() != n || method.num_hr() != m)
+    throw ShapeError("eval::evaluate: method fitted on (N, M)", {n, m}, {method.num_lr(), method.num_hr()});
+  if (test.num_lr() != n || test.num_hr() != m) throw ShapeError("eval::evaluate: test frames (N, M)", {n, m}, {test.num_lr(), test.num_hr()});
+  if (test.num_frames() < 1) throw ArgumentError("eval::evaluate: no test frames");
+  Evaluation r{ErrorAccumulator(hr_rest), VecX<double>::Zero(m)};
+  Points<Scalar> lr_disp(n, 3), hr_disp(m, 3), predicted(m, 3);
+  double seconds = 0;
+  for (Index f = 0; f < test.num_frames(); ++f) {
+    lr_disp = test.lr(f) - lr_rest;
+    const auto t0 = std::chrono::steady_clock::now();
+    method.apply(policy, lr_disp, hr_disp);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    predicted = hr_rest + hr_disp;
+    if (!predicted.allFinite()) throw ArgumentError("eval::evaluate: frame " + std::to_string(test.ids[std::size_t(f)]) + ": the prediction is not finite");
+    r.errors.add_frame(predicted, test.hr(f));
+    r.vertex_mean_error += r.errors.last_frame_errors() / double(test.num_frames());
+    if (on_frame) on_frame(f, predicted);
+  }
+  r.seconds_per_frame = seconds / double(test.num_frames());
+  return r;
+}
+
+namespace detail {
+/// fit (neighbourhoods first when needed), then `train_step()`, then evaluate; times each phase.
+template <class Policy, class I, class Train>
+Evaluation fit_train_evaluate(Policy policy, I& method, interp::UpsamplingProblem<typename I::scalar_type>& problem,
+                              const data::PairedFrames<Scalar>& test, const FrameCallback& on_frame, Train&& train_step) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  if constexpr (interp::needs_neighborhoods_v<I>)
+    if (!problem.neighborhoods) problem.ensure_neighborhoods(policy);
+  method.fit(policy, problem);
+  const auto t1 = clock::now();
+  train_step();
+  const auto t2 = clock::now();
+  Evaluation r = evaluate(policy, std::as_const(method), problem.lr.V, problem.hr.V, test, on_frame);
+  r.fit_seconds = std::chrono::duration<double>(t1 - t0).count();
+  r.train_seconds = std::chrono::duration<double>(t2 - t1).count();
+  return r;
+}
+
+inline void require_training_frames(const data::PairedFrames<Scalar>& train) {
+  if (train.num_frames() < 1) throw ArgumentError("eval::run_method: this method learns from frames, and no training frame is given");
+}
+}  // namespace detail
+
+/// Fits `method` on the problem (computing the §3.2 neighbourhoods first when the method needs
+/// them and the problem has none), trains it on `train` with its default options when it learns
+/// from frames, then evaluates it on `test`. Frames are absolute positions.
+template <exec::HostPolicy Policy, interp::Interpolator I>
+Evaluation run_method(Policy policy, I& method, interp::UpsamplingProblem<typename I::scalar_type>& problem,
+                      const data::PairedFrames<Scalar>& train, const data::PairedFrames<Scalar>& test,
+                      const FrameCallback& on_frame = {}) {
+  return detail::fit_train_evaluate(policy, method, problem, test, on_frame, [&] {
+    if constexpr (interp::TrainableInterpolator<I>) {
+      detail::require_training_frames(train);
+      method.train(policy, data::displacements(train, problem.lr.V, problem.hr.V), typename I::train_options{});
+    }
+  });
+}
+
+/// run_method with the training options given (a TrainableInterpolator).
+template <exec::HostPolicy Policy, interp::TrainableInterpolator I>
+Evaluation run_method(Policy policy, I& method, interp::UpsamplingProblem<typename I::scalar_type>& problem,
+                      const data::PairedFrames<Scalar>& train, const data::PairedFrames<Scalar>& test,
+                      const typename I::train_options& options, const FrameCallback& on_frame = {}) {
+  return detail::fit_train_evaluate(policy, method, problem, test, on_frame, [&] {
+    detail::require_training_frames(train);
+    method.train(policy, data::displacements(train, problem.lr.V, problem.hr.V), options);
+  });
+}
+
+}  // namespace simsr::eval
