@@ -90,7 +90,7 @@ TEST_CASE("β-VAE baseline: a diverging run stops at the step and tensor that we
     v.train(exec::seq, s.frames, {.epochs = 50, .lr = 1e30});
   } catch (const NumericalError& e) {
     named = e.step() >= 1 && !e.tensor().empty();
-    MESSAGE("diverging β-VAE: " << e.what());
+    MESSAGE("diverging β-VAE: " << std::string(e.what()));
   }
   CHECK(named);
 }

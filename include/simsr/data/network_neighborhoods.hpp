@@ -53,7 +53,12 @@ inline io::NpyArray read_matrix_npy(const std::filesystem::path& p, Index rows) 
   return a;
 }
 
+}  // namespace detail
+
+/// Throws (naming nb.source) unless the neighbourhoods fit N LR and M HR vertices: shapes, every
+/// index within its range, distances finite and non-negative.
 inline void check_network_neighborhoods(const NetworkNeighborhoods& nb, Index num_lr, Index num_hr) {
+  using detail::check_ids;
   const auto& up = nb.upsampling;
   check_ids(nb.source + ": upsampling indices (M×upK)", up.indices, num_hr, num_lr);
   if (up.distances.rows() != num_hr || up.distances.cols() != up.indices.cols())
@@ -62,7 +67,6 @@ inline void check_network_neighborhoods(const NetworkNeighborhoods& nb, Index nu
     throw ArgumentError(nb.source + ": upsampling distances must be finite and non-negative");
   check_ids(nb.source + ": LR graph (N×k)", nb.lr_graph, num_lr, num_lr);
 }
-}  // namespace detail
 
 /// The authors' files in `dir`: geo_dist_surf2tet_idx.npy (M×K ids), geo_dist_surf2tet.npy (M×K
 /// distances) and geo_dist_tet2tet_idx.npy (N×K LR graph), as shipped with the bunny example.
@@ -72,7 +76,7 @@ inline NetworkNeighborhoods read_official_neighborhoods(const std::filesystem::p
   nb.upsampling.indices = detail::read_matrix_npy(dir / "geo_dist_surf2tet_idx.npy", num_hr).to_matrix<VIndex>();
   nb.upsampling.distances = detail::read_matrix_npy(dir / "geo_dist_surf2tet.npy", num_hr).to_matrix<double>();
   nb.lr_graph = detail::read_matrix_npy(dir / "geo_dist_tet2tet_idx.npy", num_lr).to_matrix<VIndex>();
-  detail::check_network_neighborhoods(nb, num_lr, num_hr);
+  check_network_neighborhoods(nb, num_lr, num_hr);
   return nb;
 }
 
@@ -119,7 +123,7 @@ inline NetworkNeighborhoods read_network_neighborhoods(const std::filesystem::pa
   if (z.contains("lr_distances")) nb.lr_distances = z.read("lr_distances").to_matrix<double>();
   if (nb.upsampling.lr_to_hr.size() != num_lr)
     throw ShapeError(file.string() + ": lr_to_hr (one HR vertex per LR vertex)", {num_lr}, {nb.upsampling.lr_to_hr.size()});
-  detail::check_network_neighborhoods(nb, num_lr, num_hr);
+  check_network_neighborhoods(nb, num_lr, num_hr);
   return nb;
 }
 
