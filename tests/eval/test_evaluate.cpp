@@ -1,10 +1,15 @@
+#include <simsr/eval/comparison.hpp>
 #include <simsr/eval/evaluate.hpp>
+#include <simsr/eval/training_history.hpp>
+#include <simsr/io/npy.hpp>
 #include <simsr/interp/embedded.hpp>
 #include <simsr/interp/ridge.hpp>
 #include <simsr/mesh/generators.hpp>
 
 #include <doctest/doctest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <string>
 
@@ -125,4 +130,54 @@ TEST_CASE("evaluate: a non-finite prediction and mismatched sizes are errors nam
   other.frames.highres.conservativeResize(2, other.frames.highres.cols() - 3);
   CHECK_THROWS_AS(eval::evaluate(exec::seq, e, s.problem.lr.V, s.problem.hr.V, other.frames), ShapeError);
   CHECK_THROWS_AS(eval::evaluate(exec::seq, e, s.problem.lr.V, s.problem.hr.V, s.frames.select(std::vector<Index>{})), ArgumentError);
+}
+
+TEST_CASE("MethodComparison: Table 1, frame-wise errors and heatmaps for every method added") {
+  auto s = affine_scene(5, 6);
+  std::mt19937 rng(2);
+  std::normal_distribution<double> g(0.0, 0.01);
+  for (Index i = 0; i < s.frames.highres.size(); ++i) s.frames.highres.data()[i] += g(rng);
+  interp::Embedded<> e;
+  interp::Ridge<> r;
+  eval::MethodComparison table(s.problem.hr.V, s.problem.hr.F, s.frames);
+  const auto& ee = table.add("embedded", eval::run_method(exec::seq, e, s.problem, s.frames, s.frames));
+  CHECK(ee.vertex_errors.rows() == 5);
+  table.add("ridge", eval::run_method(exec::seq, r, s.problem, s.frames, s.frames));
+  CHECK_THROWS_AS(table.add("ridge", eval::evaluate(exec::seq, r, s.problem.lr.V, s.problem.hr.V, s.frames)), ArgumentError);
+  const auto dir = std::filesystem::path(SIMSR_TEST_TMP_DIR) / "comparison";
+  std::filesystem::remove_all(dir);
+  table.write(dir);
+  for (const char* f : {"statistics.csv", "frame_errors.csv", "frame_errors.svg", "heatmaps.pvd", "heatmaps/heatmaps_000004.vtu"})
+    CHECK_MESSAGE(std::filesystem::exists(dir / f), f);
+  std::ifstream csv(dir / "frame_errors.csv");
+  std::string header, first;
+  std::getline(csv, header);
+  std::getline(csv, first);
+  CHECK(header == "frame,embedded,ridge");
+  CHECK(first.rfind("100,", 0) == 0);  // frame ids, not positions
+  const auto stats = table.statistics();
+  REQUIRE(stats.size() == 2);
+  CHECK(stats[1].mean < stats[0].mean);  // ridge learns the noise-free part at least as well
+}
+
+TEST_CASE("training history: one CSV row per epoch, relative errors divided by the diagonal, plots") {
+  std::vector<nn::EpochReport> h(3);
+  for (int i = 0; i < 3; ++i) {
+    h[std::size_t(i)].epoch = i + 1;
+    h[std::size_t(i)].steps = 10 * (i + 1);
+    h[std::size_t(i)].loss = 1.0 / (i + 1);
+    h[std::size_t(i)].holdout_mean_error = i == 1 ? -1 : 0.5 / (i + 1);  // epoch 2 not evaluated
+  }
+  const auto dir = std::filesystem::path(SIMSR_TEST_TMP_DIR) / "history";
+  std::filesystem::remove_all(dir);
+  eval::write_training_history(dir, h, 2.0, 0.4);
+  std::ifstream csv(dir / "training_history.csv");
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(csv, l);) lines.push_back(l);
+  REQUIRE(lines.size() == 4);
+  CHECK(lines[1].substr(lines[1].size() - 12) == "0.5,0.25,0.2");  // raw 0.5, 0.5 / 2.0, the baseline 0.4 / 2.0
+  CHECK(lines[2].find(",,,0.2") != std::string::npos);                  // no held-out error in epoch 2
+  CHECK(std::filesystem::exists(dir / "training_loss.svg"));
+  CHECK(std::filesystem::exists(dir / "holdout_error.svg"));
+  CHECK_THROWS_AS(eval::write_training_history(dir, h, 0.0), ArgumentError);
 }

@@ -30,6 +30,8 @@ namespace simsr::eval {
 struct Evaluation {
   ErrorAccumulator errors;         ///< per-vertex errors of every frame: statistics, frame means, the last frame's errors
   VecX<double> vertex_mean_error;  ///< M: each HR vertex's error averaged over the frames (a heatmap)
+  /// F×M: every frame's per-vertex errors (float32: heatmaps per frame, e.g. eval::MethodComparison)
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> vertex_errors;
   double seconds_per_frame = 0;    ///< wall time of apply per frame (warm: the first frame is timed too)
   double fit_seconds = 0, train_seconds = 0;  ///< filled by run_method
 };
@@ -49,7 +51,8 @@ Evaluation evaluate(Policy policy, const I& method, const Points<Scalar>& lr_res
     throw ShapeError("eval::evaluate: method fitted on (N, M)", {n, m}, {method.num_lr(), method.num_hr()});
   if (test.num_lr() != n || test.num_hr() != m) throw ShapeError("eval::evaluate: test frames (N, M)", {n, m}, {test.num_lr(), test.num_hr()});
   if (test.num_frames() < 1) throw ArgumentError("eval::evaluate: no test frames");
-  Evaluation r{ErrorAccumulator(hr_rest), VecX<double>::Zero(m)};
+  Evaluation r{ErrorAccumulator(hr_rest), VecX<double>::Zero(m), {}};
+  r.vertex_errors.resize(test.num_frames(), m);
   Points<Scalar> lr_disp(n, 3), hr_disp(m, 3), predicted(m, 3);
   double seconds = 0;
   for (Index f = 0; f < test.num_frames(); ++f) {
@@ -61,6 +64,7 @@ Evaluation evaluate(Policy policy, const I& method, const Points<Scalar>& lr_res
     if (!predicted.allFinite()) throw ArgumentError("eval::evaluate: frame " + std::to_string(test.ids[std::size_t(f)]) + ": the prediction is not finite");
     r.errors.add_frame(predicted, test.hr(f));
     r.vertex_mean_error += r.errors.last_frame_errors() / double(test.num_frames());
+    r.vertex_errors.row(f) = r.errors.last_frame_errors().transpose().template cast<float>();
     if (on_frame) on_frame(f, predicted);
   }
   r.seconds_per_frame = seconds / double(test.num_frames());
