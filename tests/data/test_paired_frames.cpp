@@ -1,3 +1,4 @@
+#include <simsr/data/frame_set.hpp>
 #include <simsr/data/paired_frames.hpp>
 #include <simsr/data/splits.hpp>
 
@@ -189,4 +190,33 @@ TEST_CASE("splits: by sequence holds out whole performances") {
   check_contains(error_of([&] { data::by_sequence(p, {"amazement", "pain", "anger"}); }), "no training frame is left");
   const auto plain = random_frames(rng, 4, 3, 3, 0, false);
   check_contains(error_of([&] { data::by_sequence(plain, {"anger"}); }), "no 'sequence' labels");
+}
+
+TEST_CASE("frame sets: one key with ids; float dtypes only; ids matched across files") {
+  std::mt19937 rng(13);
+  const auto p = random_frames(rng, 6, 5, 7, 0, false);
+  const auto file = tmp("paired_for_set.npz");
+  data::write_paired_frames(file, p);
+  const auto lo = data::read_frame_set(file, "lowres", 5);
+  CHECK(lo.positions == p.lowres);
+  CHECK(lo.ids == p.ids);
+  CHECK(lo.has_ids);
+  check_contains(error_of([&] { data::read_frame_set(file, "lowres", 4); }), "lowres vertices");
+  check_contains(error_of([&] { data::read_frame_set(file, "midres", 5); }), "no array 'midres'");
+  data::FrameSet out;
+  out.positions = p.highres.topRows(2);
+  out.ids = {p.ids[3], p.ids[1]};
+  const auto pred = tmp("prediction.npz");
+  data::write_frame_set(pred, "highres", out);
+  const auto back = data::read_frame_set(pred, "highres", 7);
+  CHECK(back.positions == out.positions);
+  CHECK(data::match_frame_ids(back.ids, p.ids, "truth.npz") == std::vector<Index>{3, 1});
+  check_contains(error_of([&] { data::match_frame_ids({12345}, p.ids, "truth.npz"); }), "truth.npz: no frame with id 12345");
+  io::NpzArrays ints;
+  std::vector<std::int32_t> v(2 * 7 * 3, 1);
+  ints["highres"] = io::make_npy<std::int32_t>({2, 7, 3}, v.data());
+  io::write_npz(pred, ints);
+  check_contains(error_of([&] { data::read_frame_set(pred, "highres", 7); }), "expected float32 or float64");
+  out.positions(1, 4) = std::nan("");
+  check_contains(error_of([&] { data::write_frame_set(pred, "highres", out); }), "non-finite");
 }
