@@ -8,8 +8,9 @@
 // eval-mode forward. stdout: one JSON object whose
 // `seconds_per_frame` is the mean wall time of a frame's forward (also: frames, setup seconds,
 // and, when IN also holds `highres`, the error statistics against it).
-#include <simsr/eval/error_statistics.hpp>
-#include <simsr/nn/model_file.hpp>
+#include <simsr/data/data.hpp>
+#include <simsr/eval/evaluate.hpp>
+#include <simsr/interp/interp.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -29,70 +30,31 @@ struct InferArgs {
 };
 
 inline int infer_cmd(const InferArgs& a) {
-  using clock = std::chrono::steady_clock;
-  const auto sec = [](auto d) { return std::chrono::duration<double>(d).count(); };
-  const auto t0 = clock::now();
-  const io::NpzArrays arrays = nn::read_model_arrays(a.model);
-  const nn::ModelData md = nn::model_data(arrays, a.model);
-  nn::Rng rng(0);
-  nn::SuperResolutionNet<float> net(md.config, md.geometry, rng);
-  nn::load_state(net.store(), arrays);
-  net.prepare_inference(exec::omp);
-  const auto t1 = clock::now();
-
-  const Index N = net.lr_points(), M = net.hr_points();
-  io::NpzReader z(a.frames);
-  const io::NpyArray low = read_frames(z, a.frames, "lowres", N);
   if (a.every < 1) throw ArgumentError("--every must be >= 1 (got " + std::to_string(a.every) + ")");
-  std::vector<Index> sel;
-  for (Index f = 0; f < low.num_frames(); f += a.every) sel.push_back(f);
-  const Index F = Index(sel.size());
-  const nn::Matrix<float> lr0 = nn::normalize_positions<float>(md.geometry.lr_rest, md.config.norm_mean, md.config.norm_std);
-  std::vector<double> out(std::size_t(F * M * 3));
-  nn::Matrix<float> ldx(N, 3), pred;
-  double forward_seconds = 0;
-  for (Index f = 0; f < F; ++f) {
-    const Points<double> x = low.frame_points<double>(sel[std::size_t(f)]);
-    for (Index r = 0; r < N; ++r)
-      if (!x.row(r).allFinite())
-        throw ArgumentError(a.frames + ": lowres frame " + std::to_string(sel[std::size_t(f)]) + ", vertex " + std::to_string(r) + " is not finite");
-    nn::normalized_displacements(x, lr0, md.config.norm_mean, md.config.norm_std, ldx);
-    const auto s = clock::now();
-    net.infer(ldx, pred, exec::omp);
-    forward_seconds += sec(clock::now() - s);
-    // un-normalize a displacement by σ only (the mean cancels in a difference)
-    Eigen::Map<Points<double>>(out.data() + f * M * 3, M, 3) = md.geometry.hr_rest + pred.cast<double>() * md.config.norm_std;
-  }
-  io::NpzArrays result;
-  result["highres"] = io::make_npy<double>({F, M, 3}, out.data());
-  std::vector<std::int64_t> ids;
-  if (z.contains("frame")) {
-    const auto all = z.read("frame").to_vector<std::int64_t>();
-    if (Index(all.size()) != low.num_frames()) throw ShapeError(a.frames + ": frame", {low.num_frames()}, {Index(all.size())});
-    for (Index f : sel) ids.push_back(all[std::size_t(f)]);
-  } else {
-    for (Index f : sel) ids.push_back(std::int64_t(f));
-  }
-  result["frame"] = io::make_npy<std::int64_t>({F}, ids.data());
-  io::write_npz(a.out, result, io::NpzCompression::Deflate);
-
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto net = interp::Learned<>::from_model_file(a.model);
+  const auto& g = net.model().geometry;
+  const auto t1 = std::chrono::steady_clock::now();
+  const data::FrameSet all = data::read_frame_set(a.frames, "lowres", net.num_lr());
+  std::vector<Index> rows;
+  for (Index f = 0; f < all.num_frames(); f += a.every) rows.push_back(f);
+  const data::FrameSet lowres = all.select(rows);
+  const auto out = interp::apply_frames(exec::omp, net, g.lr_rest, g.hr_rest, lowres);
+  data::write_frame_set(a.out, "highres", out.highres);
   nlohmann::ordered_json j;
-  j["seconds_per_frame"] = F ? forward_seconds / double(F) : 0.0;
-  j["frames"] = F;
-  j["lr_vertices"] = N;
-  j["hr_vertices"] = M;
-  j["setup_seconds"] = sec(t1 - t0);
-  j["profile"] = md.config.profile;
-  if (z.contains("highres")) {
-    const io::NpyArray truth = read_frames(z, a.frames, "highres", M);
-    if (truth.num_frames() == low.num_frames()) {
-      eval::ErrorAccumulator acc(md.geometry.hr_rest);
-      for (Index f = 0; f < F; ++f)
-        acc.add_frame(Eigen::Map<const Points<double>>(out.data() + f * M * 3, M, 3), truth.frame_points<double>(sel[std::size_t(f)]));
-      const auto s = acc.statistics(), r = acc.relative_statistics();
-      j["error"] = statistics_json(s);
-      j["relative_error"] = statistics_json(r);
-    }
+  j["seconds_per_frame"] = out.seconds_per_frame;
+  j["frames"] = lowres.num_frames();
+  j["lr_vertices"] = net.num_lr();
+  j["hr_vertices"] = net.num_hr();
+  j["setup_seconds"] = std::chrono::duration<double>(t1 - t0).count();
+  j["profile"] = net.config().profile;
+  if (io::NpzReader(a.frames).contains("highres")) {  // the truth is in the input: report the error
+    const auto truth = data::read_frame_set(a.frames, "highres", net.num_hr());
+    if (truth.num_frames() != all.num_frames())
+      throw ShapeError(a.frames + ": highres frames (as many as lowres)", {all.num_frames()}, {truth.num_frames()});
+    const auto r = eval::evaluate_predictions(g.hr_rest, out.highres, truth.select(rows), a.frames);
+    j["error"] = statistics_json(r.errors.statistics());
+    j["relative_error"] = statistics_json(r.errors.relative_statistics());
   }
   std::cout << j.dump() << '\n';
   return 0;

@@ -2,10 +2,8 @@
 // `simsr neighbors --lr-rest L --hr-rest H --k 20 --out N.npz`: the §3.2 upsampling
 // neighbourhoods (LR→HR one-to-one assignment + k-label Dijkstra over the HR surface) and the LR
 // geodesic graph (EdgeConv's first graph: Dijkstra over LR mesh edges, self first).
-#include <simsr/io/mesh_io.hpp>
-#include <simsr/io/npz.hpp>
-#include <simsr/neighbors/geodesic_knn.hpp>
-#include <simsr/neighbors/upsampling_neighborhoods.hpp>
+#include <simsr/data/network_neighborhoods.hpp>
+#include <simsr/data/rest_shapes.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -17,51 +15,25 @@
 
 namespace simsr::cli {
 
-/// The LR rest volume mesh (any tet format, or the official 4-triangles-per-tet OBJ).
-inline TetMesh<double> read_lr_rest(const std::string& file) {
-  auto m = io::read_mesh(file);
-  if (m.T.rows() == 0) throw ArgumentError(file + ": the LR rest shape must be a tet mesh (it has no tets)");
-  return {std::move(m.V), std::move(m.T)};
-}
-
-/// The HR rest surface (any triangle format; a tet mesh gives its boundary is not accepted:
-/// the HR vertex order must be the frames' order).
-inline TriMesh<double> read_hr_rest(const std::string& file) {
-  auto m = io::read_mesh(file);
-  if (m.F.rows() == 0) throw ArgumentError(file + ": the HR rest shape must be a triangle surface (it has no triangles)");
-  return {std::move(m.V), std::move(m.F)};
-}
-
 struct NeighborsArgs {
   std::string lr, hr, out;
   Index k = 20, lr_k = 0;
 };
 
 inline int neighbors_cmd(const NeighborsArgs& a) {
-  using clock = std::chrono::steady_clock;
-  const auto lr = read_lr_rest(a.lr);
-  const auto hr = read_hr_rest(a.hr);
-  const auto t0 = clock::now();
-  neighbors::UpsamplingOptions opt;
-  opt.k = a.k;
-  const auto nb = neighbors::upsampling_neighborhoods(exec::omp, lr.V, hr.V, hr.F, opt);
-  const auto t1 = clock::now();
-  const Index lr_k = a.lr_k > 0 ? a.lr_k : a.k;
-  const auto graph = neighbors::geodesic_knn(exec::omp, lr.V, lr.T, lr_k);
-  const auto t2 = clock::now();
-  io::NpzArrays z = neighbors::upsampling_neighborhoods_arrays(nb);
-  z["lr_indices"] = io::make_npy(graph.indices.cast<std::int64_t>().eval());
-  z["lr_distances"] = io::make_npy(graph.distances);
-  io::write_npz(a.out, z, io::NpzCompression::Deflate);
-  const auto ms = [](auto d) { return std::chrono::duration<double, std::milli>(d).count(); };
+  const auto lr = data::read_lr_rest(a.lr);
+  const auto hr = data::read_hr_rest(a.hr);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto nb = data::compute_network_neighborhoods(exec::omp, lr, hr, a.k, a.lr_k > 0 ? a.lr_k : a.k);
+  const auto t1 = std::chrono::steady_clock::now();
+  data::save_network_neighborhoods(a.out, nb);
   nlohmann::ordered_json j;
   j["lr_vertices"] = lr.V.rows();
   j["hr_vertices"] = hr.V.rows();
   j["k"] = a.k;
-  j["assignment_cost"] = nb.assignment_cost;
-  j["assignment_globally_optimal"] = nb.assignment_globally_optimal;
-  j["upsampling_ms"] = ms(t1 - t0);
-  j["lr_graph_ms"] = ms(t2 - t1);
+  j["assignment_cost"] = nb.upsampling.assignment_cost;
+  j["assignment_globally_optimal"] = nb.upsampling.assignment_globally_optimal;
+  j["seconds"] = std::chrono::duration<double>(t1 - t0).count();
   std::cout << j.dump() << '\n';
   return 0;
 }

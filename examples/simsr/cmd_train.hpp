@@ -7,13 +7,10 @@
 // frames. Writes MODEL.npz (one self-contained file: weights, config, geometry), a checkpoint
 // every epoch when --checkpoint is given (resumable with --resume), and with --out-dir the
 // per-epoch history as CSV and SVG. stdout: one JSON object with the run's figures.
-#include <simsr/discretize/embedding.hpp>
-#include <simsr/eval/error_statistics.hpp>
-#include <simsr/eval/report.hpp>
-#include <simsr/neighbors/geodesic_knn.hpp>
-#include <simsr/neighbors/kd_tree.hpp>
-#include <simsr/neighbors/upsampling_neighborhoods.hpp>
-#include <simsr/nn/trainer.hpp>
+#include <simsr/data/data.hpp>
+#include <simsr/eval/evaluate.hpp>
+#include <simsr/eval/training_history.hpp>
+#include <simsr/interp/interp.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -24,7 +21,6 @@
 #include <memory>
 #include <string>
 
-#include "cmd_neighbors.hpp"
 #include "methods.hpp"
 
 namespace simsr::cli {
@@ -49,55 +45,6 @@ inline constexpr double default_lr = 1e-3;
 /// the bunny example (measured: see README, "Training the bunny").
 inline Index default_epochs(const std::string& profile) { return profile == "paper" ? 10 : 14; }
 
-/// Network geometry for the meshes: neighbourhoods from --official-neighbors (the authors'
-/// geo_dist_*.npy), --neighbors (simsr neighbors), or computed here; Euclidean for w/o CU.
-inline nn::NetworkGeometry network_geometry(const TrainArgs& a, const nn::NetworkConfig& cfg, const TetMesh<double>& lr, const TriMesh<double>& hr,
-                                            nlohmann::ordered_json& log) {
-  nn::NetworkGeometry g;
-  g.lr_rest = lr.V;
-  g.hr_rest = hr.V;
-  const Index N = lr.V.rows(), M = hr.V.rows();
-  auto npy_matrix = [](const std::filesystem::path& p, Index rows, Index min_cols) {
-    const io::NpyArray x = io::read_npy(p);
-    if (x.ndim() != 2 || x.shape[0] != rows || x.shape[1] < min_cols) throw ShapeError(p.string(), {rows, min_cols}, x.shape);
-    return x;
-  };
-  if (!a.official_neighbors.empty()) {
-    const std::filesystem::path d = a.official_neighbors;
-    g.lr_graph = npy_matrix(d / "geo_dist_tet2tet_idx.npy", N, cfg.knn).to_matrix<VIndex>().leftCols(cfg.knn);
-    g.up_indices = npy_matrix(d / "geo_dist_surf2tet_idx.npy", M, cfg.up_k).to_matrix<VIndex>().leftCols(cfg.up_k);
-    g.up_distances = npy_matrix(d / "geo_dist_surf2tet.npy", M, cfg.up_k).to_matrix<double>().leftCols(cfg.up_k);
-    log["neighbors"] = "official files in " + a.official_neighbors;
-  } else if (!a.neighbors.empty()) {
-    const auto nb = neighbors::load_upsampling_neighborhoods(a.neighbors);
-    if (nb.indices.rows() != M || nb.k() < cfg.up_k) throw ShapeError(a.neighbors + ": indices (M×upK)", {M, cfg.up_k}, {nb.indices.rows(), nb.k()});
-    g.up_indices = nb.indices.leftCols(cfg.up_k);
-    g.up_distances = nb.distances.leftCols(cfg.up_k);
-    io::NpzReader z(a.neighbors);
-    if (!z.contains("lr_indices")) throw ArgumentError(a.neighbors + ": no 'lr_indices' (the LR geodesic graph of simsr neighbors)");
-    const io::NpyArray li = z.read("lr_indices");
-    if (li.ndim() != 2 || li.shape[0] != N || li.shape[1] < cfg.knn) throw ShapeError(a.neighbors + ": lr_indices", {N, cfg.knn}, li.shape);
-    g.lr_graph = li.to_matrix<VIndex>().leftCols(cfg.knn);
-    log["neighbors"] = a.neighbors;
-  } else {
-    neighbors::UpsamplingOptions opt;
-    opt.k = cfg.up_k;
-    const auto nb = neighbors::upsampling_neighborhoods(exec::omp, lr.V, hr.V, hr.F, opt);
-    g.up_indices = nb.indices;
-    g.up_distances = nb.distances;
-    g.lr_graph = neighbors::geodesic_knn(exec::omp, lr.V, lr.T, cfg.knn).indices;
-    log["neighbors"] = "computed (assignment + k-label Dijkstra; LR geodesic kNN)";
-  }
-  if (cfg.upsampling == nn::UpsamplingKind::table) {  // w/o CU: fixed Euclidean upK-NN
-    neighbors::KdTree<double> tree(lr.V);
-    const auto r = tree.query(exec::omp, hr.V, cfg.up_k);
-    g.up_indices = r.indices;
-    g.up_distances = r.distances;
-    log["neighbors"] = "Euclidean kNN (w/o CU)";
-  }
-  return g;
-}
-
 inline int train_cmd(const TrainArgs& a) {
   using clock = std::chrono::steady_clock;
   const auto t_start = clock::now();
@@ -113,83 +60,56 @@ inline int train_cmd(const TrainArgs& a) {
   if (a.w_recon >= 0) cfg.w_recon = a.w_recon;
   if (a.w_zreg >= 0) cfg.w_zreg = a.w_zreg;
   if (a.w_fn >= 0) cfg.w_fn = a.w_fn;
-  if (a.holdout != 0 && a.holdout < 2) throw ArgumentError("--holdout-every must be 0 (none) or at least 2 (got " + std::to_string(a.holdout) + ")");
   cfg.validate();
 
-  const auto lr = read_lr_rest(a.lr);
-  const auto hr = read_hr_rest(a.hr);
+  interp::UpsamplingProblem<> problem{data::read_lr_rest(a.lr), data::read_hr_rest(a.hr), {}, {}};
   nlohmann::ordered_json j;
   j["profile"] = a.profile;
-  nn::ModelData md;
-  md.config = cfg;
-  md.geometry = network_geometry(a, cfg, lr, hr, j);
-  md.lr_tets = lr.T;
-  md.hr_faces = hr.F;
-  // the embedding: the residual's base and, on the held-out frames, the baseline to beat
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> embedding = embedding_matrix(embed(exec::omp, lr, hr.V), lr.T, lr.V.rows()).cast<double>();
-  if (cfg.residual) md.geometry.embedding = embedding;
-  const auto t_geo = clock::now();
+  if (!a.official_neighbors.empty()) {
+    problem.use(data::read_official_neighborhoods(a.official_neighbors, problem.num_lr(), problem.num_hr()));
+    j["neighbors"] = "official files in " + a.official_neighbors;
+  } else if (!a.neighbors.empty()) {
+    problem.use(data::read_network_neighborhoods(a.neighbors, problem.num_lr(), problem.num_hr()));
+    j["neighbors"] = a.neighbors;
+  } else {
+    j["neighbors"] = "computed (assignment + k-label Dijkstra; LR geodesic kNN)";
+  }
+  if (cfg.upsampling == nn::UpsamplingKind::table) j["neighbors"] = "Euclidean kNN (w/o CU)";
+  const auto frames = data::read_paired_frames(a.frames, problem.num_lr(), problem.num_hr());
+  const auto split = data::holdout_every(frames.num_frames(), a.holdout);
+  const auto train = frames.select(split.train), test = frames.select(split.test);
+  const auto held = data::displacements(test, problem.lr.V, problem.hr.V);
 
-  io::NpzReader z(a.frames);
-  const io::NpyArray low = read_frames(z, a.frames, "lowres", lr.V.rows()), high = read_frames(z, a.frames, "highres", hr.V.rows());
-  std::vector<std::int64_t> ids;
-  if (z.contains("frame")) ids = z.read("frame").to_vector<std::int64_t>();
-  if (!ids.empty() && Index(ids.size()) != low.num_frames()) throw ShapeError(a.frames + ": frame", {low.num_frames()}, {Index(ids.size())});
-  std::vector<Index> train, test;
-  for (Index f = 0; f < low.num_frames(); ++f) (a.holdout > 0 && f % a.holdout == 0 ? test : train).push_back(f);
-
-  nn::Rng rng(a.seed);
-  nn::SuperResolutionNet<float> net(cfg, md.geometry, rng);
-  nn::TrainerOptions opt;
-  opt.seed = a.seed;
-  opt.progress = !a.quiet;
-  opt.lr_decay_epochs = a.lr_decay_epochs;
-  nn::Trainer<float> trainer(net, hr.F, nn::training_frames<float>(cfg, lr.V, hr.V, low, high, train, ids), opt);
+  interp::Learned<> net(cfg, a.seed);
+  interp::prepare(exec::omp, net, problem, cfg.up_k);  // geometry only: training follows
   double embedded_error = -1;
-  if (!test.empty()) {
-    trainer.set_holdout(nn::training_frames<float>(cfg, lr.V, hr.V, low, high, test, ids));
-    eval::ErrorAccumulator acc(hr.V);  // the Embedded baseline on the same held-out frames
-    for (Index f : test) acc.add_frame(Points<double>(embedding * low.frame_points<double>(f)), high.frame_points<double>(f));
-    embedded_error = acc.statistics().mean;
+  if (test.num_frames() > 0) {  // the baseline to beat, on the same held-out frames
+    interp::Embedded<> embedded;
+    embedded_error = eval::run_method(exec::omp, embedded, problem, train, test).errors.statistics().mean;
   }
-  if (!a.resume.empty()) trainer.load_checkpoint(a.resume);
-  while (trainer.epoch() < trainer.epochs()) {
-    trainer.run_epoch(exec::omp);
-    if (!a.checkpoint.empty()) trainer.save_checkpoint(a.checkpoint, md);
-  }
+  const auto t_geo = clock::now();
+  interp::NetworkTrainOptions o;
+  o.trainer.seed = a.seed;
+  o.trainer.progress = !a.quiet;
+  o.trainer.lr_decay_epochs = a.lr_decay_epochs;
+  if (test.num_frames() > 0) o.holdout = &held;
+  o.checkpoint = a.checkpoint;
+  o.resume = a.resume;
+  net.train(exec::omp, data::displacements(train, problem.lr.V, problem.hr.V), o);
   const auto t_train = clock::now();
-  nn::save_model(a.out, net, md);
+  net.save(a.out);
 
-  const double diag = eval::bbox_diagonal(hr.V);
-  const auto& h = trainer.history();
-  if (!a.out_dir.empty() && !h.empty()) {
-    std::filesystem::create_directories(a.out_dir);
-    std::string csv = "epoch,steps,loss,recon,z_reg,face_normals,lr,seconds,holdout_mean_error,holdout_relative_error,embedded_relative_error\n";
-    eval::Series loss{"training loss", {}}, err{"network, held-out mean error / bbox diagonal", {}}, base{"Embedded on the same frames", {}};
-    for (const auto& r : h) {
-      csv += std::to_string(r.epoch) + "," + std::to_string(r.steps) + "," + std::to_string(r.loss) + "," + std::to_string(r.recon) + "," +
-             std::to_string(r.z_reg) + "," + std::to_string(r.face_normals) + "," + std::to_string(r.lr) + "," + std::to_string(r.seconds) + "," +
-             std::to_string(r.holdout_mean_error) + "," + std::to_string(r.holdout_mean_error / diag) + "," + std::to_string(embedded_error / diag) + "\n";
-      loss.values.push_back(r.loss);
-      if (r.holdout_mean_error >= 0) {
-        err.values.push_back(r.holdout_mean_error / diag);
-        base.values.push_back(embedded_error / diag);
-      }
-    }
-    eval::detail::write_file(std::filesystem::path(a.out_dir) / "training_history.csv", csv);
-    eval::write_svg_plot(std::filesystem::path(a.out_dir) / "training_loss.svg", {loss}, "training loss per epoch", "loss", true, "epoch");
-    if (!err.values.empty())
-      eval::write_svg_plot(std::filesystem::path(a.out_dir) / "holdout_error.svg", {err, base}, "held-out mean HR vertex error",
-                           "error / bbox diagonal", true, "epoch");
-  }
+  const double diag = eval::bbox_diagonal(problem.hr.V);
+  const auto& h = net.history();
+  if (!a.out_dir.empty()) eval::write_training_history(a.out_dir, h, diag, embedded_error);
   const auto sec = [](auto d) { return std::chrono::duration<double>(d).count(); };
   j["model"] = a.out;
-  j["parameters"] = net.store().num_parameters();
-  j["train_frames"] = train.size();
-  j["holdout_frames"] = test.size();
-  j["epochs"] = trainer.epoch();
-  j["steps"] = trainer.steps();
-  j["batch_size"] = trainer.batch_size();
+  j["parameters"] = net.network().store().num_parameters();
+  j["train_frames"] = train.num_frames();
+  j["holdout_frames"] = test.num_frames();
+  j["epochs"] = net.epoch();
+  j["steps"] = net.steps();
+  j["batch_size"] = net.batch_size();
   j["geometry_seconds"] = sec(t_geo - t_start);
   j["training_seconds"] = sec(t_train - t_geo);
   if (!h.empty()) {

@@ -28,6 +28,18 @@ struct FrameSet {
 
   Index num_frames() const { return positions.rows(); }
   Index num_vertices() const { return positions.cols() / 3; }
+  /// The frames at `rows` (positions in this set), ids following.
+  FrameSet select(const std::vector<Index>& rows) const {
+    FrameSet out;
+    out.has_ids = has_ids;
+    out.positions.resize(Index(rows.size()), positions.cols());
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      frame(rows[i]);  // range check
+      out.positions.row(Index(i)) = positions.row(rows[i]);
+      out.ids.push_back(ids[std::size_t(rows[i])]);
+    }
+    return out;
+  }
   Eigen::Map<const Points<Scalar>> frame(Index f) const {
     if (f < 0 || f >= num_frames()) throw ArgumentError("frame set: frame " + std::to_string(f) + " out of range [0, " + std::to_string(num_frames()) + ")");
     return {positions.row(f).data(), num_vertices(), 3};
@@ -49,10 +61,6 @@ inline FrameSet read_frame_set(const std::filesystem::path& file, const std::str
   if (s.num_vertices() != vertices)
     throw ShapeError(source + ": " + key + " vertices", {s.num_frames(), vertices, 3}, {s.num_frames(), s.num_vertices(), 3});
   const Index f = s.num_frames();
-  for (Index r = 0; r < f; ++r)
-    for (Index c = 0; c < s.positions.cols(); ++c)
-      if (!std::isfinite(s.positions(r, c)))
-        throw ArgumentError(source + ": " + key + " frame " + std::to_string(r) + ", vertex " + std::to_string(c / 3) + " is not finite");
   s.has_ids = z.contains("frame");
   if (s.has_ids) {
     const io::NpyArray a = z.read("frame");
@@ -67,6 +75,12 @@ inline FrameSet read_frame_set(const std::filesystem::path& file, const std::str
   } else {
     for (Index i = 0; i < f; ++i) s.ids.push_back(i);
   }
+  for (Index r = 0; r < f; ++r)
+    for (Index c = 0; c < s.positions.cols(); ++c)
+      if (!std::isfinite(s.positions(r, c)))
+        throw ArgumentError(source + ": " + key + " frame " + std::to_string(r) +
+                            (s.has_ids ? " (id " + std::to_string(s.ids[std::size_t(r)]) + ")" : std::string()) + ", vertex " +
+                            std::to_string(c / 3) + " is not finite");
   return s;
 }
 

@@ -3,7 +3,8 @@
 /// Several methods evaluated on the same test frames, and the files people open (the paper's
 /// Table 1 and Fig. 5): statistics.csv (raw, relative to the bounding-box diagonal, normalized to
 /// the largest), frame_errors.csv + frame_errors.svg (per-frame mean error of every method) and
-/// heatmaps.pvd (ParaView: the true HR surface of every test frame with one error array per method).
+/// heatmaps.pvd (ParaView: the true HR surface of every test frame with one error array per method);
+/// and write_evaluation, the same files for one set of predictions (`simsr eval --out`).
 ///
 ///     eval::MethodComparison table(hr.V, hr.F, test);
 ///     table.add("embedded", eval::run_method(exec::omp, embedded, problem, train, test));
@@ -91,5 +92,30 @@ class MethodComparison {
   std::vector<std::string> names_;
   std::vector<Evaluation> evaluations_;
 };
+
+/// The files of one evaluated prediction set (`simsr eval --out`): frame_errors.csv (per frame:
+/// mean, max, and both relative to the diagonal, by frame id), frame_errors.svg, error_heatmap.vtu
+/// (the HR rest surface with each vertex's mean, max and relative mean error over the frames:
+/// ParaView) and statistics.csv (one row, `name`).
+inline void write_evaluation(const std::filesystem::path& dir, const std::string& name, const Evaluation& r, const TriMesh<Scalar>& hr_rest,
+                             const std::vector<std::int64_t>& frame_ids) {
+  if (Index(frame_ids.size()) != r.errors.num_frames())
+    throw ShapeError("eval::write_evaluation: frame ids", {r.errors.num_frames()}, {Index(frame_ids.size())});
+  std::filesystem::create_directories(dir);
+  const double diagonal = r.errors.diagonal();
+  std::vector<double> rel_means = r.errors.frame_means(), rel_maxes = r.errors.frame_maxes();
+  for (double& v : rel_means) v /= diagonal;
+  for (double& v : rel_maxes) v /= diagonal;
+  const std::vector<long long> ids(frame_ids.begin(), frame_ids.end());
+  write_frame_csv(dir / "frame_errors.csv",
+                  {{"mean", r.errors.frame_means()}, {"max", r.errors.frame_maxes()}, {"relative_mean", rel_means}, {"relative_max", rel_maxes}}, ids);
+  write_svg_plot(dir / "frame_errors.svg", {{"mean", rel_means}, {"max", rel_maxes}}, "Per-vertex error of " + name + " per frame",
+                 "error / bbox diagonal", false, "frame (index)");
+  io::VtuGrid grid(hr_rest);
+  grid.add_point_data("mean_error", r.vertex_mean_error).add_point_data("max_error", r.vertex_max_error);
+  grid.add_point_data("relative_mean_error", VecX<double>(r.vertex_mean_error / diagonal));
+  io::write_vtu(dir / "error_heatmap.vtu", grid);
+  write_statistics_csv(dir / "statistics.csv", {name}, {r.errors.statistics()}, diagonal);
+}
 
 }  // namespace simsr::eval

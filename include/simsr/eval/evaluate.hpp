@@ -20,8 +20,10 @@
 
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
+#include "../data/frame_set.hpp"
 #include "../data/paired_frames.hpp"
 #include "../interp/concepts.hpp"
+#include "../interp/fit_and_train.hpp"
 #include "error_statistics.hpp"
 
 namespace simsr::eval {
@@ -30,10 +32,11 @@ namespace simsr::eval {
 struct Evaluation {
   ErrorAccumulator errors;         ///< per-vertex errors of every frame: statistics, frame means, the last frame's errors
   VecX<double> vertex_mean_error;  ///< M: each HR vertex's error averaged over the frames (a heatmap)
+  VecX<double> vertex_max_error;   ///< M: each HR vertex's largest error over the frames
   /// F×M: every frame's per-vertex errors (float32: heatmaps per frame, e.g. eval::MethodComparison)
   Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> vertex_errors;
   double seconds_per_frame = 0;    ///< wall time of apply per frame (warm: the first frame is timed too)
-  double fit_seconds = 0, train_seconds = 0;  ///< filled by run_method
+  double prepare_seconds = 0;      ///< run_method: seconds of fit + training (interp::prepare)
 };
 
 /// Called with (frame row, predicted HR positions M×3) after every frame, e.g. to keep predictions.
@@ -51,7 +54,7 @@ Evaluation evaluate(Policy policy, const I& method, const Points<Scalar>& lr_res
     throw ShapeError("eval::evaluate: method fitted on (N, M)", {n, m}, {method.num_lr(), method.num_hr()});
   if (test.num_lr() != n || test.num_hr() != m) throw ShapeError("eval::evaluate: test frames (N, M)", {n, m}, {test.num_lr(), test.num_hr()});
   if (test.num_frames() < 1) throw ArgumentError("eval::evaluate: no test frames");
-  Evaluation r{ErrorAccumulator(hr_rest), VecX<double>::Zero(m), {}};
+  Evaluation r{ErrorAccumulator(hr_rest), VecX<double>::Zero(m), VecX<double>::Zero(m), {}};
   r.vertex_errors.resize(test.num_frames(), m);
   Points<Scalar> lr_disp(n, 3), hr_disp(m, 3), predicted(m, 3);
   double seconds = 0;
@@ -64,6 +67,7 @@ Evaluation evaluate(Policy policy, const I& method, const Points<Scalar>& lr_res
     if (!predicted.allFinite()) throw ArgumentError("eval::evaluate: frame " + std::to_string(test.ids[std::size_t(f)]) + ": the prediction is not finite");
     r.errors.add_frame(predicted, test.hr(f));
     r.vertex_mean_error += r.errors.last_frame_errors() / double(test.num_frames());
+    r.vertex_max_error = r.vertex_max_error.cwiseMax(r.errors.last_frame_errors());
     r.vertex_errors.row(f) = r.errors.last_frame_errors().transpose().template cast<float>();
     if (on_frame) on_frame(f, predicted);
   }
@@ -71,43 +75,60 @@ Evaluation evaluate(Policy policy, const I& method, const Points<Scalar>& lr_res
   return r;
 }
 
-namespace detail {
-/// fit (neighbourhoods first when needed), then `train_step()`, then evaluate; times each phase.
-template <class Policy, class I, class Train>
-Evaluation fit_train_evaluate(Policy policy, I& method, interp::UpsamplingProblem<typename I::scalar_type>& problem,
-                              const data::PairedFrames<Scalar>& test, const FrameCallback& on_frame, Train&& train_step) {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  if constexpr (interp::needs_neighborhoods_v<I>)
-    if (!problem.neighborhoods) problem.ensure_neighborhoods(policy);
-  method.fit(policy, problem);
-  const auto t1 = clock::now();
-  train_step();
-  const auto t2 = clock::now();
-  Evaluation r = evaluate(policy, std::as_const(method), problem.lr.V, problem.hr.V, test, on_frame);
-  r.fit_seconds = std::chrono::duration<double>(t1 - t0).count();
-  r.train_seconds = std::chrono::duration<double>(t2 - t1).count();
+/// Predicted HR frames against true ones (both absolute positions, M = hr_rest's vertices): by
+/// `frame` id when both sets carry ids (the truth may hold more frames, e.g. a whole performance
+/// against its held-out part), else by index with equal counts. `vertex_errors` rows follow the
+/// predicted frames. ShapeError naming the truth file for a missing id or unequal counts.
+inline Evaluation evaluate_predictions(const Points<Scalar>& hr_rest, const data::FrameSet& predicted, const data::FrameSet& truth,
+                                       const std::string& truth_name = "truth") {
+  const Index m = hr_rest.rows(), f = predicted.num_frames();
+  if (predicted.num_vertices() != m || truth.num_vertices() != m)
+    throw ShapeError("eval::evaluate_predictions: HR vertices (predicted, truth)", {m, m}, {predicted.num_vertices(), truth.num_vertices()});
+  if (f < 1) throw ArgumentError("eval::evaluate_predictions: no predicted frames");
+  std::vector<Index> rows;
+  if (predicted.has_ids && truth.has_ids) {
+    rows = data::match_frame_ids(predicted.ids, truth.ids, truth_name);
+  } else {
+    if (truth.num_frames() != f)
+      throw ShapeError(truth_name + ": frames vs the prediction's (unequal frame counts need a `frame` id array in both files)", {f, m, 3},
+                       {truth.num_frames(), m, 3});
+    for (Index i = 0; i < f; ++i) rows.push_back(i);
+  }
+  Evaluation r{ErrorAccumulator(hr_rest), VecX<double>::Zero(m), VecX<double>::Zero(m), {}};
+  r.vertex_errors.resize(f, m);
+  for (Index i = 0; i < f; ++i) {
+    r.errors.add_frame(predicted.frame(i), truth.frame(rows[std::size_t(i)]));
+    r.vertex_mean_error += r.errors.last_frame_errors() / double(f);
+    r.vertex_max_error = r.vertex_max_error.cwiseMax(r.errors.last_frame_errors());
+    r.vertex_errors.row(i) = r.errors.last_frame_errors().transpose().template cast<float>();
+  }
   return r;
 }
 
-inline void require_training_frames(const data::PairedFrames<Scalar>& train) {
-  if (train.num_frames() < 1) throw ArgumentError("eval::run_method: this method learns from frames, and no training frame is given");
+namespace detail {
+template <class Policy, class I>
+Evaluation timed(Policy policy, I& method, interp::UpsamplingProblem<typename I::scalar_type>& problem, const data::PairedFrames<Scalar>& test,
+                 const FrameCallback& on_frame, std::chrono::steady_clock::time_point t0) {
+  const auto t1 = std::chrono::steady_clock::now();
+  Evaluation r = evaluate(policy, std::as_const(method), problem.lr.V, problem.hr.V, test, on_frame);
+  r.prepare_seconds = std::chrono::duration<double>(t1 - t0).count();  // fit + train (prepare)
+  return r;
 }
 }  // namespace detail
 
-/// Fits `method` on the problem (computing the §3.2 neighbourhoods first when the method needs
-/// them and the problem has none), trains it on `train` with its default options when it learns
-/// from frames, then evaluates it on `test`. Frames are absolute positions.
+/// interp::prepare (fit; the neighbourhoods first when the method needs them; training on
+/// `train` with default options when it learns from frames), then evaluate on `test`. Frames are
+/// absolute positions. `prepare_seconds` holds the time of the preparation.
 template <exec::HostPolicy Policy, interp::Interpolator I>
 Evaluation run_method(Policy policy, I& method, interp::UpsamplingProblem<typename I::scalar_type>& problem,
                       const data::PairedFrames<Scalar>& train, const data::PairedFrames<Scalar>& test,
                       const FrameCallback& on_frame = {}) {
-  return detail::fit_train_evaluate(policy, method, problem, test, on_frame, [&] {
-    if constexpr (interp::TrainableInterpolator<I>) {
-      detail::require_training_frames(train);
-      method.train(policy, data::displacements(train, problem.lr.V, problem.hr.V), typename I::train_options{});
-    }
-  });
+  const auto t0 = std::chrono::steady_clock::now();
+  if constexpr (interp::TrainableInterpolator<I>)
+    interp::prepare(policy, method, problem, train);
+  else
+    interp::prepare(policy, method, problem);
+  return detail::timed(policy, method, problem, test, on_frame, t0);
 }
 
 /// run_method with the training options given (a TrainableInterpolator).
@@ -115,10 +136,9 @@ template <exec::HostPolicy Policy, interp::TrainableInterpolator I>
 Evaluation run_method(Policy policy, I& method, interp::UpsamplingProblem<typename I::scalar_type>& problem,
                       const data::PairedFrames<Scalar>& train, const data::PairedFrames<Scalar>& test,
                       const typename I::train_options& options, const FrameCallback& on_frame = {}) {
-  return detail::fit_train_evaluate(policy, method, problem, test, on_frame, [&] {
-    detail::require_training_frames(train);
-    method.train(policy, data::displacements(train, problem.lr.V, problem.hr.V), options);
-  });
+  const auto t0 = std::chrono::steady_clock::now();
+  interp::prepare(policy, method, problem, train, options);
+  return detail::timed(policy, method, problem, test, on_frame, t0);
 }
 
 }  // namespace simsr::eval

@@ -12,9 +12,11 @@
 /// Ridge, BetaVaeBaseline and Learned are `TrainableInterpolator`s; `needs_neighborhoods_v<I>`
 /// says which methods read the §3.2 neighbourhoods.
 
+#include "apply_frames.hpp"
 #include "beta_vae.hpp"
 #include "concepts.hpp"
 #include "embedded.hpp"
+#include "fit_and_train.hpp"
 #include "idw.hpp"
 #include "learned.hpp"
 #include "mls.hpp"

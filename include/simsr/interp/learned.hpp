@@ -132,6 +132,7 @@ class Learned {
       if (!options.checkpoint.empty()) trainer.save_checkpoint(options.checkpoint, model_);
     }
     history_ = trainer.history();
+    epoch_ = trainer.epoch();
     steps_ = trainer.steps();
     batch_size_ = trainer.batch_size();
     net_->prepare_inference(policy);
@@ -171,6 +172,8 @@ class Learned {
   const nn::ModelData& model() const { return model_; }
   /// One report per trained epoch (loss terms, seconds, held-out mean error in mesh units).
   const std::vector<nn::EpochReport>& history() const { return history_; }
+  /// Epochs trained in all (a resumed run counts the checkpoint's), optimizer steps, batch size.
+  Index epoch() const { return epoch_; }
   std::int64_t steps() const { return steps_; }
   Index batch_size() const { return batch_size_; }
 
@@ -239,7 +242,7 @@ class Learned {
   std::string loaded_from_;
   std::vector<nn::EpochReport> history_;
   std::int64_t steps_ = 0;
-  Index batch_size_ = 0;
+  Index epoch_ = 0, batch_size_ = 0;
   nn::Matrix<network_scalar> lr0_;
   Points<double> lr_rest_;
   mutable Points<double> positions_;
