@@ -59,13 +59,13 @@ template <class Split>
 void check_lattice(const VoxelSet& cells, double min_quality, bool conforming = true) {
   const auto L = build_lattice<Split>(cells);
   const double h = cells.grid.h, h3 = h * h * h;
-  CHECK_NOTHROW(validate(L.mesh));
-  const auto report = check(L.mesh);
+  CHECK_NOTHROW(validate(exec::seq, L.mesh));
+  const auto report = check(exec::seq, L.mesh);
   CHECK(report.unreferenced_vertex.count == 0);
   double vol = 0;
   for (Index t = 0; t < L.mesh.T.rows(); ++t) vol += det_volume(L.mesh, t);
   CHECK(vol == doctest::Approx(cells.volume()).epsilon(1e-12));
-  const auto q = element_quality(L.mesh.V, L.mesh.T);
+  const auto q = element_quality(exec::seq, L.mesh.V, L.mesh.T);
   CHECK(q.minCoeff() >= min_quality);
   if (conforming) CHECK(boundary_faces(L.mesh.T).rows() == 2 * outer_cell_faces(cells));
   std::set<std::array<std::int64_t, 3>> coords;
@@ -123,7 +123,7 @@ TEST_CASE("build_lattice on random cell sets: conforming splits cover exactly th
 TEST_CASE("BCC quality: face tets 0.95, in mean ratio, pyramid halves only on the boundary") {
   const auto cells = random_cells({5, 5, 5}, 1.0, 1.0, 3);
   const auto L = build_lattice<BccSplit>(cells);
-  const auto q = element_quality(L.mesh.V, L.mesh.T);
+  const auto q = element_quality(exec::seq, L.mesh.V, L.mesh.T);
   std::map<long, Index> hist;
   for (Index t = 0; t < q.size(); ++t) ++hist[std::lround(q[t] * 1000)];
   REQUIRE(hist.size() == 2);  // two shapes: (centre, centre, edge) and (centre, face triangle)
@@ -178,7 +178,7 @@ TEST_CASE("bcc_lattice of an ellipsoid surface and of a tet mesh; bcc_points_ins
   const auto surf = ellipsoid_surface(2000, 1.0, 0.8, 0.6);
   const double h = 0.15;
   const auto L = bcc_lattice(surf, h);
-  CHECK_NOTHROW(validate(L.mesh));
+  CHECK_NOTHROW(validate(exec::seq, L.mesh));
   CHECK(L.mesh.T.rows() > 0);
   CHECK(boundary_faces(L.mesh.T).rows() == 2 * outer_cell_faces(L.cells));
   CHECK(connected_components(L.mesh.T, L.mesh.V.rows()).count == 1);

@@ -35,7 +35,7 @@ std::vector<TriMesh<>> random_surfaces(std::mt19937& rng) {
 TEST_CASE("cotangent_laplacian: symmetric, annihilates constants, negative semi-definite, seq == omp") {
   std::mt19937 rng(30);
   for (const auto& m : random_surfaces(rng)) {
-    const Eigen::SparseMatrix<double> L = cotangent_laplacian(m.V, m.F);
+    const Eigen::SparseMatrix<double> L = cotangent_laplacian(exec::seq, m.V, m.F);
     REQUIRE(L.rows() == m.V.rows());
     const Eigen::MatrixXd D(L);
     CHECK((D - D.transpose()).cwiseAbs().maxCoeff() <= 1e-14 * D.cwiseAbs().maxCoeff());
@@ -57,7 +57,7 @@ TEST_CASE("cotangent_laplacian: symmetric, annihilates constants, negative semi-
 TEST_CASE("cotangent_laplacian: L·V = −∇(total area), checked by central differences") {
   std::mt19937 rng(31);
   for (const auto& m : random_surfaces(rng)) {
-    const Eigen::SparseMatrix<double> L = cotangent_laplacian(m.V, m.F);
+    const Eigen::SparseMatrix<double> L = cotangent_laplacian(exec::seq, m.V, m.F);
     const Eigen::MatrixXd LV = L * Eigen::MatrixXd(m.V);
     Points<> X = m.V;
     const double h = 1e-6;
@@ -66,9 +66,9 @@ TEST_CASE("cotangent_laplacian: L·V = −∇(total area), checked by central di
       for (int d = 0; d < 3; ++d) {
         const double x0 = X(v, d);
         X(v, d) = x0 + h;
-        const double ap = face_areas(X, m.F).sum();
+        const double ap = face_areas(exec::seq, X, m.F).sum();
         X(v, d) = x0 - h;
-        const double am = face_areas(X, m.F).sum();
+        const double am = face_areas(exec::seq, X, m.F).sum();
         X(v, d) = x0;
         worst = std::max(worst, std::abs(LV(v, d) + (ap - am) / (2 * h)));
       }
@@ -82,7 +82,7 @@ TEST_CASE("cotangent_laplacian: exact on linear functions at interior vertices o
     TriMesh<> g = grid_surface(n, rng);
     std::uniform_real_distribution<double> u(-0.3, 0.3);
     for (Index v = 0; v < g.V.rows(); ++v) g.V(v, 0) += u(rng), g.V(v, 1) += u(rng);  // stays planar and valid
-    const Eigen::SparseMatrix<double> L = cotangent_laplacian(g.V, g.F);
+    const Eigen::SparseMatrix<double> L = cotangent_laplacian(exec::seq, g.V, g.F);
     const Eigen::VectorXd f = 0.7 * g.V.col(0) - 1.3 * g.V.col(1) + Eigen::VectorXd::Constant(g.V.rows(), 2.0);
     const Eigen::VectorXd Lf = L * f;
     const Edges B = boundary_edges(g.F);
@@ -96,7 +96,7 @@ TEST_CASE("cotangent_laplacian: exact on linear functions at interior vertices o
 TEST_CASE("cotangent_laplacian with Voronoi areas: mean curvature normal of a sphere is 2/r·n") {
   const double r = 1.7;
   const TriMesh<> s = icosphere(4, r);
-  const Eigen::MatrixXd LV = cotangent_laplacian(s.V, s.F) * Eigen::MatrixXd(s.V);
+  const Eigen::MatrixXd LV = cotangent_laplacian(exec::seq, s.V, s.F) * Eigen::MatrixXd(s.V);
   const VecX<> A = voronoi_areas(s.V, s.F);
   for (Index v = 0; v < s.V.rows(); ++v) {
     const Eigen::RowVector3d Hn = -LV.row(v) / A[v];
@@ -109,7 +109,7 @@ TEST_CASE("cotangent_weights of an equilateral and a right triangle") {
   V << 0, 0, 0, 1, 0, 0, 0.5, std::sqrt(3.0) / 2, 0, 0, 1, 0;
   Tris F(2, 3);
   F << 0, 1, 2, 0, 1, 3;
-  const Points<> C = cotangent_weights(V, F);
+  const Points<> C = cotangent_weights(exec::seq, V, F);
   for (int c = 0; c < 3; ++c) CHECK(C(0, c) == doctest::Approx(0.5 / std::sqrt(3.0)));
   CHECK(C(1, 0) == doctest::Approx(0.0));  // right angle at vertex 0
   CHECK(C(1, 1) == doctest::Approx(0.5));  // 45°

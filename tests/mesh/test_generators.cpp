@@ -39,7 +39,7 @@ void check_sphere_surface(const TriMesh<>& m) {
   const Index E = unique_edges(m.F).rows();
   CHECK(m.V.rows() - E + m.F.rows() == 2);
   CHECK(connected_components(m.F, m.V.rows()).count == 1);
-  CHECK_NOTHROW(validate(m));
+  CHECK_NOTHROW(validate(exec::seq, m));
 }
 
 }  // namespace
@@ -50,11 +50,11 @@ TEST_CASE("box_tet_mesh: exact volume, positive tets, boundary = 2 triangles per
       CAPTURE(n[0]);
       const Vec3<> lo(-1, 0.5, 2), hi(2, 1.5, 2.25);
       const auto m = box_tet_mesh(n[0], n[1], n[2], lo, hi, split);
-      CHECK_NOTHROW(validate(m));
+      CHECK_NOTHROW(validate(exec::seq, m));
       CHECK(m.T.rows() == (split == CubeSplit::six ? 6 : 5) * n[0] * n[1] * n[2]);
       CHECK(tets_volume(m) == doctest::Approx(3.0 * 1.0 * 0.25).epsilon(1e-13));
       CHECK(boundary_faces(m.T).rows() == test::box_boundary_count(n[0], n[1], n[2]));
-      const auto q = element_quality(m.V, m.T);
+      const auto q = element_quality(exec::seq, m.V, m.T);
       CHECK(q.minCoeff() > 0);
     }
   CHECK_THROWS_AS(box_tet_mesh(0, 1, 1), ArgumentError);
@@ -66,7 +66,7 @@ TEST_CASE("cylinder_tet_mesh: inscribed-prism volume exactly, O(h^2) convergence
   std::vector<double> err;
   for (const Index n : {2, 4, 8, 16}) {
     const auto m = cylinder_tet_mesh(r, H, n, 3);
-    CHECK_NOTHROW(validate(m));
+    CHECK_NOTHROW(validate(exec::seq, m));
     CHECK(m.T.rows() == 18 * n * n * 3);
     const double N = 6.0 * double(n), polygon = 0.5 * N * r * r * std::sin(2 * pi / N);
     CHECK(tets_volume(m) == doctest::Approx(polygon * H).epsilon(1e-12));
@@ -83,7 +83,7 @@ TEST_CASE("sphere_shell_tet_mesh: conforming shell, two boundary spheres, O(h^2)
   std::vector<double> err;
   for (const Index level : {1, 2, 3, 4}) {
     const auto m = sphere_shell_tet_mesh(r0, r1, level, 3);
-    CHECK_NOTHROW(validate(m));
+    CHECK_NOTHROW(validate(exec::seq, m));
     const auto B = boundary_faces(m.T);
     CHECK(B.rows() == 2 * 20 * (Index(1) << (2 * level)));  // inner + outer icosphere
     CHECK(connected_components(B, m.V.rows()).count == m.V.rows() - 2 * (10 * (Index(1) << (2 * level)) + 2) + 2);

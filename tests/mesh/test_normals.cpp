@@ -14,8 +14,8 @@ TEST_CASE("face_areas: Heron's formula; face_normals: unit, orthogonal to edges,
   for (Index i = 0; i < V.size(); ++i) V.data()[i] = n(rng);
   Tris F(300, 3);
   for (Index f = 0; f < F.rows(); ++f) F.row(f) << 3 * f, 3 * f + 1, 3 * f + 2;
-  const VecX<> A = face_areas(V, F);
-  const Points<> N = face_normals(V, F);
+  const VecX<> A = face_areas(exec::seq, V, F);
+  const Points<> N = face_normals(exec::seq, V, F);
   for (Index f = 0; f < F.rows(); ++f) {
     const Vec3<> a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
     const double x = (b - a).norm(), y = (c - b).norm(), z = (a - c).norm(), s = (x + y + z) / 2;
@@ -30,7 +30,7 @@ TEST_CASE("face_areas: Heron's formula; face_normals: unit, orthogonal to edges,
   }
   Tris flat(1, 3);
   flat << 0, 0, 1;
-  CHECK(face_normals(V, flat).row(0).norm() == 0);
+  CHECK(face_normals(exec::seq, V, flat).row(0).norm() == 0);
   CHECK(face_areas(exec::omp, V, F) == A);
   CHECK(face_normals(exec::omp, V, F) == N);
 }
@@ -40,10 +40,10 @@ TEST_CASE("icosphere: total area → 4πr², vertex normals → radial under eve
   double prev_err = 0;
   for (int level = 1; level <= 4; ++level) {
     const TriMesh<> s = icosphere(level, r);
-    const double area = face_areas(s.V, s.F).sum();
+    const double area = face_areas(exec::seq, s.V, s.F).sum();
     CHECK(area < 4 * M_PI * r * r);  // inscribed polyhedron
     if (level == 4) CHECK(area == doctest::Approx(4 * M_PI * r * r).epsilon(5e-3));
-    const Points<> fn = face_normals(s.V, s.F);
+    const Points<> fn = face_normals(exec::seq, s.V, s.F);
     for (Index f = 0; f < s.F.rows(); ++f) {  // outward: the normal points away from the centre
       CHECK(fn.row(f).dot(s.V.row(s.F(f, 0))) > 0);
     }

@@ -27,7 +27,7 @@ TEST_CASE("element_quality of tets: 1 when regular under any similarity, → 0 w
     const Mat3<> R = random_rotation(rng);
     const double s = std::exp(n(rng));
     const Points<> V = ((regular_tet() * R.transpose()) * s).rowwise() + Eigen::RowVector3d(n(rng), n(rng), n(rng));
-    const VecX<> q = element_quality(V, T);
+    const VecX<> q = element_quality(exec::seq, V, T);
     CHECK(q[0] == doctest::Approx(1.0).epsilon(1e-12));
     CHECK(q[1] == doctest::Approx(-1.0).epsilon(1e-12));
   }
@@ -38,7 +38,7 @@ TEST_CASE("element_quality of tets: 1 when regular under any similarity, → 0 w
   for (double t : {1.0, 0.5, 0.1, 1e-2, 1e-4, 1e-8}) {
     Points<> W = V;
     W.row(3) = (base + t * (V.row(3).transpose() - base)).transpose();
-    const double q = element_quality(W, T)[0];
+    const double q = element_quality(exec::seq, W, T)[0];
     CHECK(q < prev);
     CHECK(q > 0);
     prev = q;
@@ -58,18 +58,18 @@ TEST_CASE("element_quality: random tets and triangles lie in (0, 1], similarity-
     if (det_volume6(V, {T(t, 0), T(t, 1), T(t, 2), T(t, 3)}) < 0) std::swap(T(t, 2), T(t, 3));
     F.row(t) << 4 * t, 4 * t + 1, 4 * t + 2;
   }
-  const VecX<> qt = element_quality(V, T), qf = element_quality(V, F);
+  const VecX<> qt = element_quality(exec::seq, V, T), qf = element_quality(exec::seq, V, F);
   CHECK(qt.minCoeff() > 0);
   CHECK(qt.maxCoeff() <= 1 + 1e-12);
   CHECK(qf.minCoeff() >= 0);
   CHECK(qf.maxCoeff() <= 1 + 1e-12);
   const Mat3<> R = random_rotation(rng);
   const Points<> W = (V * R.transpose() * 3.7).rowwise() + Eigen::RowVector3d(1, 2, 3);
-  CHECK((element_quality(W, T) - qt).cwiseAbs().maxCoeff() < 1e-9);
-  CHECK((element_quality(W, F) - qf).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK((element_quality(exec::seq, W, T) - qt).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK((element_quality(exec::seq, W, F) - qf).cwiseAbs().maxCoeff() < 1e-9);
   CHECK(element_quality(exec::omp, V, T) == qt);
   CHECK(element_quality(exec::omp, V, F) == qf);
-  CHECK_THROWS_AS(element_quality(V, Edges(1, 2)), ShapeError);
+  CHECK_THROWS_AS(element_quality(exec::seq, V, Edges(1, 2)), ShapeError);
 }
 
 TEST_CASE("element_quality of triangles: equilateral 1, collinear 0, right isosceles √3/2") {
@@ -77,7 +77,7 @@ TEST_CASE("element_quality of triangles: equilateral 1, collinear 0, right isosc
   V << 0, 0, 0, 1, 0, 0, 0.5, std::sqrt(3.0) / 2, 0, 0, 1, 0, 2, 0, 0, 7, 7, 7;
   Tris F(3, 3);
   F << 0, 1, 2, 0, 1, 3, 0, 1, 4;
-  const VecX<> q = element_quality(V, F);
+  const VecX<> q = element_quality(exec::seq, V, F);
   CHECK(q[0] == doctest::Approx(1.0));
   CHECK(q[1] == doctest::Approx(std::sqrt(3.0) / 2));  // 4√3·½ / (1 + 1 + 2)
   CHECK(q[2] == doctest::Approx(0.0));

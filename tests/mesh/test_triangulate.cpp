@@ -124,8 +124,8 @@ TEST_CASE("triangulate: several polygons, face_of_triangle, and errors naming th
   const TriMesh<> t = triangulate(poly, &face_of);
   CHECK(t.F.rows() == 5);
   CHECK(face_of == std::vector<Index>{0, 0, 1, 1, 2});
-  CHECK(face_areas(t.V, t.F).sum() == doctest::Approx(1.0 + 0.75 + 0.5));
-  for (Index f = 0; f < t.F.rows(); ++f) CHECK(face_normals(t.V, t.F)(f, 2) == doctest::Approx(1.0));
+  CHECK(face_areas(exec::seq, t.V, t.F).sum() == doctest::Approx(1.0 + 0.75 + 0.5));
+  for (Index f = 0; f < t.F.rows(); ++f) CHECK(face_normals(exec::seq, t.V, t.F)(f, 2) == doctest::Approx(1.0));
   PolyMesh<> bad = poly;
   bad.add_face(std::vector<int>{0, 1});
   try {
@@ -170,7 +170,7 @@ TEST_CASE("real data: the ICT face (quads) triangulates, keeps vector areas, is 
     tri_area.row(face_of[t]) += (b - a).cross(c - a).transpose() / 2;
   }
   CHECK((newell - tri_area).cwiseAbs().maxCoeff() < 1e-9);
-  CHECK_NOTHROW(validate(tri));
+  CHECK_NOTHROW(validate(exec::seq, tri));
   // Topology: one connected piece, genus 0 with holes (eyes, mouth, neck...): χ = 2 − #loops.
   const Components C = connected_components(tri.F, tri.V.rows());
   CHECK(C.count == 1);

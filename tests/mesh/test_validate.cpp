@@ -16,7 +16,7 @@ namespace {
 template <class Mesh>
 std::pair<std::string, Index> error_of(const Mesh& m, const ValidateOptions& opt = {}) {
   try {
-    validate(m, opt);
+    validate(exec::seq, m, opt);
   } catch (const MeshError& e) {
     return {e.kind(), e.element()};
   }
@@ -33,11 +33,11 @@ TEST_CASE("validate accepts box tetrahedralizations and their boundary surfaces"
   for (int trial = 0; trial < 10; ++trial) {
     TetMesh<> m = box_tets(1 + trial % 4, 2, 1 + trial % 3, 0.01 + trial, Vec3<>::Zero(), trial % 2);
     jitter(m.V, 0.05 * (0.01 + trial), rng);
-    CHECK_NOTHROW(validate(m));
+    CHECK_NOTHROW(validate(exec::seq, m));
     CHECK_NOTHROW(validate(exec::omp, m));
-    CHECK(check(m).ok());
-    CHECK(check(m).summary().empty());
-    CHECK_NOTHROW(validate(boundary_surface(m)));
+    CHECK(check(exec::seq, m).ok());
+    CHECK(check(exec::seq, m).summary().empty());
+    CHECK_NOTHROW(validate(exec::seq, boundary_surface(m)));
   }
 }
 
@@ -54,29 +54,29 @@ TEST_CASE("validate names the offending tet for each kind of problem, at random 
       TetMesh<> m = good;
       m.T(t, rng() % 4) = (rng() & 1) ? VIndex(m.V.rows() + rng() % 5) : VIndex(-1 - VIndex(rng() % 5));
       CHECK(error_of(m) == std::pair<std::string, Index>{"tet", t});
-      CHECK(check(m).out_of_range.count == 1);
-      CHECK(check(m).out_of_range.first == t);
+      CHECK(check(exec::seq, m).out_of_range.count == 1);
+      CHECK(check(exec::seq, m).out_of_range.first == t);
     }
     {  // repeated vertex
       TetMesh<> m = good;
       const int a = int(rng() % 4), b = (a + 1 + int(rng() % 3)) % 4;
       m.T(t, a) = m.T(t, b);
       CHECK(error_of(m) == std::pair<std::string, Index>{"tet", t});
-      CHECK(check(m).repeated_vertex.first == t);
+      CHECK(check(exec::seq, m).repeated_vertex.first == t);
     }
     {  // degenerate: four coplanar vertices
       TetMesh<> m = good;
       const auto q = coplanar_quad(nx);
       m.T.row(t) << q[0], q[1], q[2], q[3];
       CHECK(error_of(m) == std::pair<std::string, Index>{"tet", t});
-      CHECK(check(m).degenerate.count == 1);
-      CHECK(check(m).degenerate.first == t);
+      CHECK(check(exec::seq, m).degenerate.count == 1);
+      CHECK(check(exec::seq, m).degenerate.first == t);
     }
     {  // inverted: an odd permutation of the corners
       TetMesh<> m = good;
       std::swap(m.T(t, 0), m.T(t, 1 + rng() % 3));
       CHECK(error_of(m) == std::pair<std::string, Index>{"tet", t});
-      CHECK(check(m).inverted.first == t);
+      CHECK(check(exec::seq, m).inverted.first == t);
       ValidateOptions allow;
       allow.allow_inverted = true;
       CHECK(error_of(m, allow).second == -2);
@@ -87,7 +87,7 @@ TEST_CASE("validate names the offending tet for each kind of problem, at random 
       m.V(v, rng() % 3) = (rng() & 1) ? std::numeric_limits<double>::quiet_NaN() : std::numeric_limits<double>::infinity();
       std::swap(m.T(t, 0), m.T(t, 1));
       CHECK(error_of(m) == std::pair<std::string, Index>{"vertex", v});
-      CHECK(check(m).non_finite_vertex.first == v);
+      CHECK(check(exec::seq, m).non_finite_vertex.first == v);
     }
   }
 }
@@ -134,20 +134,20 @@ TEST_CASE("validate: degenerate tolerance is relative to the longest edge (scale
     CHECK(error_of(m, tight).second == -2);
     m.V(3, 2) = 0;  // exactly flat
     CHECK(error_of(m, off).second == -2);
-    CHECK(check(m, off).degenerate.count == 0);
-    CHECK(check(m).degenerate.count == 1);
+    CHECK(check(exec::seq, m, off).degenerate.count == 0);
+    CHECK(check(exec::seq, m).degenerate.count == 1);
   }
 }
 
 TEST_CASE("validate triangle meshes; unreferenced vertices are reported, not errors") {
   std::mt19937 rng(63);
   TriMesh<> s = icosphere(2);
-  CHECK_NOTHROW(validate(s));
+  CHECK_NOTHROW(validate(exec::seq, s));
   s.V.conservativeResize(s.V.rows() + 2, 3);
   s.V.bottomRows(2).setConstant(5.0);
-  CHECK_NOTHROW(validate(s));
-  CHECK(check(s).unreferenced_vertex.count == 2);
-  CHECK(check(s).unreferenced_vertex.first == s.V.rows() - 2);
+  CHECK_NOTHROW(validate(exec::seq, s));
+  CHECK(check(exec::seq, s).unreferenced_vertex.count == 2);
+  CHECK(check(exec::seq, s).unreferenced_vertex.first == s.V.rows() - 2);
   for (int trial = 0; trial < 20; ++trial) {
     const Index f = Index(rng() % s.F.rows());
     TriMesh<> m = s;
@@ -157,7 +157,7 @@ TEST_CASE("validate triangle meshes; unreferenced vertices are reported, not err
       case 2: m.V.row(m.F(f, 2)) = (m.V.row(m.F(f, 0)) + m.V.row(m.F(f, 1))) / 2; break;  // flat
     }
     if (trial % 3 == 2) {  // moving a shared vertex onto an edge may also flatten an earlier triangle
-      const MeshReport r = check(m);
+      const MeshReport r = check(exec::seq, m);
       CHECK(r.degenerate.count >= 1);
       CHECK(error_of(m) == std::pair<std::string, Index>{"triangle", r.degenerate.first});
       CHECK(r.degenerate.first <= f);
@@ -169,7 +169,7 @@ TEST_CASE("validate triangle meshes; unreferenced vertices are reported, not err
   m.V(3, 1) = std::numeric_limits<double>::quiet_NaN();
   CHECK(error_of(m) == std::pair<std::string, Index>{"vertex", 3});
   try {
-    validate(m);
+    validate(exec::seq, m);
   } catch (const MeshError& e) {
     CHECK(std::string(e.what()).find("vertex 3") == 0);
   }

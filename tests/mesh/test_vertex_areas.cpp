@@ -21,7 +21,7 @@ TEST_CASE("voronoi_areas and barycentric_areas sum to the total area, are non-ne
   for (int trial = 0; trial < 20; ++trial) {
     TriMesh<> m = trial % 2 ? icosphere(1 + trial % 3, 1.0) : grid_surface(2 + trial % 5, rng);
     jitter(m.V, 0.25, rng);  // plenty of obtuse triangles
-    const double total = face_areas(m.V, m.F).sum();
+    const double total = face_areas(exec::seq, m.V, m.F).sum();
     const VecX<> vor = voronoi_areas(m.V, m.F), bar = barycentric_areas(m.V, m.F);
     CHECK(vor.sum() == doctest::Approx(total).epsilon(1e-12));
     CHECK(bar.sum() == doctest::Approx(total).epsilon(1e-12));

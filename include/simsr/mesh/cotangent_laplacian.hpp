@@ -30,12 +30,6 @@ Points<typename DV::Scalar> cotangent_weights(P policy, const Eigen::MatrixBase<
   return C;
 }
 
-/// Sequential cotangent_weights.
-template <class DV, class DF>
-Points<typename DV::Scalar> cotangent_weights(const Eigen::MatrixBase<DV>& V, const Eigen::MatrixBase<DF>& F) {
-  return cotangent_weights(exec::seq, V, F);
-}
-
 /// Cotangent Laplacian L (#V×#V, symmetric) of V #V×3, F #F×3, libigl's sign convention:
 /// L(i,j) = ½(cot α_ij + cot β_ij) for each edge ij (α, β the angles opposite it), L(i,i) = −Σ_j L(i,j).
 /// L is negative semi-definite, annihilates constants, and L·V = −∇(total area) (the mean
@@ -60,12 +54,6 @@ Eigen::SparseMatrix<typename DV::Scalar> cotangent_laplacian(P policy, const Eig
   Eigen::SparseMatrix<S> L(V.rows(), V.rows());
   L.setFromTriplets(trip.begin(), trip.end());
   return L;
-}
-
-/// Sequential cotangent_laplacian.
-template <class DV, class DF>
-Eigen::SparseMatrix<typename DV::Scalar> cotangent_laplacian(const Eigen::MatrixBase<DV>& V, const Eigen::MatrixBase<DF>& F) {
-  return cotangent_laplacian(exec::seq, V, F);
 }
 
 }  // namespace simsr

@@ -30,12 +30,6 @@ VecX<typename DV::Scalar> face_areas(P policy, const Eigen::MatrixBase<DV>& V, c
   return A;
 }
 
-/// Sequential face_areas.
-template <class DV, class DF>
-VecX<typename DV::Scalar> face_areas(const Eigen::MatrixBase<DV>& V, const Eigen::MatrixBase<DF>& F) {
-  return face_areas(exec::seq, V, F);
-}
-
 /// Unit normal of every triangle, (v1−v0)×(v2−v0) normalized (right-hand rule: outward for
 /// counter-clockwise faces); zero for a degenerate (zero-area) triangle. V #V×3, F #F×3 → #F×3.
 template <exec::HostPolicy P, class DV, class DF>
@@ -50,12 +44,6 @@ Points<typename DV::Scalar> face_normals(P policy, const Eigen::MatrixBase<DV>& 
     N.row(f) = (len > S(0) ? Vec3<S>(n / len) : Vec3<S>::Zero()).transpose();
   });
   return N;
-}
-
-/// Sequential face_normals.
-template <class DV, class DF>
-Points<typename DV::Scalar> face_normals(const Eigen::MatrixBase<DV>& V, const Eigen::MatrixBase<DF>& F) {
-  return face_normals(exec::seq, V, F);
 }
 
 /// How the normals of the triangles around a vertex are averaged.

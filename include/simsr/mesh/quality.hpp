@@ -55,10 +55,4 @@ VecX<typename DV::Scalar> element_quality(P policy, const Eigen::MatrixBase<DV>&
   return q;
 }
 
-/// Sequential element_quality.
-template <class DV, class DE>
-VecX<typename DV::Scalar> element_quality(const Eigen::MatrixBase<DV>& V, const Eigen::MatrixBase<DE>& E) {
-  return element_quality(exec::seq, V, E);
-}
-
 }  // namespace simsr

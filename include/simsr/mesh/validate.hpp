@@ -4,7 +4,7 @@
 /// offending vertex or element of each kind; `validate` throws MeshError naming the first one.
 ///
 ///     simsr::validate(exec::omp, mesh);                  // throws "tet 17: inverted (volume -0.002)"
-///     auto r = simsr::check(mesh);  if (!r.ok()) std::cerr << r.summary();
+///     auto r = simsr::check(exec::omp, mesh);  if (!r.ok()) std::cerr << r.summary();
 
 #include <algorithm>
 #include <cmath>
@@ -201,15 +201,6 @@ MeshReport check(P policy, const TriMesh<S>& mesh, const ValidateOptions& option
   return detail::check_elements<3>(policy, mesh.V, mesh.F, options);
 }
 
-template <class S>
-MeshReport check(const TetMesh<S>& mesh, const ValidateOptions& options = {}) {
-  return check(exec::seq, mesh, options);
-}
-template <class S>
-MeshReport check(const TriMesh<S>& mesh, const ValidateOptions& options = {}) {
-  return check(exec::seq, mesh, options);
-}
-
 /// Throws MeshError for the first problem of a tet mesh: a non-finite vertex coordinate (kind
 /// "vertex", smallest such vertex) first, otherwise the smallest tet (kind "tet") with an index
 /// outside [0, #V), a repeated vertex, |volume| ≤ tolerance·ℓ³, or a negative volume.
@@ -225,15 +216,6 @@ template <exec::HostPolicy P, class S>
 void validate(P policy, const TriMesh<S>& mesh, const ValidateOptions& options = {}) {
   const MeshReport r = check(policy, mesh, options);
   if (!r.ok()) detail::throw_first<3>(r, mesh.V, mesh.F, options);
-}
-
-template <class S>
-void validate(const TetMesh<S>& mesh, const ValidateOptions& options = {}) {
-  validate(exec::seq, mesh, options);
-}
-template <class S>
-void validate(const TriMesh<S>& mesh, const ValidateOptions& options = {}) {
-  validate(exec::seq, mesh, options);
 }
 
 }  // namespace simsr
