@@ -4,22 +4,13 @@
 
 #include <doctest/doctest.h>
 
+#include "../support/error_of.hpp"
+
 #include <filesystem>
 #include <string>
 
 using namespace simsr;
-
-namespace {
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-}  // namespace
+using simsr::test::error_of;
 
 TEST_CASE("network neighbourhoods: the authors' bunny files and rest shapes") {
   const auto dir = std::filesystem::path(SIMSR_DATA_DIR) / "bunny";

@@ -4,12 +4,15 @@
 
 #include <doctest/doctest.h>
 
+#include "../support/error_of.hpp"
+
 #include <filesystem>
 #include <random>
 #include <set>
 #include <string>
 
 using namespace simsr;
+using simsr::test::error_of;
 
 namespace {
 
@@ -33,15 +36,6 @@ data::PairedFrames<> random_frames(std::mt19937& rng, Index f, Index n, Index m,
   return p;
 }
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 void check_contains(const std::string& message, const std::string& part) {
   INFO(message);
