@@ -1,6 +1,6 @@
 /// The super-resolution network (profile `official`) at the paper's sizes and on the bunny:
 ///  - BM_official_forward_paper_size/{seq,omp}: inference (eval mode; the upsampling weights are
-///    precomputed once by prepare_inference outside the loop, then infer() per frame) with
+///    precomputed once by prepare_inference(policy) outside the loop, then infer(policy, …) per frame) with
 ///    up_k = 20 at N = 15,872 LR and M = 35,637 HR vertices, B = 1 (issue #4's "about a second
 ///    per frame on 2 cores").
 ///  - BM_official_forward_train_mode_paper_size/omp: forward(Mode::train), B = 1, same sizes
@@ -92,16 +92,16 @@ Matrix<float> paper_ldx(Index B) {
   return x;
 }
 
-template <class Policy>
-void BM_official_forward_paper_size(benchmark::State& state, Policy policy) {
+template <exec::HostPolicy Policy>
+void BM_official_forward_paper_size(Policy policy, benchmark::State& state) {
   nn::Rng rng(0);
   nn::SuperResolutionNet<float> net(paper_config(), paper_geo(), rng);
   const Matrix<float> ldx = paper_ldx(1);
   Matrix<float> pred;
-  net.prepare_inference(exec::omp);
-  net.infer(ldx, pred, policy);  // warm the buffers
+  net.prepare_inference(policy);
+  net.infer(policy, ldx, pred);  // warm the buffers
   for (auto _ : state) {
-    net.infer(ldx, pred, policy);
+    net.infer(policy, ldx, pred);
     benchmark::DoNotOptimize(pred.data());
   }
 }
@@ -111,9 +111,9 @@ void BM_official_forward_train_mode_paper_size(benchmark::State& state) {
   nn::SuperResolutionNet<float> net(paper_config(), paper_geo(), rng);
   const Matrix<float> ldx = paper_ldx(1);
   Matrix<float> pred;
-  net.forward(nn::Mode::train, ldx, pred, exec::omp);
+  net.forward(exec::omp, nn::Mode::train, ldx, pred);
   for (auto _ : state) {
-    net.forward(nn::Mode::train, ldx, pred, exec::omp);
+    net.forward(exec::omp, nn::Mode::train, ldx, pred);
     benchmark::DoNotOptimize(pred.data());
   }
 }
@@ -169,9 +169,9 @@ void BM_official_train_step_bunny(benchmark::State& state) {
   Matrix<float> pred, d_pred, d_z;
   auto step = [&] {
     net.store().zero_grad();
-    net.forward(nn::Mode::train, ldx, pred, exec::omp);
+    net.forward(exec::omp, nn::Mode::train, ldx, pred);
     const auto t = loss.evaluate(exec::omp, pred, hdx, net.code(), 0, &d_pred, &d_z);
-    net.backward(d_pred, &d_z, exec::omp);
+    net.backward(exec::omp, d_pred, &d_z);
     adam.step(exec::omp);
     return t.total;
   };
@@ -181,8 +181,8 @@ void BM_official_train_step_bunny(benchmark::State& state) {
   state.counters["loss"] = total;
 }
 
-void BM_official_forward_paper_size_seq(benchmark::State& s) { BM_official_forward_paper_size(s, exec::seq); }
-void BM_official_forward_paper_size_omp(benchmark::State& s) { BM_official_forward_paper_size(s, exec::omp); }
+void BM_official_forward_paper_size_seq(benchmark::State& s) { BM_official_forward_paper_size(exec::seq, s); }
+void BM_official_forward_paper_size_omp(benchmark::State& s) { BM_official_forward_paper_size(exec::omp, s); }
 
 }  // namespace
 

@@ -117,12 +117,14 @@ inline void check_gradients(const std::vector<GradientError>& errors, double tol
 }
 
 /// The same layer checked on its own (forward/backward with `mode`).
-template <class L>
+template <nn::Layer L>
 std::vector<GradientError> layer_gradient_check(L& layer, nn::ParameterStore<double>* store, const Matrix<double>& x, nn::Mode mode,
                                                 std::mt19937_64& rng) {
   return gradient_check(
-      x, store, [&](const Matrix<double>& in, Matrix<double>& out) { layer.forward(mode, in, out); },
-      [&](const Matrix<double>& in, const Matrix<double>& out, const Matrix<double>& d, Matrix<double>* dx) { layer.backward(in, out, d, dx); },
+      x, store, [&](const Matrix<double>& in, Matrix<double>& out) { layer.forward(exec::seq, mode, in, out); },
+      [&](const Matrix<double>& in, const Matrix<double>& out, const Matrix<double>& d, Matrix<double>* dx) {
+        layer.backward(exec::seq, in, out, d, dx);
+      },
       rng);
 }
 
@@ -133,18 +135,18 @@ bool bitwise_equal(const A& a, const B& b) {
 
 /// forward + backward under exec::seq and exec::omp from the same state: outputs, input
 /// gradients, parameter gradients and buffers must agree bit for bit.
-template <class L, class S>
+template <nn::Layer L, class S>
 void check_seq_equals_omp(L& layer, nn::ParameterStore<S>* store, const Matrix<S>& x, nn::Mode mode, std::mt19937_64& rng) {
   const nn::Vector<S> buffers0 = store ? nn::Vector<S>(store->buffers()) : nn::Vector<S>();
   Matrix<S> out1, dx1, out2, dx2;
   if (store) store->zero_grad();
-  layer.forward(mode, x, out1, exec::seq);
+  layer.forward(exec::seq, mode, x, out1);
   const Matrix<S> r = random_matrix(rng, out1.rows(), out1.cols()).template cast<S>();
-  layer.backward(x, out1, r, &dx1, exec::seq);
+  layer.backward(exec::seq, x, out1, r, &dx1);
   nn::Vector<S> grads1, buffers1;
   if (store) grads1 = store->gradients(), buffers1 = store->buffers(), store->buffers() = buffers0, store->zero_grad();
-  layer.forward(mode, x, out2, exec::omp);
-  layer.backward(x, out2, r, &dx2, exec::omp);
+  layer.forward(exec::omp, mode, x, out2);
+  layer.backward(exec::omp, x, out2, r, &dx2);
   CHECK(bitwise_equal(out1, out2));
   CHECK(bitwise_equal(dx1, dx2));
   if (store) {
@@ -155,17 +157,17 @@ void check_seq_equals_omp(L& layer, nn::ParameterStore<S>* store, const Matrix<S
 
 /// A second forward + backward of the same shapes under `policy` calls malloc zero times and
 /// keeps the output and input-gradient buffers.
-template <class L, class S, class Policy>
-void check_warm_no_allocation(L& layer, const Matrix<S>& x, nn::Mode mode, Policy policy) {
+template <exec::HostPolicy Policy, nn::Layer L, class S>
+void check_warm_no_allocation(Policy policy, L& layer, const Matrix<S>& x, nn::Mode mode) {
   Matrix<S> out, dx;
-  layer.forward(mode, x, out, policy);
+  layer.forward(policy, mode, x, out);
   const Matrix<S> r = Matrix<S>::Ones(out.rows(), out.cols());
-  layer.backward(x, out, r, &dx, policy);
+  layer.backward(policy, x, out, r, &dx);
   const S* out_ptr = out.data();
   const S* dx_ptr = dx.data();
   const long before = simsr_test_malloc_count();
-  layer.forward(mode, x, out, policy);
-  layer.backward(x, out, r, &dx, policy);
+  layer.forward(policy, mode, x, out);
+  layer.backward(policy, x, out, r, &dx);
   const long after = simsr_test_malloc_count();
   CHECK(after - before == 0);
   CHECK(out.data() == out_ptr);

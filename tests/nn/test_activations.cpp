@@ -10,12 +10,12 @@ TEST_CASE("nn::LeakyReLU: values and gradients (slope 0.2 default)") {
   CHECK(act.slope() == 0.2);
   Matrix<double> x(1, 4), y, d;
   x << -2, 0, 3, -0.5;
-  act.forward(nn::Mode::train, x, y);
+  act.forward(exec::seq, nn::Mode::train, x, y);
   CHECK(y(0, 0) == doctest::Approx(-0.4));
   CHECK(y(0, 1) == 0.0);
   CHECK(y(0, 2) == 3.0);
   CHECK(y(0, 3) == doctest::Approx(-0.1));
-  act.backward(x, y, Matrix<double>::Ones(1, 4), &d);
+  act.backward(exec::seq, x, y, Matrix<double>::Ones(1, 4), &d);
   CHECK(d(0, 1) == doctest::Approx(0.2));  // PyTorch: slope at 0
   for (double slope : {0.2, 0.01, 1.5}) {
     nn::LeakyReLU<double> a(slope);
@@ -29,7 +29,7 @@ TEST_CASE("nn::Sine: sin(ω₀x) and its gradient") {
     nn::Sine<double> s(w0);
     const Matrix<double> x = random_matrix(rng, 11, 6, -0.2, 0.2);
     Matrix<double> y;
-    s.forward(nn::Mode::eval, x, y);
+    s.forward(exec::seq, nn::Mode::eval, x, y);
     for (Index i = 0; i < x.size(); ++i) CHECK(y.data()[i] == std::sin(w0 * x.data()[i]));
     test::check_gradients(test::layer_gradient_check(s, nullptr, x, nn::Mode::train, rng));
   }
@@ -63,13 +63,13 @@ TEST_CASE("nn activations: a Linear → Sine chain matches finite differences (S
   test::check_gradients(test::gradient_check(
       random_matrix(rng, 9, 7), &store,
       [&](const Matrix<double>& x, Matrix<double>& y) {
-        l.forward(nn::Mode::train, x, h);
-        s.forward(nn::Mode::train, h, y);
+        l.forward(exec::seq, nn::Mode::train, x, h);
+        s.forward(exec::seq, nn::Mode::train, h, y);
       },
       [&](const Matrix<double>& x, const Matrix<double>& y, const Matrix<double>& d, Matrix<double>* dx) {
         Matrix<double> dh;
-        s.backward(h, y, d, &dh);
-        l.backward(x, h, dh, dx);
+        s.backward(exec::seq, h, y, d, &dh);
+        l.backward(exec::seq, x, h, dh, dx);
       },
       rng));
 }
@@ -81,6 +81,6 @@ TEST_CASE("nn activations: seq == omp bitwise; warm calls allocate nothing") {
   nn::Sine<float> s(30.0f);
   test::check_seq_equals_omp(a, (nn::ParameterStore<float>*)nullptr, x, nn::Mode::train, rng);
   test::check_seq_equals_omp(s, (nn::ParameterStore<float>*)nullptr, x, nn::Mode::train, rng);
-  test::check_warm_no_allocation(a, x, nn::Mode::train, exec::omp);
-  test::check_warm_no_allocation(s, x, nn::Mode::train, exec::seq);
+  test::check_warm_no_allocation(exec::omp, a, x, nn::Mode::train);
+  test::check_warm_no_allocation(exec::seq, s, x, nn::Mode::train);
 }

@@ -36,7 +36,7 @@ TEST_CASE("nn::Adam: a few steps against a hand-written reference (with and with
     for (int step = 0; step < 6; ++step) {
       const Matrix<double> g = random_matrix(rng, store.num_parameters(), 1, -step - 1.0, step + 1.0);
       store.gradients() = g;
-      opt.step();
+      opt.step(exec::seq);
       ref.step(p, std::vector<long double>(g.data(), g.data() + g.size()));
       double err = 0;
       for (Index i = 0; i < store.num_parameters(); ++i) err = std::max(err, double(std::abs(store.values()[i] - p[std::size_t(i)])));
@@ -51,7 +51,7 @@ TEST_CASE("nn::Adam: a few steps against a hand-written reference (with and with
   store.values() << 1, -1;
   store.gradients() << 1e-3, -50;
   nn::Adam<double> opt(store, {.lr = 0.1});
-  opt.step();
+  opt.step(exec::seq);
   CHECK(store.values()[0] == doctest::Approx(1 - 0.1 * 1e-3 / (1e-3 + 1e-8)).epsilon(1e-12));
   CHECK(store.values()[1] == doctest::Approx(-1 + 0.1 * 50 / (50 + 1e-8)).epsilon(1e-12));
 }

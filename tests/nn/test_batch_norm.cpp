@@ -13,7 +13,7 @@ TEST_CASE("nn::BatchNorm1d train: two-pass batch statistics, PyTorch's running-a
   Matrix<double> x = random_matrix(rng, 37, 4, -2, 3);
   x.col(2).array() += 100;  // a large offset: one-pass E[x²] − E[x]² would lose digits here
   Matrix<double> y;
-  bn.forward(nn::Mode::train, x, y);
+  bn.forward(exec::seq, nn::Mode::train, x, y);
   const Index R = x.rows();
   for (Index c = 0; c < 4; ++c) {
     long double mean = 0, var = 0;
@@ -29,7 +29,7 @@ TEST_CASE("nn::BatchNorm1d train: two-pass batch statistics, PyTorch's running-a
     CHECK(bn.running_var()[c] == doctest::Approx(double(0.9L + 0.1L * var * R / (R - 1))).epsilon(1e-14));
   }
   CHECK(bn.num_batches_tracked() == 1.0);
-  bn.forward(nn::Mode::train, x, y);
+  bn.forward(exec::seq, nn::Mode::train, x, y);
   CHECK(bn.num_batches_tracked() == 2.0);
 }
 
@@ -44,15 +44,15 @@ TEST_CASE("nn::BatchNorm1d eval: normalizes with the running statistics and leav
   const Matrix<double> x = random_matrix(rng, 5, 3);
   Matrix<double> y;
   const nn::Vector<double> buffers = store.buffers();
-  bn.forward(nn::Mode::eval, x, y);
+  bn.forward(exec::seq, nn::Mode::eval, x, y);
   CHECK(test::bitwise_equal(buffers, nn::Vector<double>(store.buffers())));
   for (Index r = 0; r < 5; ++r)
     for (Index c = 0; c < 3; ++c)
       CHECK(y(r, c) == doctest::Approx((x(r, c) - bn.running_mean()[c]) / std::sqrt(bn.running_var()[c] + 1e-5) * bn.weight()[c] + bn.bias()[c]).epsilon(1e-14));
   Matrix<double> one = x.topRows(1), y1;
-  bn.forward(nn::Mode::eval, one, y1);  // one row is fine in eval
+  bn.forward(exec::seq, nn::Mode::eval, one, y1);  // one row is fine in eval
   CHECK(y1.row(0) == y.row(0));
-  CHECK_THROWS_AS(bn.forward(nn::Mode::train, one, y1), ArgumentError);
+  CHECK_THROWS_AS(bn.forward(exec::seq, nn::Mode::train, one, y1), ArgumentError);
 }
 
 TEST_CASE("nn::BatchNorm1d: full Jacobian-vector products match finite differences (train and eval)") {
@@ -87,9 +87,9 @@ TEST_CASE("nn::BatchNorm1d: state-dict tensors, seq == omp bitwise, warm calls a
   const Matrix<float> x = random_matrix(rng, 2000, 96, -3, 5).cast<float>();
   test::check_seq_equals_omp(bn, &store, x, nn::Mode::train, rng);
   test::check_seq_equals_omp(bn, &store, x, nn::Mode::eval, rng);
-  test::check_warm_no_allocation(bn, x, nn::Mode::train, exec::omp);
-  test::check_warm_no_allocation(bn, x, nn::Mode::eval, exec::seq);
+  test::check_warm_no_allocation(exec::omp, bn, x, nn::Mode::train);
+  test::check_warm_no_allocation(exec::seq, bn, x, nn::Mode::eval);
   CHECK_THROWS_AS(nn::BatchNorm1d<float>(store, "bad", 3, {.momentum = 2}), ArgumentError);
   Matrix<float> y;
-  CHECK_THROWS_AS(bn.forward(nn::Mode::train, Matrix<float>(4, 95), y), ShapeError);
+  CHECK_THROWS_AS(bn.forward(exec::seq, nn::Mode::train, Matrix<float>(4, 95), y), ShapeError);
 }

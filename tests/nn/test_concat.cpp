@@ -11,22 +11,22 @@ TEST_CASE("nn::Concat: column blocks forward, split (or accumulate) backward") {
   CHECK(cat.out_features() == 6);
   CHECK(cat.offset(2) == 5);
   Matrix<double> y;
-  cat.forward({a, b, c}, y);
+  cat.forward(exec::seq, {a, b, c}, y);
   CHECK(y.leftCols(2) == a);
   CHECK(y.middleCols(2, 3) == b);
   CHECK(y.rightCols(1) == c);
   const Matrix<double> d = random_matrix(rng, 5, 6);
   Matrix<double> da, dc;
-  cat.backward(d, {&da, nullptr, &dc});
+  cat.backward(exec::seq, d, {&da, nullptr, &dc});
   CHECK(da == d.leftCols(2));
   CHECK(dc == d.rightCols(1));
   Matrix<double> acc = Matrix<double>::Ones(5, 2);
-  cat.backward(d, {&acc, nullptr, nullptr}, true);
+  cat.backward(exec::seq, d, {&acc, nullptr, nullptr}, true);
   CHECK((acc.array() - 1 - d.leftCols(2).array()).abs().maxCoeff() < 1e-15);
-  CHECK_THROWS_AS(cat.forward({a, b}, y), ArgumentError);
-  CHECK_THROWS_AS(cat.forward({a, a, c}, y), ShapeError);
+  CHECK_THROWS_AS(cat.forward(exec::seq, {a, b}, y), ArgumentError);
+  CHECK_THROWS_AS(cat.forward(exec::seq, {a, a, c}, y), ShapeError);
   Matrix<double> wrong(4, 2);
-  CHECK_THROWS_AS(cat.backward(d, {&wrong, nullptr, nullptr}, true), ShapeError);
+  CHECK_THROWS_AS(cat.backward(exec::seq, d, {&wrong, nullptr, nullptr}, true), ShapeError);
 }
 
 TEST_CASE("nn composition: fc_out-like Linear → BatchNorm → LeakyReLU on cat(h, max, mean) matches finite differences") {
@@ -43,24 +43,24 @@ TEST_CASE("nn composition: fc_out-like Linear → BatchNorm → LeakyReLU on cat
   nn::Linear<double> fc1(store, "fc_out.3", 4, 2, init, {.bias = true, .kernel_dims = 1});
   Matrix<double> pmax, pmean, h, a, b, c;
   auto fwd = [&](const Matrix<double>& x, Matrix<double>& y) {
-    gmax.forward(nn::Mode::train, x, pmax);
-    gmean.forward(nn::Mode::train, x, pmean);
-    cat.forward({x, pmax, pmean}, h);
-    fc0.forward(nn::Mode::train, h, a);
-    bn.forward(nn::Mode::train, a, b);
-    act.forward(nn::Mode::train, b, c);
-    fc1.forward(nn::Mode::train, c, y);
+    gmax.forward(exec::seq, nn::Mode::train, x, pmax);
+    gmean.forward(exec::seq, nn::Mode::train, x, pmean);
+    cat.forward(exec::seq, {x, pmax, pmean}, h);
+    fc0.forward(exec::seq, nn::Mode::train, h, a);
+    bn.forward(exec::seq, nn::Mode::train, a, b);
+    act.forward(exec::seq, nn::Mode::train, b, c);
+    fc1.forward(exec::seq, nn::Mode::train, c, y);
   };
   auto bwd = [&](const Matrix<double>& x, const Matrix<double>& y, const Matrix<double>& dy, Matrix<double>* dx) {
     Matrix<double> dc, db, da, dh, dmax, dmean, dtmp;
-    fc1.backward(c, y, dy, &dc);
-    act.backward(b, c, dc, &db);
-    bn.backward(a, b, db, &da);
-    fc0.backward(h, a, da, &dh);
-    cat.backward(dh, {dx, &dmax, &dmean});
-    gmax.backward(x, pmax, dmax, &dtmp);
+    fc1.backward(exec::seq, c, y, dy, &dc);
+    act.backward(exec::seq, b, c, dc, &db);
+    bn.backward(exec::seq, a, b, db, &da);
+    fc0.backward(exec::seq, h, a, da, &dh);
+    cat.backward(exec::seq, dh, {dx, &dmax, &dmean});
+    gmax.backward(exec::seq, x, pmax, dmax, &dtmp);
     *dx += dtmp;
-    gmean.backward(x, pmean, dmean, &dtmp);
+    gmean.backward(exec::seq, x, pmean, dmean, &dtmp);
     *dx += dtmp;
   };
   Matrix<double> x(B * N, C);
@@ -76,17 +76,17 @@ TEST_CASE("nn::Concat: seq == omp bitwise; warm calls allocate nothing") {
   const Matrix<float> a = random_matrix(rng, 3000, 35).cast<float>(), b = random_matrix(rng, 3000, 64).cast<float>();
   nn::Concat<float> cat({35, 64});
   Matrix<float> y1, y2, da1, db1, da2, db2;
-  cat.forward({a, b}, y1, exec::seq);
-  cat.forward({a, b}, y2, exec::omp);
+  cat.forward(exec::seq, {a, b}, y1);
+  cat.forward(exec::omp, {a, b}, y2);
   CHECK(test::bitwise_equal(y1, y2));
-  cat.backward(y1, {&da1, &db1}, false, exec::seq);
-  cat.backward(y1, {&da2, &db2}, false, exec::omp);
+  cat.backward(exec::seq, y1, {&da1, &db1}, false);
+  cat.backward(exec::omp, y1, {&da2, &db2}, false);
   CHECK(test::bitwise_equal(da2, a));
   CHECK(test::bitwise_equal(db2, b));
   const float* p = y1.data();
   const long before = simsr_test_malloc_count();
-  cat.forward({a, b}, y1, exec::omp);
-  cat.backward(y1, {&da1, &db1}, true, exec::omp);
+  cat.forward(exec::omp, {a, b}, y1);
+  cat.backward(exec::omp, y1, {&da1, &db1}, true);
   CHECK(simsr_test_malloc_count() - before == 0);
   CHECK(y1.data() == p);
 }

@@ -1,4 +1,7 @@
+#include <simsr/neighbors/kd_tree.hpp>
 #include <simsr/nn/edge_conv.hpp>
+
+#include <type_traits>
 
 #include "gradient_check.hpp"
 
@@ -24,7 +27,7 @@ TEST_CASE("nn::GraphFeatures: edge rows cat(h_j - h_i, h_i), shared and per-item
     const GraphIndices g = random_graph(rng, shared ? N : B * N, N, k);
     nn::GraphFeatures<double> gf(g, N);
     Matrix<double> e;
-    gf.forward(nn::Mode::train, h, e);
+    gf.forward(exec::seq, nn::Mode::train, h, e);
     REQUIRE(e.rows() == B * N * k);
     REQUIRE(e.cols() == 2 * C);
     for (Index b = 0; b < B; ++b)
@@ -44,7 +47,7 @@ TEST_CASE("nn::GraphFeatures: edge rows cat(h_j - h_i, h_i), shared and per-item
   CHECK_THROWS_AS(nn::GraphFeatures<double>(GraphIndices::Zero(N + 1, k), N), ArgumentError);
   nn::GraphFeatures<double> gf(GraphIndices::Zero(N, k), N);
   Matrix<double> e;
-  CHECK_THROWS_AS(gf.forward(nn::Mode::train, Matrix<double>(N + 1, C), e), ShapeError);
+  CHECK_THROWS_AS(gf.forward(exec::seq, nn::Mode::train, Matrix<double>(N + 1, C), e), ShapeError);
 }
 
 TEST_CASE("nn::GraphFeatures: seq == omp bitwise; warm calls allocate nothing") {
@@ -53,7 +56,7 @@ TEST_CASE("nn::GraphFeatures: seq == omp bitwise; warm calls allocate nothing") 
   const Matrix<float> h = random_matrix(rng, B * N, 16).cast<float>();
   nn::GraphFeatures<float> gf(random_graph(rng, N, N, k), N);
   test::check_seq_equals_omp(gf, (nn::ParameterStore<float>*)nullptr, h, nn::Mode::train, rng);
-  test::check_warm_no_allocation(gf, h, nn::Mode::train, exec::omp);
+  test::check_warm_no_allocation(exec::omp, gf, h, nn::Mode::train);
 }
 
 TEST_CASE("nn::DynamicKnnGraph: k nearest other points per item, matching a plain-loop reference") {
@@ -85,6 +88,35 @@ TEST_CASE("nn::DynamicKnnGraph: k nearest other points per item, matching a plai
   CHECK_THROWS_AS(dyn.build(exec::seq, h, N + 1, k, g2), ShapeError);
 }
 
+TEST_CASE("nn::DynamicKnnGraph and EdgeConv: the search is one type (any neighbors::NeighborSearch), same graph") {
+  static_assert(neighbors::NeighborSearch<neighbors::KdTree<double>>);
+  static_assert(std::is_same_v<nn::EdgeConv<double>::scalar_type, double>);
+  std::mt19937_64 rng(75);
+  const Index B = 3, N = 40, C = 3, k = 5;
+  const Matrix<double> h = random_matrix(rng, B * N, C);  // 3 feature columns: a KdTree applies
+  nn::DynamicKnnGraph<double> brute;
+  nn::DynamicKnnGraph<double, neighbors::KdTree<double>> tree;
+  GraphIndices gb, gt;
+  brute.build(exec::seq, h, N, k, gb);
+  tree.build(exec::omp, h, N, k, gt);
+  CHECK(gt == gb);
+  // a search of fixed dimension refuses features of another width
+  CHECK_THROWS_AS(tree.build(exec::seq, random_matrix(rng, B * N, C + 1), N, k, gt), ArgumentError);
+
+  // a dynamic-graph EdgeConv with the other search: same weights (same seed), same bits
+  nn::ParameterStore<double> s1, s2;
+  nn::Rng i1(9), i2(9);
+  nn::EdgeConv<double> e1(s1, "ec", C, 4, k, i1);
+  nn::EdgeConv<double, neighbors::KdTree<double>> e2(s2, "ec", C, 4, k, i2);
+  e1.use_dynamic_graph(N);
+  e2.use_dynamic_graph(N);
+  Matrix<double> y1, y2;
+  e1.forward(exec::seq, nn::Mode::train, h, y1);
+  e2.forward(exec::seq, nn::Mode::train, h, y2);
+  CHECK(e2.graph() == e1.graph());
+  CHECK(test::bitwise_equal(y1, y2));
+}
+
 TEST_CASE("nn::EdgeConv: state-dict names and forward against a plain-loop reference") {
   std::mt19937_64 rng(74);
   nn::Rng init(5);
@@ -107,7 +139,7 @@ TEST_CASE("nn::EdgeConv: state-dict names and forward against a plain-loop refer
   ec.set_graph(g, N);
   const Matrix<double> h = random_matrix(rng, B * N, C);
   Matrix<double> y;
-  ec.forward(nn::Mode::eval, h, y);  // eval: running statistics (0, 1)
+  ec.forward(exec::seq, nn::Mode::eval, h, y);  // eval: running statistics (0, 1)
   const Matrix<double> W0 = ec.conv0().weight(), W3 = ec.conv3().weight();
   const auto gamma = ec.batch_norm().weight(), beta = ec.batch_norm().bias();
   REQUIRE(y.rows() == B * N);
@@ -156,7 +188,7 @@ TEST_CASE("nn::EdgeConv: dynamic graph equals the explicit kNN graph; seq == omp
   ec.use_dynamic_graph(N);
   const Matrix<float> h = random_matrix(rng, B * N, C).cast<float>();
   Matrix<float> y1, y2;
-  ec.forward(nn::Mode::train, h, y1);
+  ec.forward(exec::seq, nn::Mode::train, h, y1);
   nn::DynamicKnnGraph<float> dyn;
   GraphIndices g;
   dyn.build(exec::seq, h, N, k, g);
@@ -165,11 +197,11 @@ TEST_CASE("nn::EdgeConv: dynamic graph equals the explicit kNN graph; seq == omp
   nn::Rng init2(7);
   nn::EdgeConv<float> fixed(store2, "blk", C, O, k, init2);
   fixed.set_graph(g, N);
-  fixed.forward(nn::Mode::train, h, y2);
+  fixed.forward(exec::seq, nn::Mode::train, h, y2);
   CHECK(test::bitwise_equal(y1, y2));
 
   test::check_seq_equals_omp(ec, &store, h, nn::Mode::train, rng);
   test::check_seq_equals_omp(fixed, &store2, h, nn::Mode::eval, rng);
-  test::check_warm_no_allocation(ec, h, nn::Mode::train, exec::omp);
-  test::check_warm_no_allocation(fixed, h, nn::Mode::train, exec::seq);
+  test::check_warm_no_allocation(exec::omp, ec, h, nn::Mode::train);
+  test::check_warm_no_allocation(exec::seq, fixed, h, nn::Mode::train);
 }

@@ -70,15 +70,15 @@ double rel_error(const Matrix<double>& a, const std::vector<Ld>& b) {
 /// Central differences of loss(P) against the analytic gradient (max-norm relative error).
 double fd_error(nn::FaceNormalLoss<double>& loss, const Matrix<double>& P, const Matrix<double>& T, double scale, double h = 1e-6) {
   Matrix<double> d;
-  loss.value_and_gradient(P, T, &d, scale);
+  loss.value_and_gradient(exec::seq, P, T, &d, scale);
   Matrix<double> x = P;
   double diff = 0, s = 0;
   for (Index i = 0; i < x.size(); ++i) {
     const double v = x.data()[i];
     x.data()[i] = v + h;
-    const double lp = loss.value_and_gradient(x, T);
+    const double lp = loss.value_and_gradient(exec::seq, x, T);
     x.data()[i] = v - h;
-    const double lm = loss.value_and_gradient(x, T);
+    const double lm = loss.value_and_gradient(exec::seq, x, T);
     x.data()[i] = v;
     const double num = scale * (lp - lm) / (2 * h);
     diff = std::max(diff, std::abs(num - d.data()[i]));
@@ -113,10 +113,10 @@ TEST_CASE("nn::FaceNormalLoss: value and gradient against a long-double referenc
       CHECK(fd_error(loss, P, T, 2.5) < 1e-6);
       // mean = sum / (B·F)
       nn::FaceNormalLoss<double> other(sphere.V, sphere.F, mean ? nn::Reduction::sum : nn::Reduction::mean);
-      const double lo = other.value_and_gradient(P, T);
+      const double lo = other.value_and_gradient(exec::seq, P, T);
       CHECK((mean ? lo / double(B * sphere.F.rows()) : lo * double(B * sphere.F.rows())) == doctest::Approx(l).epsilon(1e-13));
       // identical prediction and target: zero loss, zero gradient
-      CHECK(loss.value_and_gradient(T, T, &d) == doctest::Approx(0.0).scale(1.0).epsilon(1e-14));
+      CHECK(loss.value_and_gradient(exec::seq, T, T, &d) == doctest::Approx(0.0).scale(1.0).epsilon(1e-14));
       CHECK(d.cwiseAbs().maxCoeff() < 1e-12);
     }
 }
@@ -136,7 +136,7 @@ TEST_CASE("nn::FaceNormalLoss: random triangles (shared vertices, all orientatio
   nn::FaceNormalLoss<double> loss(rest, faces, nn::Reduction::sum);
   const Matrix<double> P = random_matrix(rng, 2 * M, 3, -0.2, 0.2), T = random_matrix(rng, 2 * M, 3, -0.2, 0.2);
   Matrix<double> d;
-  const double l = loss.value_and_gradient(P, T, &d, -0.7);
+  const double l = loss.value_and_gradient(exec::seq, P, T, &d, -0.7);
   const NormalLossReference ref = normal_loss_reference(rest, faces, P, T, false, -0.7L);
   CHECK(l == doctest::Approx(double(ref.loss)).epsilon(1e-13));
   CHECK(rel_error(d, ref.grad) < 1e-12);
@@ -156,7 +156,7 @@ TEST_CASE("nn::FaceNormalLoss: a triangle rotated by θ costs 1 − cos θ") {
     Matrix<double> P(3, 3);
     for (Index v = 0; v < 3; ++v) P.row(v) = (R * rest.row(v).transpose() - rest.row(v).transpose() + Eigen::Vector3d(0.2, -1, 3)).transpose();
     const Matrix<double> T = Matrix<double>::Zero(3, 3);
-    CHECK(loss.value_and_gradient(P, T) == doctest::Approx(1 - std::cos(theta)).epsilon(1e-14).scale(1.0));
+    CHECK(loss.value_and_gradient(exec::seq, P, T) == doctest::Approx(1 - std::cos(theta)).epsilon(1e-14).scale(1.0));
   }
   // B = 2 items rotated by different angles about an in-plane axis (⟂ n): the mean of both terms
   const double a = 0.4, b = 1.1;
@@ -165,7 +165,7 @@ TEST_CASE("nn::FaceNormalLoss: a triangle rotated by θ costs 1 − cos θ") {
     const Eigen::Matrix3d R = Eigen::AngleAxisd(item ? b : a, Eigen::Vector3d(1, 2, 0).normalized()).toRotationMatrix();
     for (Index v = 0; v < 3; ++v) P.row(item * 3 + v) = (R * rest.row(v).transpose() - rest.row(v).transpose()).transpose();
   }
-  CHECK(loss.value_and_gradient(P, Matrix<double>::Zero(6, 3)) == doctest::Approx((2 - std::cos(a) - std::cos(b)) / 2).epsilon(1e-14));
+  CHECK(loss.value_and_gradient(exec::seq, P, Matrix<double>::Zero(6, 3)) == doctest::Approx((2 - std::cos(a) - std::cos(b)) / 2).epsilon(1e-14));
 }
 
 TEST_CASE("nn::FaceNormalLoss: degenerate normals mirror torch 1.13's cosine_similarity (eps = 1e-8)") {
@@ -179,7 +179,7 @@ TEST_CASE("nn::FaceNormalLoss: degenerate normals mirror torch 1.13's cosine_sim
   const Matrix<double> zero = Matrix<double>::Zero(3, 3);
   auto check = [&](const Matrix<double>& P, const Matrix<double>& T, double expected_loss, const Matrix<double>& expected_grad) {
     Matrix<double> d;
-    CHECK(loss.value_and_gradient(P, T, &d) == doctest::Approx(expected_loss).epsilon(1e-12));
+    CHECK(loss.value_and_gradient(exec::seq, P, T, &d) == doctest::Approx(expected_loss).epsilon(1e-12));
     for (Index i = 0; i < d.size(); ++i) {
       CAPTURE(i);
       CHECK(d.data()[i] == doctest::Approx(expected_grad.data()[i]).epsilon(1e-9).scale(1e-6));
@@ -236,11 +236,11 @@ TEST_CASE("nn::FaceNormalLoss: errors name the array or the triangle") {
   CHECK(loss.vertices() == 4);
   CHECK(loss.triangles() == 2);
   Matrix<double> P = Matrix<double>::Zero(8, 3), d;
-  CHECK_THROWS_AS(loss.value_and_gradient(Matrix<double>::Zero(7, 3), Matrix<double>::Zero(7, 3)), ShapeError);
-  CHECK_THROWS_AS(loss.value_and_gradient(Matrix<double>::Zero(8, 2), Matrix<double>::Zero(8, 2)), ShapeError);
-  CHECK_THROWS_AS(loss.value_and_gradient(Matrix<double>::Zero(0, 3), Matrix<double>::Zero(0, 3)), ShapeError);
-  CHECK_THROWS_AS(loss.value_and_gradient(P, Matrix<double>::Zero(4, 3)), ShapeError);
-  CHECK_THROWS_AS(loss.value_and_gradient(P, P, &P), ArgumentError);
+  CHECK_THROWS_AS(loss.value_and_gradient(exec::seq, Matrix<double>::Zero(7, 3), Matrix<double>::Zero(7, 3)), ShapeError);
+  CHECK_THROWS_AS(loss.value_and_gradient(exec::seq, Matrix<double>::Zero(8, 2), Matrix<double>::Zero(8, 2)), ShapeError);
+  CHECK_THROWS_AS(loss.value_and_gradient(exec::seq, Matrix<double>::Zero(0, 3), Matrix<double>::Zero(0, 3)), ShapeError);
+  CHECK_THROWS_AS(loss.value_and_gradient(exec::seq, P, Matrix<double>::Zero(4, 3)), ShapeError);
+  CHECK_THROWS_AS(loss.value_and_gradient(exec::seq, P, P, &P), ArgumentError);
   CHECK_THROWS_AS(nn::FaceNormalLoss<double>(Matrix<double>::Zero(4, 2), faces), ShapeError);
   CHECK_THROWS_AS(nn::FaceNormalLoss<double>(rest, Tris(0, 3)), ArgumentError);
   CHECK_THROWS_AS(nn::FaceNormalLoss<double>(rest, faces, nn::Reduction::mean, 0.0), ArgumentError);

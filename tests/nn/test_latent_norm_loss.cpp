@@ -31,9 +31,9 @@ TEST_CASE("nn::row_norm_sum: value against plain loops, gradient against finite 
     for (Index i = 0; i < x.size(); ++i) {
       const double v = x.data()[i];
       x.data()[i] = v + h;
-      const double lp = nn::row_norm_sum(x, nullptr, 1.0, mean);
+      const double lp = nn::row_norm_sum(exec::seq, x, nullptr, 1.0, mean);
       x.data()[i] = v - h;
-      const double lm = nn::row_norm_sum(x, nullptr, 1.0, mean);
+      const double lm = nn::row_norm_sum(exec::seq, x, nullptr, 1.0, mean);
       x.data()[i] = v;
       err = std::max(err, std::abs(1.5 * (lp - lm) / (2 * h) - d.data()[i]));
       s = std::max(s, std::abs(d.data()[i]));
@@ -47,24 +47,24 @@ TEST_CASE("nn::row_norm_sum: a zero row adds 0 and gets the subgradient 0; colum
   Matrix<double> z(3, 4);
   z << 3, 0, 4, 0, 0, 0, 0, 0, 1, 2, 2, 0;
   Matrix<double> d;
-  CHECK(nn::row_norm_sum(z, &d, 2.0) == 8.0);
+  CHECK(nn::row_norm_sum(exec::seq, z, &d, 2.0) == 8.0);
   CHECK(d.row(1).cwiseAbs().maxCoeff() == 0.0);
   CHECK(d(0, 0) == doctest::Approx(2.0 * 0.6));
   CHECK(d(0, 2) == doctest::Approx(2.0 * 0.8));
   CHECK(d(2, 1) == doctest::Approx(2.0 * 2.0 / 3.0));
-  CHECK(nn::row_norm_sum(z, &d, 1.0, true) == doctest::Approx(8.0 / 3.0));
+  CHECK(nn::row_norm_sum(exec::seq, z, &d, 1.0, true) == doctest::Approx(8.0 / 3.0));
   // Eq. 6 per feature block: a column block of a wider activation (no copy)
   const nn::ConstView<double> block = z.leftCols(2);
-  CHECK(nn::row_norm_sum(block, &d) == doctest::Approx(3.0 + std::sqrt(5.0)));
-  CHECK(nn::row_norm_sum(z.leftCols(2), &d) == doctest::Approx(3.0 + std::sqrt(5.0)));
+  CHECK(nn::row_norm_sum(exec::seq, block, &d) == doctest::Approx(3.0 + std::sqrt(5.0)));
+  CHECK(nn::row_norm_sum(exec::seq, z.leftCols(2), &d) == doctest::Approx(3.0 + std::sqrt(5.0)));
   CHECK(d.rows() == 3);
   CHECK(d.cols() == 2);
   Matrix<double> all_zero = Matrix<double>::Zero(2, 3);
-  CHECK(nn::row_norm_sum(all_zero, &d) == 0.0);
+  CHECK(nn::row_norm_sum(exec::seq, all_zero, &d) == 0.0);
   CHECK(d.cwiseAbs().maxCoeff() == 0.0);
-  CHECK_THROWS_AS(nn::row_norm_sum(Matrix<double>(0, 3)), ArgumentError);
-  CHECK_THROWS_AS(nn::row_norm_sum(Matrix<double>(3, 0)), ArgumentError);
-  CHECK_THROWS_AS(nn::row_norm_sum(z, &z), ArgumentError);
+  CHECK_THROWS_AS(nn::row_norm_sum(exec::seq, Matrix<double>(0, 3)), ArgumentError);
+  CHECK_THROWS_AS(nn::row_norm_sum(exec::seq, Matrix<double>(3, 0)), ArgumentError);
+  CHECK_THROWS_AS(nn::row_norm_sum(exec::seq, z, &z), ArgumentError);
 }
 
 TEST_CASE("nn::row_norm_sum: seq == omp bitwise; warm calls allocate nothing") {

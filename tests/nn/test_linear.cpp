@@ -12,7 +12,7 @@ TEST_CASE("nn::Linear: forward is in·Wᵀ + b, row by row") {
     nn::Linear<double> l(store, "l", 6, 4, init, {.bias = bias});
     const Matrix<double> x = random_matrix(rng, 150, 6);
     Matrix<double> y;
-    l.forward(nn::Mode::train, x, y);
+    l.forward(exec::seq, nn::Mode::train, x, y);
     REQUIRE(y.rows() == 150);
     REQUIRE(y.cols() == 4);
     double err = 0;
@@ -34,8 +34,8 @@ TEST_CASE("nn::Linear: a column block of a wider matrix is read in place") {
   const Matrix<float> wide = random_matrix(rng, 40, 9).cast<float>();
   const Matrix<float> part = wide.middleCols(2, 5);
   Matrix<float> a, b;
-  l.forward(nn::Mode::eval, wide.middleCols(2, 5), a);
-  l.forward(nn::Mode::eval, part, b);
+  l.forward(exec::seq, nn::Mode::eval, wide.middleCols(2, 5), a);
+  l.forward(exec::seq, nn::Mode::eval, part, b);
   CHECK(test::bitwise_equal(a, b));
 }
 
@@ -60,10 +60,10 @@ TEST_CASE("nn::Linear: gradients accumulate across backward calls until zero_gra
   nn::Linear<double> l(store, "l", 3, 2, init);
   const Matrix<double> x = random_matrix(rng, 5, 3), d = random_matrix(rng, 5, 2);
   Matrix<double> y;
-  l.forward(nn::Mode::train, x, y);
-  l.backward(x, y, d, nullptr);
+  l.forward(exec::seq, nn::Mode::train, x, y);
+  l.backward(exec::seq, x, y, d, nullptr);
   const nn::Vector<double> once = store.gradients();
-  l.backward(x, y, d, nullptr);
+  l.backward(exec::seq, x, y, d, nullptr);
   CHECK((store.gradients() - 2 * once).cwiseAbs().maxCoeff() < 1e-14);
   CHECK(once.cwiseAbs().maxCoeff() > 0);
   CHECK((Matrix<double>(l.weight_grad()) - 2 * d.transpose() * x).cwiseAbs().maxCoeff() < 1e-13);
@@ -85,7 +85,7 @@ TEST_CASE("nn::Linear: PyTorch default init U(±1/√in), explicit setters, erro
   CHECK_THROWS_AS(l.set_bias(nn::Vector<float>(3)), ShapeError);
   Matrix<float> x(10, 63), y;
   try {
-    l.forward(nn::Mode::train, x, y);
+    l.forward(exec::seq, nn::Mode::train, x, y);
     FAIL("no ShapeError");
   } catch (const ShapeError& e) {
     CHECK(std::string(e.what()).find("nn::Linear 'fc'") != std::string::npos);
@@ -104,6 +104,6 @@ TEST_CASE("nn::Linear: exec::seq and exec::omp agree bit for bit; warm calls all
   test::check_seq_equals_omp(l, &store, x, nn::Mode::train, rng);
   nn::Linear<float> nb(store, "nb", 35, 19, init, {.bias = false});
   test::check_seq_equals_omp(nb, &store, x, nn::Mode::train, rng);
-  test::check_warm_no_allocation(l, x, nn::Mode::train, exec::seq);
-  test::check_warm_no_allocation(l, x, nn::Mode::train, exec::omp);
+  test::check_warm_no_allocation(exec::seq, l, x, nn::Mode::train);
+  test::check_warm_no_allocation(exec::omp, l, x, nn::Mode::train);
 }

@@ -15,9 +15,9 @@ TEST_CASE("nn losses: values against plain loops, gradients against finite diffe
   }
   const double n = double(a.size());
   Matrix<double> d1, d2, d3;
-  CHECK(nn::l1_loss(a, b, &d1, 10.0) == doctest::Approx(double(l1 / n)).epsilon(1e-14));
-  CHECK(nn::mean_abs(a, &d2, 2.0) == doctest::Approx(double(ab / n)).epsilon(1e-14));
-  CHECK(nn::mean_square(a, &d3) == doctest::Approx(double(sq / n)).epsilon(1e-14));
+  CHECK(nn::l1_loss(exec::seq, a, b, &d1, 10.0) == doctest::Approx(double(l1 / n)).epsilon(1e-14));
+  CHECK(nn::mean_abs(exec::seq, a, &d2, 2.0) == doctest::Approx(double(ab / n)).epsilon(1e-14));
+  CHECK(nn::mean_square(exec::seq, a, &d3) == doctest::Approx(double(sq / n)).epsilon(1e-14));
   // finite differences of each loss (entries away from the kinks of |·|)
   const double h = 1e-6;
   auto fd = [&](auto&& f, const Matrix<double>& x, const Matrix<double>& g, double scale) {
@@ -36,14 +36,14 @@ TEST_CASE("nn losses: values against plain loops, gradients against finite diffe
     CHECK(s > 0);
     return err / s;
   };
-  CHECK(fd([&](const Matrix<double>& x) { return nn::l1_loss(x, b); }, a, d1, 10.0) < 1e-6);
-  CHECK(fd([&](const Matrix<double>& x) { return nn::mean_abs(x); }, a, d2, 2.0) < 1e-6);
-  CHECK(fd([&](const Matrix<double>& x) { return nn::mean_square(x); }, a, d3, 1.0) < 1e-6);
+  CHECK(fd([&](const Matrix<double>& x) { return nn::l1_loss(exec::seq, x, b); }, a, d1, 10.0) < 1e-6);
+  CHECK(fd([&](const Matrix<double>& x) { return nn::mean_abs(exec::seq, x); }, a, d2, 2.0) < 1e-6);
+  CHECK(fd([&](const Matrix<double>& x) { return nn::mean_square(exec::seq, x); }, a, d3, 1.0) < 1e-6);
   Matrix<double> eq;
-  nn::l1_loss(a, a, &eq);
+  nn::l1_loss(exec::seq, a, a, &eq);
   CHECK(eq.cwiseAbs().maxCoeff() == 0.0);  // sign(0) = 0, as PyTorch
-  CHECK_THROWS_AS(nn::l1_loss(a, Matrix<double>(17, 2)), ShapeError);
-  CHECK_THROWS_AS(nn::mean_abs(Matrix<double>(0, 3)), ArgumentError);
+  CHECK_THROWS_AS(nn::l1_loss(exec::seq, a, Matrix<double>(17, 2)), ShapeError);
+  CHECK_THROWS_AS(nn::mean_abs(exec::seq, Matrix<double>(0, 3)), ArgumentError);
 }
 
 TEST_CASE("nn losses: seq == omp bitwise") {

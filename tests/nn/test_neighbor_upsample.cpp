@@ -24,7 +24,7 @@ TEST_CASE("nn::NeighborUpsample: softmax weights and the weighted gather against
   for (bool shared : {true, false}) {
     const Matrix<double> logits = random_matrix(rng, shared ? M : B * M, K, -3, 3);
     Matrix<double> out, out2;
-    up.forward(logits, z, out);
+    up.forward(exec::seq, logits, z, out);
     REQUIRE(out.rows() == B * M);
     for (Index r = 0; r < logits.rows(); ++r) {
       double s = 0;
@@ -40,19 +40,19 @@ TEST_CASE("nn::NeighborUpsample: softmax weights and the weighted gather against
         }
     // inference path with precomputed weights: the same bits
     Matrix<double> w;
-    nn::NeighborUpsample<double>::softmax_rows(logits, w);
-    up.apply(w, z, out2);
+    nn::NeighborUpsample<double>::softmax_rows(exec::seq, logits, w);
+    up.apply(exec::seq, w, z, out2);
     CHECK(test::bitwise_equal(out, out2));
   }
   // large logits do not overflow
   Matrix<double> big = Matrix<double>::Constant(M, K, 1000.0), w;
-  nn::NeighborUpsample<double>::softmax_rows(big, w);
+  nn::NeighborUpsample<double>::softmax_rows(exec::seq, big, w);
   CHECK((w.array() - 0.25).abs().maxCoeff() < 1e-15);
   GraphIndices bad = GraphIndices::Constant(M, K, VIndex(N));
   CHECK_THROWS_AS(nn::NeighborUpsample<double>(bad, N), ArgumentError);
   Matrix<double> out;
-  CHECK_THROWS_AS(up.forward(Matrix<double>(M + 1, K), z, out), ShapeError);
-  CHECK_THROWS_AS(up.forward(Matrix<double>(M, K), Matrix<double>(N + 1, C), out), ShapeError);
+  CHECK_THROWS_AS(up.forward(exec::seq, Matrix<double>(M + 1, K), z, out), ShapeError);
+  CHECK_THROWS_AS(up.forward(exec::seq, Matrix<double>(M, K), Matrix<double>(N + 1, C), out), ShapeError);
 }
 
 TEST_CASE("nn::NeighborUpsample: gradients to logits and LR codes match finite differences") {
@@ -65,13 +65,15 @@ TEST_CASE("nn::NeighborUpsample: gradients to logits and LR codes match finite d
     const Matrix<double> z = random_matrix(rng, B * N, C);
     // w.r.t. z (logits fixed)
     test::check_gradients(test::gradient_check(
-        z, (nn::ParameterStore<double>*)nullptr, [&](const Matrix<double>& x, Matrix<double>& o) { up.forward(logits, x, o); },
-        [&](const Matrix<double>& x, const Matrix<double>&, const Matrix<double>& d, Matrix<double>* dx) { up.backward(x, d, nullptr, dx); },
+        z, (nn::ParameterStore<double>*)nullptr, [&](const Matrix<double>& x, Matrix<double>& o) { up.forward(exec::seq, logits, x, o); },
+        [&](const Matrix<double>& x, const Matrix<double>&, const Matrix<double>& d, Matrix<double>* dx) {
+          up.backward(exec::seq, x, d, nullptr, dx);
+        },
         rng));
     // w.r.t. the logits (z fixed)
     test::check_gradients(test::gradient_check(
-        logits, (nn::ParameterStore<double>*)nullptr, [&](const Matrix<double>& l, Matrix<double>& o) { up.forward(l, z, o); },
-        [&](const Matrix<double>&, const Matrix<double>&, const Matrix<double>& d, Matrix<double>* dl) { up.backward(z, d, dl, nullptr); },
+        logits, (nn::ParameterStore<double>*)nullptr, [&](const Matrix<double>& l, Matrix<double>& o) { up.forward(exec::seq, l, z, o); },
+        [&](const Matrix<double>&, const Matrix<double>&, const Matrix<double>& d, Matrix<double>* dl) { up.backward(exec::seq, z, d, dl, nullptr); },
         rng));
   }
 }
@@ -83,19 +85,19 @@ TEST_CASE("nn::NeighborUpsample: seq == omp bitwise; warm calls allocate nothing
   const Matrix<float> z = random_matrix(rng, B * N, C).cast<float>();
   const Matrix<float> logits = random_matrix(rng, M, K, -2, 2).cast<float>();
   Matrix<float> o1, o2, dl1, dl2, dz1, dz2;
-  up.forward(logits, z, o1, exec::seq);
+  up.forward(exec::seq, logits, z, o1);
   const Matrix<float> r = random_matrix(rng, o1.rows(), o1.cols()).cast<float>();
-  up.backward(z, r, &dl1, &dz1, exec::seq);
-  up.forward(logits, z, o2, exec::omp);
-  up.backward(z, r, &dl2, &dz2, exec::omp);
+  up.backward(exec::seq, z, r, &dl1, &dz1);
+  up.forward(exec::omp, logits, z, o2);
+  up.backward(exec::omp, z, r, &dl2, &dz2);
   CHECK(test::bitwise_equal(o1, o2));
   CHECK(test::bitwise_equal(dl1, dl2));
   CHECK(test::bitwise_equal(dz1, dz2));
   const float* p = o1.data();
   const long before = simsr_test_malloc_count();
-  up.forward(logits, z, o1, exec::omp);
-  up.backward(z, r, &dl1, &dz1, exec::omp);
-  up.apply(up.weights(), z, o1, exec::seq);
+  up.forward(exec::omp, logits, z, o1);
+  up.backward(exec::omp, z, r, &dl1, &dz1);
+  up.apply(exec::seq, up.weights(), z, o1);
   CHECK(simsr_test_malloc_count() - before == 0);
   CHECK(o1.data() == p);
 }

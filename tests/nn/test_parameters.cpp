@@ -73,6 +73,6 @@ TEST_CASE("nn::ParameterStore: registering more tensors later keeps earlier laye
   for (int i = 0; i < 50; ++i) nn::Linear<double>(store, std::string("b").append(std::to_string(i)), 30, 30, rng);  // (GCC 12 false -Wrestrict on "b" + string)
   CHECK(Matrix<double>(a.weight()) == Wa);
   Matrix<double> x = Matrix<double>::Ones(2, 3), y;
-  a.forward(nn::Mode::eval, x, y);
+  a.forward(exec::seq, nn::Mode::eval, x, y);
   CHECK(y.rows() == 2);
 }

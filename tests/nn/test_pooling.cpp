@@ -24,9 +24,9 @@ TEST_CASE("nn::GroupPool: global max / mean per batch item, broadcast back") {
   const Matrix<double> x = random_matrix(rng, B * N, C);
   nn::GroupPool<double> gmax(nn::PoolKind::max, N), gmean(nn::PoolKind::mean, N), gmax1(nn::PoolKind::max, N, false);
   Matrix<double> ymax, ymean, y1;
-  gmax.forward(nn::Mode::train, x, ymax);
-  gmean.forward(nn::Mode::train, x, ymean);
-  gmax1.forward(nn::Mode::train, x, y1);
+  gmax.forward(exec::seq, nn::Mode::train, x, ymax);
+  gmean.forward(exec::seq, nn::Mode::train, x, ymean);
+  gmax1.forward(exec::seq, nn::Mode::train, x, y1);
   REQUIRE(ymax.rows() == B * N);
   REQUIRE(y1.rows() == B);
   for (Index b = 0; b < B; ++b) {
@@ -43,13 +43,13 @@ TEST_CASE("nn::GroupPool: max routes the gradient to the first maximum") {
   nn::GroupPool<double> pool(nn::PoolKind::max, 4, false);
   Matrix<double> x(4, 2), y, d;
   x << 1, 5, 3, 5, 3, 2, 0, 5;
-  pool.forward(nn::Mode::train, x, y);
+  pool.forward(exec::seq, nn::Mode::train, x, y);
   CHECK(y(0, 0) == 3);
   CHECK(pool.argmax()(0, 0) == 1);
   CHECK(pool.argmax()(0, 1) == 0);
   Matrix<double> g(1, 2);
   g << 2, 7;
-  pool.backward(x, y, g, &d);
+  pool.backward(exec::seq, x, y, g, &d);
   Matrix<double> expected(4, 2);
   expected << 0, 7, 2, 0, 0, 0, 0, 0;
   CHECK(d == expected);
@@ -69,7 +69,7 @@ TEST_CASE("nn::GroupPool: gradients match finite differences (distinct values fo
   }
   nn::GroupPool<double> pool(nn::PoolKind::max, 3);
   Matrix<double> y;
-  CHECK_THROWS_AS(pool.forward(nn::Mode::train, Matrix<double>(4, 2), y), ShapeError);
+  CHECK_THROWS_AS(pool.forward(exec::seq, nn::Mode::train, Matrix<double>(4, 2), y), ShapeError);
 }
 
 TEST_CASE("nn::GroupPool: seq == omp bitwise; warm calls allocate nothing") {
@@ -79,7 +79,7 @@ TEST_CASE("nn::GroupPool: seq == omp bitwise; warm calls allocate nothing") {
     nn::GroupPool<float> global(kind, 500), edges(kind, 5, false);
     test::check_seq_equals_omp(global, (nn::ParameterStore<float>*)nullptr, x, nn::Mode::train, rng);
     test::check_seq_equals_omp(edges, (nn::ParameterStore<float>*)nullptr, x, nn::Mode::train, rng);
-    test::check_warm_no_allocation(global, x, nn::Mode::train, exec::omp);
-    test::check_warm_no_allocation(edges, x, nn::Mode::train, exec::seq);
+    test::check_warm_no_allocation(exec::omp, global, x, nn::Mode::train);
+    test::check_warm_no_allocation(exec::seq, edges, x, nn::Mode::train);
   }
 }

@@ -30,7 +30,7 @@ TEST_CASE("nn::PositionalEncoding: [input, PE(vertex index)] per batch item, gra
   nn::PositionalEncoding<double> pe(N, 8);
   const Matrix<double> x = random_matrix(rng, B * N, 3);
   Matrix<double> y;
-  pe.forward(nn::Mode::train, x, y);
+  pe.forward(exec::seq, nn::Mode::train, x, y);
   REQUIRE(y.cols() == 11);
   for (Index b = 0; b < B; ++b)
     for (Index n = 0; n < N; ++n) {
@@ -38,10 +38,10 @@ TEST_CASE("nn::PositionalEncoding: [input, PE(vertex index)] per batch item, gra
       CHECK(y.row(b * N + n).tail(8) == pe.table().row(n));
     }
   test::check_gradients(test::layer_gradient_check(pe, nullptr, x, nn::Mode::train, rng));
-  CHECK_THROWS_AS(pe.forward(nn::Mode::train, Matrix<double>(7, 3), y), ShapeError);
+  CHECK_THROWS_AS(pe.forward(exec::seq, nn::Mode::train, Matrix<double>(7, 3), y), ShapeError);
   CHECK_THROWS_AS(nn::PositionalEncoding<double>(5, 7), ArgumentError);
   const Matrix<float> xf = random_matrix(rng, 40 * N, 3).cast<float>();
   nn::PositionalEncoding<float> pf(N);
   test::check_seq_equals_omp(pf, (nn::ParameterStore<float>*)nullptr, xf, nn::Mode::eval, rng);
-  test::check_warm_no_allocation(pf, xf, nn::Mode::eval, exec::omp);
+  test::check_warm_no_allocation(exec::omp, pf, xf, nn::Mode::eval);
 }

@@ -35,7 +35,7 @@ void check_net_gradients(const nn::NetworkConfig& cfg, Index B, double tol, std:
   if (cfg.residual) {
     // A fresh residual network is exactly the embedding (zero output layer)...
     Matrix<double> pred;
-    net.forward(nn::Mode::eval, ldx, pred);
+    net.forward(exec::seq, nn::Mode::eval, ldx, pred);
     for (Index b = 0; b < B; ++b) {
       const Matrix<double> e = geo.embedding * ldx.middleRows(b * net.lr_points(), net.lr_points());
       CHECK((pred.middleRows(b * net.hr_points(), net.hr_points()) - e).cwiseAbs().maxCoeff() < 1e-15);
@@ -49,7 +49,7 @@ void check_net_gradients(const nn::NetworkConfig& cfg, Index B, double tol, std:
   // loss = Σ r⊙pred + Σ zw⊙z: d_pred = r, d_code = zw.
   auto errors = test::gradient_check(
       ldx, &store, [&](const Matrix<double>& x, Matrix<double>& out) {
-        net.forward(nn::Mode::train, x, out);
+        net.forward(exec::seq, nn::Mode::train, x, out);
         // append the code term as extra columns of the "output": out' = [pred | z] flattened
         Matrix<double> both(out.size() + net.code().size(), 1);
         both.topRows(out.size()) = Eigen::Map<const Eigen::VectorXd>(out.data(), out.size());
@@ -60,7 +60,7 @@ void check_net_gradients(const nn::NetworkConfig& cfg, Index B, double tol, std:
         const Index P = out.size() - net.code().size();
         const Matrix<double> d_pred = Eigen::Map<const Matrix<double>>(r.data(), P / 3, 3);
         const Matrix<double> d_code = Eigen::Map<const Matrix<double>>(r.data() + P, net.code().rows(), net.code().cols());
-        net.backward(d_pred, &d_code);
+        net.backward(exec::seq, d_pred, &d_code);
       },
       rng, false);
   REQUIRE(errors.size() > 5);
@@ -150,21 +150,21 @@ TEST_CASE("nn::SuperResolutionNet: seq == omp bitwise; infer (precomputed sparse
   const nn::Vector<float> buffers0 = net.store().buffers();
   Matrix<float> p1, p2;
   net.store().zero_grad();
-  net.forward(nn::Mode::train, ldx, p1, exec::seq);
-  net.backward(r, nullptr, exec::seq);
+  net.forward(exec::seq, nn::Mode::train, ldx, p1);
+  net.backward(exec::seq, r, nullptr);
   const nn::Vector<float> g1 = net.store().gradients(), b1 = net.store().buffers();
   net.store().zero_grad();
   net.store().buffers() = buffers0;
-  net.forward(nn::Mode::train, ldx, p2, exec::omp);
-  net.backward(r, nullptr, exec::omp);
+  net.forward(exec::omp, nn::Mode::train, ldx, p2);
+  net.backward(exec::omp, r, nullptr);
   CHECK(test::bitwise_equal(p1, p2));
   CHECK(test::bitwise_equal(g1, nn::Vector<float>(net.store().gradients())));
   CHECK(test::bitwise_equal(b1, nn::Vector<float>(net.store().buffers())));
 
   Matrix<float> pe, pi, pi2;
-  net.forward(nn::Mode::eval, ldx, pe, exec::seq);
+  net.forward(exec::seq, nn::Mode::eval, ldx, pe);
   net.prepare_inference(exec::omp);
-  net.infer(ldx, pi, exec::omp);
+  net.infer(exec::omp, ldx, pi);
   CHECK(test::bitwise_equal(pe, pi));
   // the sparse M×N matrix is the same operator
   const auto W = net.upsampling().sparse_matrix();
@@ -173,9 +173,9 @@ TEST_CASE("nn::SuperResolutionNet: seq == omp bitwise; infer (precomputed sparse
   const Matrix<float> zH = W * net.code().topRows(60);
   CHECK((zH - net.hr_code().topRows(70)).cwiseAbs().maxCoeff() < 1e-5f);
   // warm inference allocates nothing
-  net.infer(ldx, pi2, exec::omp);
+  net.infer(exec::omp, ldx, pi2);
   const long before = simsr_test_malloc_count();
-  net.infer(ldx, pi2, exec::omp);
+  net.infer(exec::omp, ldx, pi2);
   CHECK(simsr_test_malloc_count() - before == 0);
   // the residual path (a sparse embedding product per item) allocates nothing either
   nn::NetworkConfig rcfg = cfg;
@@ -183,14 +183,14 @@ TEST_CASE("nn::SuperResolutionNet: seq == omp bitwise; infer (precomputed sparse
   nn::Rng init2(4);
   nn::SuperResolutionNet<float> rnet(rcfg, geo, init2);
   Matrix<float> pr;
-  rnet.infer(ldx, pr, exec::omp);
-  rnet.infer(ldx, pr, exec::omp);
+  rnet.infer(exec::omp, ldx, pr);
+  rnet.infer(exec::omp, ldx, pr);
   const long before_r = simsr_test_malloc_count();
-  rnet.infer(ldx, pr, exec::omp);
+  rnet.infer(exec::omp, ldx, pr);
   CHECK(simsr_test_malloc_count() - before_r == 0);
   // bad input
-  CHECK_THROWS_AS(net.infer(Matrix<float>::Zero(59, 3), pi), ShapeError);
-  CHECK_THROWS_AS(net.infer(Matrix<float>::Zero(60, 2), pi), ShapeError);
+  CHECK_THROWS_AS(net.infer(exec::seq, Matrix<float>::Zero(59, 3), pi), ShapeError);
+  CHECK_THROWS_AS(net.infer(exec::seq, Matrix<float>::Zero(60, 2), pi), ShapeError);
 }
 
 TEST_CASE("nn::NetworkConfig: JSON round trip, presets, the converter's official keys, and errors") {

@@ -169,14 +169,14 @@ int check(const std::string& model, const std::string& state, const std::string&
     if (a.tied) edge1.set_graph(as_graph(ref, k1), N);
     return a.tied > 0;
   };
-  net.forward(nn::Mode::eval, ldx, pred);
-  if (check_graph("eval")) net.forward(nn::Mode::eval, ldx, pred);
+  net.forward(exec::seq, nn::Mode::eval, ldx, pred);
+  if (check_graph("eval")) net.forward(exec::seq, nn::Mode::eval, ldx, pred);
   rep.compare("eval/z_lr", net.code(), as_matrix<S>(fx.at("eval/z_lr"), net.latent_dim()));
   rep.compare("eval/up_weights", net.upsampling().weights(), as_matrix<S>(fx.at("eval/up_weights"), net.config().up_k).topRows(M));
   rep.compare("eval/z_hr", net.hr_code(), as_matrix<S>(fx.at("eval/z_hr"), net.latent_dim()));
   rep.compare("eval/hdx_pred", pred, as_matrix<S>(fx.at("eval/hdx_pred"), 3));
-  net.prepare_inference();
-  net.infer(ldx, pred_inf);
+  net.prepare_inference(exec::seq);
+  net.infer(exec::seq, ldx, pred_inf);
   rep.compare("infer/hdx_pred", pred_inf, as_matrix<S>(fx.at("eval/hdx_pred"), 3));
   {
     nn::SuperResolutionLoss<S> loss(net.config(), net.hr_rest_normalized(), data.hr_faces);
@@ -197,13 +197,13 @@ int check(const std::string& model, const std::string& state, const std::string&
   auto train_forward = [&] {
     nn::load_state(net.store(), start);
     net.parameters_changed();
-    net.forward(nn::Mode::train, ldx, pred, exec::omp);
+    net.forward(exec::omp, nn::Mode::train, ldx, pred);
   };
   train_forward();
   if (check_graph("train")) train_forward();
   net.store().zero_grad();
   const auto t = loss.evaluate(exec::omp, pred, hdx, net.code(), 0, &d_pred, &d_z);
-  net.backward(d_pred, &d_z, exec::omp);
+  net.backward(exec::omp, d_pred, &d_z);
   rep.compare("train/z_lr", net.code(), as_matrix<S>(fx.at("train/z_lr"), net.latent_dim()));
   rep.compare("train/up_weights", net.upsampling().weights(), as_matrix<S>(fx.at("train/up_weights"), net.config().up_k).topRows(M));
   rep.compare("train/hdx_pred", pred, as_matrix<S>(fx.at("train/hdx_pred"), 3));

@@ -10,7 +10,6 @@
 
 #include <cmath>
 
-#include "detail/chunks.hpp"
 #include "layer.hpp"
 #include "linear.hpp"
 
@@ -22,8 +21,8 @@ template <class S, class Policy, class F>
 void map_rows(Policy policy, const ConstView<S>& in, Matrix<S>& out, F&& f) {
   const Index R = in.rows(), C = in.cols();
   ensure_shape(out, R, C);
-  const Index nc = chunk_count(R, product_chunks), workers = worker_count(policy, nc);
-  for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+  const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+  exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
     const Index n = C;  // row pointers and a local count: the loop vectorizes (no per-element index checks)
     for (Index r = b; r < e; ++r) {
       const S* x = in.row(r).data();
@@ -38,8 +37,8 @@ void map_rows_backward(Policy policy, const ConstView<S>& in, const ConstView<S>
   check_shape(layer, "output gradient", d_out, in.rows(), in.cols());
   const Index R = in.rows(), C = in.cols();
   ensure_shape(d_in, R, C);
-  const Index nc = chunk_count(R, product_chunks), workers = worker_count(policy, nc);
-  for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+  const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+  exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
     const Index n = C;
     for (Index r = b; r < e; ++r) {
       const S* x = in.row(r).data();
@@ -61,13 +60,13 @@ class LeakyReLU {
   S slope() const { return slope_; }
   Index out_features(Index in_cols) const { return in_cols; }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
     const S a = slope_;
     detail::map_rows<S>(policy, in, out, [a](S x) { return x > S(0) ? x : a * x; });
   }
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
     if (!d_in) return;
     const S a = slope_;
     detail::map_rows_backward<S>(policy, in, d_out, *d_in, "nn::LeakyReLU", [a](S x) { return x > S(0) ? S(1) : a; });
@@ -76,6 +75,7 @@ class LeakyReLU {
  private:
   S slope_;
 };
+static_assert(assert_layer<LeakyReLU<float>>());
 
 /// Sine activation sin(ω₀·x) (SIREN, Sitzmann et al. 2020; the reference's `Sine(w0)`).
 /// `out` must not alias `in`.
@@ -87,13 +87,13 @@ class Sine {
   S omega0() const { return w0_; }
   Index out_features(Index in_cols) const { return in_cols; }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
     const S w0 = w0_;
     detail::map_rows<S>(policy, in, out, [w0](S x) { return std::sin(w0 * x); });
   }
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
     if (!d_in) return;
     const S w0 = w0_;
     detail::map_rows_backward<S>(policy, in, d_out, *d_in, "nn::Sine", [w0](S x) { return w0 * std::cos(w0 * x); });
@@ -102,6 +102,7 @@ class Sine {
  private:
   S w0_;
 };
+static_assert(assert_layer<Sine<float>>());
 
 /// Bound of the SIREN uniform initialization of a Linear with `fan_in` inputs followed by
 /// sin(ω₀·): 1/fan_in for the first layer, √(c/fan_in)/ω₀ after (c = 6; SPEC §7, the

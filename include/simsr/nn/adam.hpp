@@ -11,7 +11,6 @@
 #include <cmath>
 #include <cstdint>
 
-#include "detail/chunks.hpp"
 #include "parameters.hpp"
 
 namespace simsr::nn {
@@ -61,8 +60,8 @@ class Adam {
   }
 
   /// One update of every trainable parameter from the store's gradients.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void step(Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void step(Policy policy) {
     const Index n = store_->num_parameters();
     if (st_.exp_avg.size() != n) {
       if (st_.step != 0) throw ShapeError("nn::Adam::step: the store's parameter count changed after the first step", {st_.exp_avg.size()}, {n});
@@ -80,8 +79,8 @@ class Adam {
     S* m = st_.exp_avg.data();
     S* v = st_.exp_avg_sq.data();
     const bool decay = opt_.weight_decay != 0;
-    const Index nc = detail::chunk_count(n, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, n, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(n, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, n, nc, workers, [&](Index, Index, Index b, Index e) {
       for (Index i = b; i < e; ++i) {
         const S g = decay ? grad[i] + wd * p[i] : grad[i];
         m[i] = w1 < S(0.5) ? m[i] + w1 * (g - m[i]) : g - (g - m[i]) * (S(1) - w1);

@@ -5,13 +5,12 @@
 /// convolutions of the edge MLP, of `fc_out` and of the upsampling weight network.
 ///
 ///     nn::BatchNorm1d<float> bn(store, "fc_out.1", 384);
-///     bn.forward(nn::Mode::train, y, z);  // batch statistics, running averages updated
+///     bn.forward(exec::omp, nn::Mode::train, y, z);  // batch statistics, running averages updated
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "detail/chunks.hpp"
 #include "layer.hpp"
 #include "parameters.hpp"
 
@@ -71,8 +70,8 @@ class BatchNorm1d {
   /// The normalized input x̂ of the last forward (rows×C); kept for backward.
   const Matrix<S>& normalized() const { return xhat_; }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& in, Matrix<S>& out) {
     detail::check_shape(where_, "input", in, -1, c_);
     const Index R = in.rows();
     batch_stats_ = mode == Mode::train || !opt_.track_running_stats;
@@ -101,8 +100,8 @@ class BatchNorm1d {
       load_running_stats();
     }
     load_transform();
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       for (Index r = b; r < e; ++r) {
         xhat_.row(r) = (in.row(r) - shift_.transpose()).cwiseProduct(scale_.transpose());
         out.row(r) = xhat_.row(r).cwiseProduct(gamma_.transpose()) + beta_.transpose();
@@ -134,8 +133,8 @@ class BatchNorm1d {
   /// With batch statistics: d_in = γ/σ·(d_out − mean(d_out) − x̂·mean(d_out ⊙ x̂)) per channel
   /// (every output depends on every row); with running statistics: d_in = γ/σ·d_out.
   /// Adds ∂/∂γ = Σ d_out ⊙ x̂ and ∂/∂β = Σ d_out.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
     detail::check_shape(where_, "input", in, xhat_.rows(), c_);
     detail::check_shape(where_, "output gradient", d_out, xhat_.rows(), c_);
     const Index R = in.rows();
@@ -160,8 +159,8 @@ class BatchNorm1d {
     } else {
       dmean_.setZero(), dxmean_.setZero();
     }
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       for (Index r = b; r < e; ++r)
         d_in->row(r) = (d_out.row(r) - dmean_.transpose() - xhat_.row(r).cwiseProduct(dxmean_.transpose())).cwiseProduct(scale_.transpose());
     });
@@ -200,9 +199,9 @@ class BatchNorm1d {
   /// then over chunks in order (so seq and omp agree bit for bit).
   template <class Policy, class Add>
   void column_sums(Policy policy, Index R, Add&& add) {
-    const Index nr = detail::chunk_count(R, detail::reduction_chunks), workers = detail::worker_count(policy, nr);
+    const Index nr = exec::chunk_count(R, reduction_chunks), workers = exec::worker_count(policy, nr);
     ensure_shape(parts_, nr, c_);
-    detail::for_chunks(policy, R, nr, workers, [&](Index, Index c, Index b, Index e) {
+    exec::for_chunks(policy, R, nr, workers, [&](Index, Index c, Index b, Index e) {
       parts_.row(c).setZero();
       for (Index r = b; r < e; ++r) add(r, parts_.row(c));
     });
@@ -222,5 +221,6 @@ class BatchNorm1d {
   Vector<double> total_, mean_, inv_std_, var_, dsum_, dxsum_;
   Vector<S> shift_, scale_, gamma_, beta_, dmean_, dxmean_;
 };
+static_assert(assert_layer<BatchNorm1d<float>>());
 
 }  // namespace simsr::nn

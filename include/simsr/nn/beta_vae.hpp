@@ -48,7 +48,6 @@
 #include <vector>
 
 #include "activations.hpp"
-#include "detail/chunks.hpp"
 #include "layer.hpp"
 #include "linear.hpp"
 #include "losses.hpp"
@@ -180,7 +179,7 @@ class BetaVae {
 
   /// Eval mode: out (B×3M) = decoder(μ(lr)). Deterministic, draws nothing. ShapeError unless lr
   /// is B×3N.
-  template <exec::HostPolicy Policy = exec::seq_t>
+  template <exec::HostPolicy Policy>
   void predict(Policy policy, const ConstView<S>& lr, Matrix<S>& out) {
     check_input(lr);
     forward(policy, lr, nullptr, out);
@@ -189,7 +188,7 @@ class BetaVae {
   /// The loss of one batch without backward: train mode (ε drawn from *rng) when rng is given,
   /// eval mode (z = μ) when it is null (e.g. a validation loss). ShapeError unless lr is B×3N and
   /// hr B×3M; ArgumentError for an empty batch.
-  template <exec::HostPolicy Policy = exec::seq_t>
+  template <exec::HostPolicy Policy>
   Loss loss(Policy policy, const ConstView<S>& lr, const ConstView<S>& hr, Rng* rng) {
     check_batch(lr, hr);
     forward(policy, lr, rng, out_);
@@ -199,7 +198,7 @@ class BetaVae {
   /// One training pass: forward in train mode (ε from `rng`), the loss, and backward, which ADDS
   /// ∂loss/∂θ into the store's gradients (the caller zero_grads before and steps the optimizer
   /// after). With `d_lr`, also writes ∂loss/∂lr (B×3N). Errors as loss().
-  template <exec::HostPolicy Policy = exec::seq_t>
+  template <exec::HostPolicy Policy>
   Loss loss_and_backward(Policy policy, const ConstView<S>& lr, const ConstView<S>& hr, Rng& rng, Matrix<S>* d_lr = nullptr) {
     check_batch(lr, hr);
     forward(policy, lr, &rng, out_);
@@ -235,15 +234,15 @@ class BetaVae {
     for (Index i = 0; i < ne; ++i) {
       auto& pre = enc_pre_[std::size_t(i)];
       if (i == 0)
-        encoder_[0].forward(mode, lr, pre, policy);
+        encoder_[0].forward(policy, mode, lr, pre);
       else
-        encoder_[std::size_t(i)].forward(mode, enc_act_[std::size_t(i - 1)], pre, policy);
-      act_.forward(mode, pre, enc_act_[std::size_t(i)], policy);
+        encoder_[std::size_t(i)].forward(policy, mode, enc_act_[std::size_t(i - 1)], pre);
+      act_.forward(policy, mode, pre, enc_act_[std::size_t(i)]);
     }
     if (ne == 0)
-      head_->forward(mode, lr, head_out_, policy);
+      head_->forward(policy, mode, lr, head_out_);
     else
-      head_->forward(mode, enc_act_.back(), head_out_, policy);
+      head_->forward(policy, mode, enc_act_.back(), head_out_);
     ensure_shape(z_, B, L);
     sampled_ = rng != nullptr;
     if (sampled_) {
@@ -261,10 +260,10 @@ class BetaVae {
     }
     for (Index i = 0; i < nd; ++i) {
       auto& pre = dec_pre_[std::size_t(i)];
-      decoder_[std::size_t(i)].forward(mode, i == 0 ? z_ : dec_act_[std::size_t(i - 1)], pre, policy);
-      act_.forward(mode, pre, dec_act_[std::size_t(i)], policy);
+      decoder_[std::size_t(i)].forward(policy, mode, i == 0 ? z_ : dec_act_[std::size_t(i - 1)], pre);
+      act_.forward(policy, mode, pre, dec_act_[std::size_t(i)]);
     }
-    decoder_.back().forward(mode, nd == 0 ? z_ : dec_act_.back(), out, policy);
+    decoder_.back().forward(policy, mode, nd == 0 ? z_ : dec_act_.back(), out);
   }
 
   /// recon (chunked, double sums: policy-independent) and KL (serial, double); with `grad`, the
@@ -302,11 +301,11 @@ class BetaVae {
   template <class Policy>
   void backward(Policy policy, const ConstView<S>& lr, Matrix<S>* d_lr) {
     const Index ne = num_encoder_layers(), nd = num_decoder_layers() - 1, B = lr.rows(), L = cfg_.latent;
-    decoder_.back().backward(nd == 0 ? z_ : dec_act_.back(), out_, d_out_, nd == 0 ? &d_z_ : &dec_dact_.back(), policy);
+    decoder_.back().backward(policy, nd == 0 ? z_ : dec_act_.back(), out_, d_out_, nd == 0 ? &d_z_ : &dec_dact_.back());
     for (Index i = nd - 1; i >= 0; --i) {
       const auto k = std::size_t(i);
-      act_.backward(dec_pre_[k], dec_act_[k], dec_dact_[k], &dec_dpre_[k], policy);
-      decoder_[k].backward(i == 0 ? z_ : dec_act_[k - 1], dec_pre_[k], dec_dpre_[k], i == 0 ? &d_z_ : &dec_dact_[k - 1], policy);
+      act_.backward(policy, dec_pre_[k], dec_act_[k], dec_dact_[k], &dec_dpre_[k]);
+      decoder_[k].backward(policy, i == 0 ? z_ : dec_act_[k - 1], dec_pre_[k], dec_dpre_[k], i == 0 ? &d_z_ : &dec_dact_[k - 1]);
     }
     // z = μ + σ⊙ε, σ = exp(½·logvar): ∂z/∂μ = 1, ∂z/∂logvar = ½·σ⊙ε (eval: z = μ).
     for (Index b = 0; b < B; ++b)
@@ -316,16 +315,16 @@ class BetaVae {
       }
     Matrix<S>* d_head_in = ne == 0 ? d_lr : &enc_dact_.back();
     if (ne == 0)
-      head_->backward(lr, head_out_, d_head_, d_head_in, policy);
+      head_->backward(policy, lr, head_out_, d_head_, d_head_in);
     else
-      head_->backward(enc_act_.back(), head_out_, d_head_, d_head_in, policy);
+      head_->backward(policy, enc_act_.back(), head_out_, d_head_, d_head_in);
     for (Index i = ne - 1; i >= 0; --i) {
       const auto k = std::size_t(i);
-      act_.backward(enc_pre_[k], enc_act_[k], enc_dact_[k], &enc_dpre_[k], policy);
+      act_.backward(policy, enc_pre_[k], enc_act_[k], enc_dact_[k], &enc_dpre_[k]);
       if (i == 0)
-        encoder_[0].backward(lr, enc_pre_[0], enc_dpre_[0], d_lr, policy);
+        encoder_[0].backward(policy, lr, enc_pre_[0], enc_dpre_[0], d_lr);
       else
-        encoder_[k].backward(enc_act_[k - 1], enc_pre_[k], enc_dpre_[k], &enc_dact_[k - 1], policy);
+        encoder_[k].backward(policy, enc_act_[k - 1], enc_pre_[k], enc_dpre_[k], &enc_dact_[k - 1]);
     }
   }
 

@@ -4,14 +4,13 @@
 /// the edge features cat(h_j − h_i, h_i), `fc_out` on cat(h, g, max, mean), z = [h⁰, h¹, h²]).
 ///
 ///     nn::Concat<float> cat({C, C, C, C});
-///     cat.forward({h, g, gmax, gmean}, x);          // rows × 4C
-///     cat.backward(dx, {&dh, &dg, nullptr, nullptr}); // split; null parts skipped
+///     cat.forward(exec::omp, {h, g, gmax, gmean}, x);           // rows × 4C
+///     cat.backward(exec::omp, dx, {&dh, &dg, nullptr, nullptr}); // split; null parts skipped
 
 #include <initializer_list>
 #include <numeric>
 #include <vector>
 
-#include "detail/chunks.hpp"
 #include "tensor.hpp"
 
 namespace simsr::nn {
@@ -39,35 +38,35 @@ class Concat {
   Index out_features() const { return offsets_.back(); }
 
   /// out = [in₀, in₁, …] (rows × Σ widths).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(std::initializer_list<ConstView<S>> ins, Matrix<S>& out, Policy policy = {}) const {
-    forward_parts(ins.size(), [&](std::size_t i) -> const ConstView<S>& { return ins.begin()[i]; }, out, policy);
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, std::initializer_list<ConstView<S>> ins, Matrix<S>& out) const {
+    forward_parts(policy, ins.size(), [&](std::size_t i) -> const ConstView<S>& { return ins.begin()[i]; }, out);
   }
 
   /// The same with the parts given by part(i) (i < n), for a number of parts known at run time
   /// (FeatureEmbedding's z = [h⁰, h¹, …]); nothing is allocated.
-  template <class Part, exec::HostPolicy Policy = exec::seq_t>
-  void forward_parts(std::size_t n, Part&& part, Matrix<S>& out, Policy policy = {}) const {
+  template <exec::HostPolicy Policy, class Part>
+  void forward_parts(Policy policy, std::size_t n, Part&& part, Matrix<S>& out) const {
     check_count(n);
     const Index R = part(0).rows();
     for (std::size_t i = 0; i < n; ++i) detail::check_shape("nn::Concat", part_name(i).c_str(), part(i), R, widths_[i]);
     ensure_shape(out, R, out_features());
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       for (std::size_t p = 0; p < n; ++p) out.block(b, offsets_[p], e - b, widths_[p]) = part(p).middleRows(b, e - b);
     });
   }
 
   /// Splits d_out into the parts' gradients: d_ins[i] = columns of part i (overwritten, or added
   /// with `accumulate`, where d_ins[i] must already be rows × width(i)); null entries are skipped.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& d_out, std::initializer_list<Matrix<S>*> d_ins, bool accumulate = false, Policy policy = {}) const {
-    backward_parts(d_out, d_ins.size(), [&](std::size_t i) { return d_ins.begin()[i]; }, accumulate, policy);
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& d_out, std::initializer_list<Matrix<S>*> d_ins, bool accumulate = false) const {
+    backward_parts(policy, d_out, d_ins.size(), [&](std::size_t i) { return d_ins.begin()[i]; }, accumulate);
   }
 
   /// The same with the gradients given by grad(i) (i < n; null: skipped).
-  template <class Grad, exec::HostPolicy Policy = exec::seq_t>
-  void backward_parts(const ConstView<S>& d_out, std::size_t n, Grad&& grad, bool accumulate = false, Policy policy = {}) const {
+  template <exec::HostPolicy Policy, class Grad>
+  void backward_parts(Policy policy, const ConstView<S>& d_out, std::size_t n, Grad&& grad, bool accumulate = false) const {
     check_count(n);
     detail::check_shape("nn::Concat", "output gradient", d_out, -1, out_features());
     const Index R = d_out.rows();
@@ -79,8 +78,8 @@ class Concat {
           ensure_shape(*d, R, widths_[i]);
       }
     }
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       for (std::size_t p = 0; p < n; ++p) {
         Matrix<S>* d = grad(p);
         if (!d) continue;

@@ -7,8 +7,8 @@
 /// are computed once (precompute_weights) and every frame is a sparse M×N product (apply).
 ///
 ///     nn::CoordinateUpsampling<float> up(store, "net_upscale", cfg, query, up_indices, N, rng);
-///     up.forward(nn::Mode::train, z, zH);      // training: f_θ once per step, not per item
-///     up.precompute_weights(); up.apply(z, zH); // inference
+///     up.forward(exec::omp, nn::Mode::train, z, zH);                    // training: f_θ once per step, not per item
+///     up.precompute_weights(exec::omp); up.apply(exec::omp, z, zH);     // inference
 ///
 /// Official names: `conv_weights.<3l>` (Conv2d, no bias), `conv_weights.<3l+1>` (BatchNorm2d),
 /// sin, …, `conv_weights.<3L>` (Conv2d →1 with bias); without BatchNorm the indices step by 2.
@@ -110,16 +110,16 @@ class CoordinateUpsampling {
   const Matrix<S>& weights() const { return kind_ == UpsamplingKind::table || !precomputed_ ? up_.weights() : weights_; }
 
   /// Training path: logits from f_θ (mode: BatchNorm statistics), softmax, gather. z: (B·N)×C.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& z, Matrix<S>& zH, Policy policy = {}) {
-    compute_logits(mode, policy);
-    up_.forward(logits_view(), z, zH, policy);
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& z, Matrix<S>& zH) {
+    compute_logits(policy, mode);
+    up_.forward(policy, logits_view(), z, zH);
   }
 
   /// After forward: d_z written (overwritten), f_θ's (or the table's) gradients added.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& z, const ConstView<S>& d_zH, Matrix<S>* d_z, Policy policy = {}) {
-    up_.backward(z, d_zH, &d_logits_, d_z, policy);
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& z, const ConstView<S>& d_zH, Matrix<S>* d_z) {
+    up_.backward(policy, z, d_zH, &d_logits_, d_z);
     if (kind_ == UpsamplingKind::table) {
       auto g = store_->gradient(logits_off_, up_.hr_points(), up_.neighbors());
       g += d_logits_;
@@ -127,14 +127,14 @@ class CoordinateUpsampling {
     }
     const Index MK = up_.hr_points() * up_.neighbors();
     const ConstView<S> d_col(Eigen::Map<const Matrix<S>>(d_logits_.data(), MK, 1));
-    mlp_->backward(query_, logits_, d_col, nullptr, policy);
+    mlp_->backward(policy, query_, logits_, d_col, nullptr);
   }
 
   /// Inference: weights from f_θ in eval mode (running BatchNorm statistics), once.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void precompute_weights(Policy policy = {}) {
-    compute_logits(Mode::eval, policy);
-    NeighborUpsample<S>::softmax_rows(logits_view(), weights_, policy);
+  template <exec::HostPolicy Policy>
+  void precompute_weights(Policy policy) {
+    compute_logits(policy, Mode::eval);
+    NeighborUpsample<S>::softmax_rows(policy, logits_view(), weights_);
     precomputed_ = true;
   }
   bool has_precomputed_weights() const { return precomputed_; }
@@ -142,15 +142,15 @@ class CoordinateUpsampling {
   void invalidate() { precomputed_ = false; }
 
   /// Inference gather with the precomputed weights: zH = W·z per batch item.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void apply(const ConstView<S>& z, Matrix<S>& zH, Policy policy = {}) const {
-    if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::apply: call precompute_weights() first");
-    up_.apply(weights_, z, zH, policy);
+  template <exec::HostPolicy Policy>
+  void apply(Policy policy, const ConstView<S>& z, Matrix<S>& zH) const {
+    if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::apply: call precompute_weights(policy) first");
+    up_.apply(policy, weights_, z, zH);
   }
 
   /// The precomputed upsampling as an M×N sparse matrix (duplicate neighbours summed).
   SparseMatrix sparse_matrix() const {
-    if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::sparse_matrix: call precompute_weights() first");
+    if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::sparse_matrix: call precompute_weights(policy) first");
     std::vector<Eigen::Triplet<S>> t;
     const Index M = up_.hr_points(), K = up_.neighbors();
     t.reserve(std::size_t(M * K));
@@ -163,14 +163,14 @@ class CoordinateUpsampling {
 
  private:
   template <class Policy>
-  void compute_logits(Mode mode, Policy policy) {
+  void compute_logits(Policy policy, Mode mode) {
     if (kind_ == UpsamplingKind::table) {
       const Index M = up_.hr_points(), K = up_.neighbors();
       ensure_shape(logits_, M * K, 1);
       Eigen::Map<Matrix<S>>(logits_.data(), M, K) = std::as_const(*store_).value(logits_off_, M, K);
       return;
     }
-    mlp_->forward(mode, query_, logits_, policy);
+    mlp_->forward(policy, mode, query_, logits_);
   }
   /// The (M·upK)×1 logits seen as M×upK (row-major: the same memory).
   ConstView<S> logits_view() const { return Eigen::Map<const Matrix<S>>(logits_.data(), up_.hr_points(), up_.neighbors()); }

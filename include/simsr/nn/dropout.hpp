@@ -3,12 +3,11 @@
 /// Dropout (the official FeatEmb's `drop_out`, applied after each embedding block; SPEC §7).
 ///
 ///     nn::Dropout<float> drop(0.1, nn::Rng(42));
-///     drop.forward(nn::Mode::train, h, y);   // y = h ⊙ mask / (1 − p), mask ~ Bernoulli(1 − p)
-///     drop.forward(nn::Mode::eval, h, y);    // y = h
+///     drop.forward(exec::omp, nn::Mode::train, h, y);   // y = h ⊙ mask / (1 − p), mask ~ Bernoulli(1 − p)
+///     drop.forward(exec::omp, nn::Mode::eval, h, y);    // y = h
 
 #include <string>
 
-#include "detail/chunks.hpp"
 #include "layer.hpp"
 
 namespace simsr::nn {
@@ -33,8 +32,8 @@ class Dropout {
   /// The mask of the last train forward (0 or 1/(1 − p) per entry); empty after an identity forward.
   const Matrix<S>& mask() const { return mask_; }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& in, Matrix<S>& out) {
     const Index R = in.rows(), C = in.cols();
     ensure_shape(out, R, C);
     masked_ = mode == Mode::train && p_ > 0;
@@ -43,8 +42,8 @@ class Dropout {
       const S keep = p_ < 1 ? static_cast<S>(1.0 / (1.0 - p_)) : S(0);
       for (Index i = 0; i < mask_.size(); ++i) mask_.data()[i] = uniform(rng_, 0, 1) < p_ ? S(0) : keep;
     }
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       if (masked_)
         out.middleRows(b, e - b) = in.middleRows(b, e - b).cwiseProduct(mask_.middleRows(b, e - b));
       else
@@ -53,15 +52,15 @@ class Dropout {
   }
 
   /// d_in = d_out ⊙ mask (train, p > 0) or d_out.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
     detail::check_shape("nn::Dropout", "output gradient", d_out, in.rows(), in.cols());
     if (masked_) detail::check_shape("nn::Dropout", "input (the last forward's)", in, mask_.rows(), mask_.cols());
     if (!d_in) return;
     const Index R = in.rows();
     ensure_shape(*d_in, R, in.cols());
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       if (masked_)
         d_in->middleRows(b, e - b) = d_out.middleRows(b, e - b).cwiseProduct(mask_.middleRows(b, e - b));
       else
@@ -75,5 +74,6 @@ class Dropout {
   bool masked_ = false;
   Matrix<S> mask_;
 };
+static_assert(assert_layer<Dropout<float>>());
 
 }  // namespace simsr::nn

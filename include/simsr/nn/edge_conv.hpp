@@ -7,7 +7,7 @@
 ///     nn::EdgeConv<float> ec(store, "net_feat_emb.blocks.0", 35, 64, 5, rng);
 ///     ec.set_graph(lr_graph, N);                     // fixed graph (block 0), or:
 ///     ec.use_dynamic_graph(N);                       // kNN in feature space per forward (block 1)
-///     ec.forward(nn::Mode::train, h, e);             // h: (B·N)×35 → e: (B·N)×64
+///     ec.forward(exec::omp, nn::Mode::train, h, e);  // h: (B·N)×35 → e: (B·N)×64
 ///
 /// State-dict names (official_model.py): `<prefix>.edge_conv.0.weight` (2out×2C×1×1),
 /// `<prefix>.edge_conv.1.{weight,bias,running_mean,running_var,num_batches_tracked}`,
@@ -25,9 +25,10 @@ namespace simsr::nn {
 
 /// One EdgeConv: (B·N)×in → (B·N)×out. A fixed graph (set_graph) serves every batch item; a
 /// dynamic graph (use_dynamic_graph) is rebuilt from the input features at every forward (k
-/// nearest other points per item, see DynamicKnnGraph) and is not differentiated. Backward must
-/// follow the forward of the same input (it reuses the graph and the intermediate activations).
-template <class S = float>
+/// nearest other points per item, found by `Search`, any neighbors::NeighborSearch; see
+/// DynamicKnnGraph) and is not differentiated. Backward must follow the forward of the same input
+/// (it reuses the graph and the intermediate activations).
+template <class S = float, class Search = neighbors::BruteForceKnn<S>>
 class EdgeConv {
  public:
   using scalar_type = S;
@@ -91,8 +92,8 @@ class EdgeConv {
   /// into per-worker scratch and run through the edge MLP there (Mlp::eval_block, the chunks of
   /// Linear::forward): the (B·N·k)×2C edge features and the MLP's intermediates are never stored,
   /// and the values are those of the stored path. A backward after it recomputes them.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& in, Matrix<S>& out) {
     detail::check_shape("nn::EdgeConv", "input", in, -1, in_);
     if (dynamic_) {
       knn_.build(policy, in, n_, k_, dyn_graph_);
@@ -100,40 +101,40 @@ class EdgeConv {
     }
     lean_ = mode == Mode::eval && mlp_.eval_fusable();
     if (lean_) {
-      forward_fused(in, policy);
+      forward_fused(policy, in);
     } else {
-      features_.forward(mode, in, e0_, policy);
-      mlp_.forward(mode, e0_, e4_, policy);
+      features_.forward(policy, mode, in, e0_);
+      mlp_.forward(policy, mode, e0_, e4_);
     }
-    pool_.forward(mode, e4_, out, policy);
+    pool_.forward(policy, mode, e4_, out);
   }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in) {
     if (lean_) {  // the fused eval forward stored no edge features: make them (the MLP recomputes its own)
       detail::check_shape("nn::EdgeConv", "input", in, e4_.rows() / k_, in_);
-      features_.forward(Mode::eval, in, e0_, policy);
+      features_.forward(policy, Mode::eval, in, e0_);
       lean_ = false;
     }
     detail::check_shape("nn::EdgeConv", "input", in, e0_.rows() / k_, in_);
-    pool_.backward(e4_, out, d_out, &g4_, policy);
-    mlp_.backward(e0_, e4_, g4_, d_in ? &g0_ : nullptr, policy);
-    if (d_in) features_.backward(in, e0_, g0_, d_in, policy);
+    pool_.backward(policy, e4_, out, d_out, &g4_);
+    mlp_.backward(policy, e0_, e4_, g4_, d_in ? &g0_ : nullptr);
+    if (d_in) features_.backward(policy, in, e0_, g0_, d_in);
   }
 
  private:
   template <class Policy>
-  void forward_fused(const ConstView<S>& in, Policy policy) {
+  void forward_fused(Policy policy, const ConstView<S>& in) {
     if (features_.graph().size() == 0) throw ArgumentError("nn::GraphFeatures: no graph set (call set_graph first)");
     if (in.rows() % features_.graph().rows())
       throw ShapeError("nn::GraphFeatures: input rows (a multiple of the graph's " + std::to_string(features_.graph().rows()) + ")",
                        {-1, in.cols()}, {in.rows(), in.cols()});
     const Index R = in.rows() * k_, C2 = 2 * in_;
     ensure_shape(e4_, R, mlp_.out_features());
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
     mlp_.prepare_eval_blocks(R, workers);
     if (gathered_.size() < std::size_t(workers)) gathered_.resize(std::size_t(workers));
-    for (auto& g : gathered_) ensure_shape(g, detail::max_chunk_rows(R, nc), C2);
+    for (auto& g : gathered_) ensure_shape(g, exec::max_chunk_size(R, nc), C2);
     detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
       Matrix<S>& g = gathered_[std::size_t(w)];
       features_.gather(in, b, e, g.data(), C2);
@@ -145,7 +146,7 @@ class EdgeConv {
   EdgeMlp kind_;
   bool dynamic_ = false;
   GraphFeatures<S> features_;
-  DynamicKnnGraph<S> knn_;
+  DynamicKnnGraph<S, Search> knn_;
   GraphIndices dyn_graph_;
   Mlp<S> mlp_;
   GroupPool<S> pool_;
@@ -153,5 +154,6 @@ class EdgeConv {
   std::vector<Matrix<S>> gathered_;  ///< fused eval path: per worker, one chunk of edge rows
   bool lean_ = false;                ///< the last forward was the fused eval one (e0_ not made)
 };
+static_assert(assert_layer<EdgeConv<float>>());
 
 }  // namespace simsr::nn

@@ -13,7 +13,6 @@
 #include <type_traits>
 #include <Eigen/Geometry>
 
-#include "detail/chunks.hpp"
 #include "graph_features.hpp"
 #include "tensor.hpp"
 
@@ -117,10 +116,10 @@ class FaceNormalLoss {
     if (d_pred) ensure_shape(g_, T, 3);
 
     // pass 1: per triangle (item-major), the term 1 − cos and the normal's gradient g.
-    const Index nc = detail::chunk_count(T, exec::default_chunks), workers = detail::worker_count(policy, nc);
+    const Index nc = exec::chunk_count(T, exec::default_chunks), workers = exec::worker_count(policy, nc);
     double parts[exec::default_chunks];
     const double eps2 = eps_ * eps_;
-    detail::for_chunks(policy, T, nc, workers, [&](Index, Index c, Index begin, Index end) {
+    exec::for_chunks(policy, T, nc, workers, [&](Index, Index c, Index begin, Index end) {
       double s = 0;
       for (Index i = begin; i < end; ++i) {
         const Index item = i / F, t = i % F;
@@ -140,8 +139,8 @@ class FaceNormalLoss {
     if (d_pred) {
       ensure_shape(*d_pred, B * M, 3);
       const Index rows = B * M;
-      const Index vc = detail::chunk_count(rows, detail::product_chunks), vworkers = detail::worker_count(policy, vc);
-      detail::for_chunks(policy, rows, vc, vworkers, [&](Index, Index, Index begin, Index end) {
+      const Index vc = exec::chunk_count(rows, product_chunks), vworkers = exec::worker_count(policy, vc);
+      exec::for_chunks(policy, rows, vc, vworkers, [&](Index, Index, Index begin, Index end) {
         for (Index r = begin; r < end; ++r) {
           const Index item = r / M, v = r % M;
           V3 acc = V3::Zero();
@@ -157,10 +156,6 @@ class FaceNormalLoss {
     return total / norm;
   }
 
-  /// exec::seq.
-  double value_and_gradient(const ConstView<S>& pred, const ConstView<S>& target, Matrix<S>* d_pred = nullptr, double scale = 1.0) {
-    return value_and_gradient(exec::seq, pred, target, d_pred, scale);
-  }
 
  private:
   using V3 = Eigen::Matrix<double, 3, 1>;

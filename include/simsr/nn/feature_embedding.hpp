@@ -6,7 +6,7 @@
 /// `fc_out`(cat(h, e, max, mean)); block s feeds block s+1, and the code is z = [h⁰, h¹, …, h^S].
 ///
 ///     nn::FeatureEmbedding<float> fe(store, "net_feat_emb", cfg, N, lr_graph, rng);
-///     fe.forward(nn::Mode::train, h0, z);   // (B·N)×35 → (B·N)×227
+///     fe.forward(exec::omp, nn::Mode::train, h0, z);   // (B·N)×35 → (B·N)×227
 
 #include <memory>
 #include <string>
@@ -22,7 +22,7 @@
 namespace simsr::nn {
 
 /// One submodule (`blocks.<b>`): (B·N)×in → (B·N)×out.
-template <class S = float>
+template <class S = float, class Search = neighbors::BruteForceKnn<S>>
 class EmbeddingBlock {
  public:
   using scalar_type = S;
@@ -41,41 +41,41 @@ class EmbeddingBlock {
   }
 
   Index out_features(Index = -1) const { return out_; }
-  EdgeConv<S>& edge_conv() { return edge_; }
+  EdgeConv<S, Search>& edge_conv() { return edge_; }
   Mlp<S>& fc_out() { return fc_out_; }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& h, Matrix<S>& out, Policy policy = {}) {
-    edge_.forward(mode, h, e_, policy);
-    gmax_.forward(mode, e_, max_, policy);
-    gmean_.forward(mode, e_, mean_, policy);
-    cat_.forward({h, e_, max_, mean_}, cat_out_, policy);
-    fc_out_.forward(mode, cat_out_, out, policy);
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& h, Matrix<S>& out) {
+    edge_.forward(policy, mode, h, e_);
+    gmax_.forward(policy, mode, e_, max_);
+    gmean_.forward(policy, mode, e_, mean_);
+    cat_.forward(policy, {h, e_, max_, mean_}, cat_out_);
+    fc_out_.forward(policy, mode, cat_out_, out);
   }
 
   /// d_h written when not null (the block's input gradient, all paths summed).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& h, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_h, Policy policy = {}) {
-    fc_out_.backward(cat_out_, out, d_out, &d_cat_, policy);
-    cat_.backward(d_cat_, {&d_h_direct_, &d_e_, &d_max_, &d_mean_}, false, policy);
-    gmax_.backward(e_, max_, d_max_, &d_e_part_, policy);
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& h, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_h) {
+    fc_out_.backward(policy, cat_out_, out, d_out, &d_cat_);
+    cat_.backward(policy, d_cat_, {&d_h_direct_, &d_e_, &d_max_, &d_mean_}, false);
+    gmax_.backward(policy, e_, max_, d_max_, &d_e_part_);
     d_e_ += d_e_part_;
-    gmean_.backward(e_, mean_, d_mean_, &d_e_part_, policy);
+    gmean_.backward(policy, e_, mean_, d_mean_, &d_e_part_);
     d_e_ += d_e_part_;
     if (!d_h) {
-      edge_.backward(h, e_, d_e_, nullptr, policy);
+      edge_.backward(policy, h, e_, d_e_, nullptr);
       return;
     }
-    edge_.backward(h, e_, d_e_, d_h, policy);
+    edge_.backward(policy, h, e_, d_e_, d_h);
     *d_h += d_h_direct_;
   }
 
-  static typename EdgeConv<S>::Options edge_options(const NetworkConfig& cfg) {
-    typename EdgeConv<S>::Options o;
+  static typename EdgeConv<S, Search>::Options edge_options(const NetworkConfig& cfg) {
+    typename EdgeConv<S, Search>::Options o;
     o.slope = static_cast<S>(cfg.leaky_relu_slope);
     o.bn.eps = cfg.batchnorm_eps;
     o.bn.momentum = cfg.batchnorm_momentum;
-    o.edge_mlp = cfg.edge_batch_norm ? EdgeConv<S>::EdgeMlp::official : EdgeConv<S>::EdgeMlp::single_linear;
+    o.edge_mlp = cfg.edge_batch_norm ? EdgeConv<S, Search>::EdgeMlp::official : EdgeConv<S, Search>::EdgeMlp::single_linear;
     return o;
   }
 
@@ -103,17 +103,18 @@ class EmbeddingBlock {
 
  private:
   Index in_, out_, n_;
-  EdgeConv<S> edge_;
+  EdgeConv<S, Search> edge_;
   GroupPool<S> gmax_, gmean_;
   Concat<S> cat_;
   Mlp<S> fc_out_;
   Matrix<S> e_, max_, mean_, cat_out_, d_cat_, d_h_direct_, d_e_, d_max_, d_mean_, d_e_part_;
 };
+static_assert(assert_layer<EmbeddingBlock<float>>());
 
 /// The blocks, their dropout and the code z = [h⁰, h¹, …] ((B·N)×latent_dim). The official module
 /// also builds `fc_initial` (Linear 3→D, LeakyReLU, Linear D→D) and never calls it; it is
 /// registered (cfg.profile == "official") so the state dict loads, and gets no gradient.
-template <class S = float>
+template <class S = float, class Search = neighbors::BruteForceKnn<S>>
 class FeatureEmbedding {
  public:
   using scalar_type = S;
@@ -127,8 +128,9 @@ class FeatureEmbedding {
     graph_ = lr_graph.leftCols(cfg.knn);
     const Index S_blocks = Index(dims_.size()) - 1;
     for (Index b = 0; b < S_blocks; ++b) {
-      blocks_.push_back(std::make_unique<EmbeddingBlock<S>>(store, prefix + ".blocks." + std::to_string(b), cfg, dims_[std::size_t(b)],
-                                                            dims_[std::size_t(b + 1)], n_points, b == 0 ? &graph_ : nullptr, rng));
+      blocks_.push_back(std::make_unique<EmbeddingBlock<S, Search>>(store, prefix + ".blocks." + std::to_string(b), cfg,
+                                                                    dims_[std::size_t(b)], dims_[std::size_t(b + 1)], n_points,
+                                                                    b == 0 ? &graph_ : nullptr, rng));
       drops_.push_back(std::make_unique<Dropout<S>>(cfg.dropout, Rng(rng())));
     }
     if (cfg.profile == "official") {
@@ -146,7 +148,7 @@ class FeatureEmbedding {
   }
 
   Index blocks() const { return Index(blocks_.size()); }
-  EmbeddingBlock<S>& block(Index b) { return *blocks_.at(std::size_t(b)); }
+  EmbeddingBlock<S, Search>& block(Index b) { return *blocks_.at(std::size_t(b)); }
   /// The dropout after block b (its Rng is reseeded by the trainer at every step).
   Dropout<S>& dropout(Index b) { return *drops_.at(std::size_t(b)); }
   Index out_features(Index = -1) const { return cat_->out_features(); }
@@ -154,31 +156,31 @@ class FeatureEmbedding {
   const Matrix<S>& block_output(Index s) const { return h_.at(std::size_t(s)); }
 
   /// h0: (B·N)×D₀ → z = [h0, h¹, …] (B·N)×Σ D.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& h0, Matrix<S>& z, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& h0, Matrix<S>& z) {
     const ConstView<S>* x = &h0;
     std::optional<ConstView<S>> xv;
     for (std::size_t b = 0; b < blocks_.size(); ++b) {
-      blocks_[b]->forward(mode, *x, pre_drop_[b], policy);
-      drops_[b]->forward(mode, pre_drop_[b], h_[b], policy);
+      blocks_[b]->forward(policy, mode, *x, pre_drop_[b]);
+      drops_[b]->forward(policy, mode, pre_drop_[b], h_[b]);
       xv.emplace(h_[b]);
       x = &*xv;
     }
-    concat_forward(h0, z, policy);
+    concat_forward(policy, h0, z);
   }
 
   /// d_z: gradient of z; parameter gradients added (h0 needs none: it is data).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& h0, const ConstView<S>& d_z, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& h0, const ConstView<S>& d_z) {
     const std::size_t nb = blocks_.size();
-    split(d_z, policy);
+    split(policy, d_z);
     for (std::size_t b = nb; b-- > 0;) {
-      drops_[b]->backward(pre_drop_[b], h_[b], d_h_[b], &d_pre_, policy);
+      drops_[b]->backward(policy, pre_drop_[b], h_[b], d_h_[b], &d_pre_);
       const ConstView<S> in = b == 0 ? h0 : ConstView<S>(h_[b - 1]);
       if (b == 0) {
-        blocks_[b]->backward(in, pre_drop_[b], d_pre_, nullptr, policy);
+        blocks_[b]->backward(policy, in, pre_drop_[b], d_pre_, nullptr);
       } else {
-        blocks_[b]->backward(in, pre_drop_[b], d_pre_, &d_in_, policy);
+        blocks_[b]->backward(policy, in, pre_drop_[b], d_pre_, &d_in_);
         d_h_[b - 1] += d_in_;
       }
     }
@@ -187,21 +189,21 @@ class FeatureEmbedding {
  private:
   /// z = [h⁰, h¹, …, h^S].
   template <class Policy>
-  void concat_forward(const ConstView<S>& h0, Matrix<S>& z, Policy policy) {
+  void concat_forward(Policy policy, const ConstView<S>& h0, Matrix<S>& z) {
     const std::size_t n = blocks_.size() + 1;
-    cat_->forward_parts(n, [&](std::size_t i) { return i == 0 ? h0 : ConstView<S>(h_[i - 1]); }, z, policy);
+    cat_->forward_parts(policy, n, [&](std::size_t i) { return i == 0 ? h0 : ConstView<S>(h_[i - 1]); }, z);
   }
   /// d_h_[s] = the h^{s+1} columns of d_z (h⁰ is data: no gradient).
   template <class Policy>
-  void split(const ConstView<S>& d_z, Policy policy) {
+  void split(Policy policy, const ConstView<S>& d_z) {
     const std::size_t n = blocks_.size() + 1;
-    cat_->backward_parts(d_z, n, [&](std::size_t i) { return i == 0 ? nullptr : &d_h_[i - 1]; }, false, policy);
+    cat_->backward_parts(policy, d_z, n, [&](std::size_t i) { return i == 0 ? nullptr : &d_h_[i - 1]; }, false);
   }
 
   Index n_;
   std::vector<Index> dims_;
   GraphIndices graph_;
-  std::vector<std::unique_ptr<EmbeddingBlock<S>>> blocks_;
+  std::vector<std::unique_ptr<EmbeddingBlock<S, Search>>> blocks_;
   std::vector<std::unique_ptr<Dropout<S>>> drops_;
   std::unique_ptr<Mlp<S>> fc_initial_;
   std::unique_ptr<Concat<S>> cat_;

@@ -5,18 +5,19 @@
 /// second embedding block (k nearest other points per batch item, not differentiated).
 ///
 ///     nn::GraphFeatures<float> gf;
-///     gf.set_graph(lr_graph, N);                 // N×k, shared by every batch item
-///     gf.forward(nn::Mode::train, h, e);         // h: (B·N)×C → e: (B·N·k)×2C, row (b·N+n)·k+j
+///     gf.set_graph(lr_graph, N);                         // N×k, shared by every batch item
+///     gf.forward(exec::omp, nn::Mode::train, h, e);      // h: (B·N)×C → e: (B·N·k)×2C, row (b·N+n)·k+j
 ///
-///     nn::DynamicKnnGraph<float> dyn;
-///     dyn.build(exec::omp, h, N, k, graph);      // graph: (B·N)×k, indices local to each item
+///     nn::DynamicKnnGraph<float> dyn;                    // or DynamicKnnGraph<float, MySearch>
+///     dyn.build(exec::omp, h, N, k, graph);              // graph: (B·N)×k, indices local to each item
 ///     gf.set_graph(graph, N);
 
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "../neighbors/brute_force_knn.hpp"
-#include "detail/chunks.hpp"
+#include "../neighbors/concepts.hpp"
 #include "layer.hpp"
 
 namespace simsr::nn {
@@ -88,13 +89,13 @@ class GraphFeatures {
   Index points_per_item() const { return n_; }
   Index out_features(Index in_cols) const { return 2 * in_cols; }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
     const Index reps = check_input(in), R = graph_.rows(), k = graph_.cols(), C = in.cols();
     ensure_shape(out, in.rows() * k, 2 * C);
     const Index rows = reps * R;
-    const Index nc = detail::chunk_count(rows, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(rows, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
       gather(in, b * k, e * k, out.data() + b * k * out.cols(), out.cols());
     });
   }
@@ -114,15 +115,15 @@ class GraphFeatures {
 
   /// d_in[t] = Σ_{edges (n, j) → t} d_nbr − Σ_j d_nbr(t, j) + Σ_j d_ctr(t, j), where d_nbr and
   /// d_ctr are the first and second C columns of d_out.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
     const Index reps = check_input(in), R = graph_.rows(), k = graph_.cols(), C = in.cols();
     detail::check_shape("nn::GraphFeatures", "output gradient", d_out, in.rows() * k, 2 * C);
     if (!d_in) return;
     ensure_shape(*d_in, in.rows(), C);
     const Index rows = reps * R;
-    const Index nc = detail::chunk_count(rows, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(rows, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
       for (Index row = b; row < e; ++row) {
         const Index p = row / R, t = row % R;
         auto g = d_in->row(row);
@@ -151,11 +152,19 @@ class GraphFeatures {
   Index n_ = 0;
   detail::ReverseAdjacency rev_;
 };
+static_assert(assert_layer<GraphFeatures<float>>());
 
 /// Dynamic kNN graph in feature space (DGCNN; SPEC §7 graph 2): for every batch item of N
-/// points, the k nearest *other* points by Euclidean distance of their feature rows, via the
-/// exact neighbors::BruteForceKnn (self excluded by index, the rest ascending by distance, ties
-/// by ascending index). Not differentiated (the graph is a constant of the backward pass).
+/// points, the k nearest *other* points by Euclidean distance of their feature rows (self
+/// excluded by index, the rest ascending by distance, ties as the search orders them). Not
+/// differentiated (the graph is a constant of the backward pass).
+///
+/// `Search` is any neighbors::NeighborSearch (one type to swap; checked with a sentence): the
+/// default, the exact neighbors::BruteForceKnn (any feature width, ties by ascending index), is
+/// built on each item's rows in place and asked for the k nearest other points directly
+/// (query_self_into); any other search is built on a copy of the item's rows (its point_matrix)
+/// and asked for k + 1 neighbours, of which the point itself (or, should exact duplicates crowd it
+/// out, the last) is dropped.
 ///
 /// Difference from the official `topk(k+1)` on −squared distance with the first column dropped:
 /// the reference drops whatever comes first, which is the point itself unless another point has
@@ -163,12 +172,17 @@ class GraphFeatures {
 /// neighbour and drops the duplicate; here the point is never its own neighbour and duplicates
 /// are ordinary neighbours. The two agree whenever the features of an item are distinct (and up
 /// to the order of exact ties, which topk leaves unspecified).
-template <class S = float>
+template <class S = float, class Search = neighbors::BruteForceKnn<S>>
 class DynamicKnnGraph {
+  static_assert(neighbors::assert_neighbor_search<Search>());
+
  public:
+  using search_type = Search;
+
   /// graph ((B·N)×k) ← the k nearest other points of every row of h ((B·N)×C) within its item.
-  /// ArgumentError when rows are not a multiple of N, k ≥ N, or features are not finite.
-  /// Allocates nothing once warm (for a contiguous h; a column block of a wider matrix is copied).
+  /// ArgumentError when rows are not a multiple of N, k ≥ N, or features are not finite (or do
+  /// not fit the search's point_matrix). Allocates nothing once warm (for the default search and
+  /// a contiguous h; a column block of a wider matrix is copied).
   template <exec::HostPolicy Policy>
   void build(Policy policy, const ConstView<S>& h, Index points_per_item, Index k, GraphIndices& graph) {
     const Index N = points_per_item, C = h.cols();
@@ -176,25 +190,51 @@ class DynamicKnnGraph {
     if (k < 1 || k >= N) throw ArgumentError("nn::DynamicKnnGraph: k = " + std::to_string(k) + " must be in [1, N-1] with N = " + std::to_string(N));
     const Index B = h.rows() / N;
     if (graph.rows() != B * N || graph.cols() != k) graph.resize(B * N, k);
-    const bool contiguous = h.outerStride() == C;
-    if (!contiguous) ensure_shape(copy_, N, C);
-    using PM = typename neighbors::BruteForceKnn<S>::point_matrix;
-    for (Index b = 0; b < B; ++b) {
-      const S* data = h.data() + b * N * h.outerStride();
-      if (!contiguous) {
-        copy_ = h.middleRows(b * N, N);
-        data = copy_.data();
+    if constexpr (searches_rows_in_place) {
+      const bool contiguous = h.outerStride() == C;
+      if (!contiguous) ensure_shape(copy_, N, C);
+      for (Index b = 0; b < B; ++b) {
+        const S* data = h.data() + b * N * h.outerStride();
+        if (!contiguous) {
+          copy_ = h.middleRows(b * N, N);
+          data = copy_.data();
+        }
+        search_.build(Eigen::Map<const PointMatrix>(data, N, C));
+        search_.query_self_into(policy, k, result_, true);
+        graph.middleRows(b * N, N) = result_.indices;
       }
-      knn_.build(Eigen::Map<const PM>(data, N, C));
-      knn_.query_self_into(policy, k, result_, true);
-      graph.middleRows(b * N, N) = result_.indices;
+    } else {
+      constexpr int fixed_cols = PointMatrix::ColsAtCompileTime;
+      if (fixed_cols != Eigen::Dynamic && fixed_cols != C)
+        throw ArgumentError("nn::DynamicKnnGraph: the search's points have " + std::to_string(fixed_cols) + " coordinates, the features " +
+                            std::to_string(C) + " columns");
+      for (Index b = 0; b < B; ++b) {
+        points_ = h.middleRows(b * N, N).template cast<typename PointMatrix::Scalar>();
+        search_.build(points_);
+        search_.query_into(policy, points_, k + 1, result_);
+        for (Index n = 0; n < N; ++n) {
+          Index j = 0;
+          for (Index c = 0; c <= k && j < k; ++c)  // the point itself skipped, else the (k+1)-th
+            if (const Index idx = result_.indices(n, c); idx != n) graph(b * N + n, j++) = VIndex(idx);
+        }
+      }
     }
   }
 
  private:
-  neighbors::BruteForceKnn<S> knn_;
-  neighbors::KnnResult<S> result_;
+  using PointMatrix = typename Search::point_matrix;
+  /// The default search's fast path: built on a Map of the item's rows, self queries excluding the point.
+  static constexpr bool searches_rows_in_place =
+      std::is_same_v<typename PointMatrix::Scalar, S> && requires(Search& s, Eigen::Map<const PointMatrix> m, Index k,
+                                                                  neighbors::KnnResult<typename Search::scalar_type>& r) {
+        s.build(m);
+        s.query_self_into(exec::seq, k, r, true);
+      };
+
+  Search search_;
+  neighbors::KnnResult<typename Search::scalar_type> result_;
   Matrix<S> copy_;
+  PointMatrix points_;  ///< other searches: the item's rows as the search's points (it borrows them)
 };
 
 }  // namespace simsr::nn

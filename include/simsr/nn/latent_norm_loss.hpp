@@ -14,7 +14,6 @@
 #include <cmath>
 #include <string>
 
-#include "detail/chunks.hpp"
 #include "tensor.hpp"
 
 namespace simsr::nn {
@@ -40,9 +39,9 @@ double row_norm_sum(Policy policy, const Eigen::MatrixBase<D>& z, Matrix<typenam
   }
   if (d_z) ensure_shape(*d_z, R, C);
   const double norm = mean_over_rows ? double(R) : 1.0, g_scale = scale / norm;
-  const Index nc = detail::chunk_count(R, exec::default_chunks), workers = detail::worker_count(policy, nc);
+  const Index nc = exec::chunk_count(R, exec::default_chunks), workers = exec::worker_count(policy, nc);
   double parts[exec::default_chunks];
-  detail::for_chunks(policy, R, nc, workers, [&](Index, Index c, Index b, Index e) {
+  exec::for_chunks(policy, R, nc, workers, [&](Index, Index c, Index b, Index e) {
     double s = 0;
     for (Index r = b; r < e; ++r) {
       double sq = 0;
@@ -61,12 +60,6 @@ double row_norm_sum(Policy policy, const Eigen::MatrixBase<D>& z, Matrix<typenam
   return total / norm;
 }
 
-/// exec::seq.
-template <class D>
-double row_norm_sum(const Eigen::MatrixBase<D>& z, Matrix<typename D::Scalar>* d_z = nullptr, double scale = 1.0,
-                    bool mean_over_rows = false) {
-  return row_norm_sum(exec::seq, z, d_z, scale, mean_over_rows);
-}
 
 /// A loss weight ramped from `start` (step 0) to `end` (step ≥ ramp_steps), then held: β of Eq. 6,
 /// which the paper (Table 3) "gradually increased from 0.001 to 20" without saying how. Two

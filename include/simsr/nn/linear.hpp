@@ -4,7 +4,7 @@
 /// `nn.Linear` of the network).
 ///
 ///     nn::Linear<float> fc(store, "fc_out.0", 323, 384, rng, {.bias = false, .kernel_dims = 1});
-///     fc.forward(nn::Mode::train, h, y);  // h: rows×323 → y: rows×384
+///     fc.forward(exec::omp, nn::Mode::train, h, y);  // h: rows×323 → y: rows×384
 
 #include <atomic>
 #include <cmath>
@@ -12,7 +12,6 @@
 #include <utility>
 #include <vector>
 
-#include "detail/chunks.hpp"
 #include "../core/serial_gemm.hpp"
 #include "layer.hpp"
 #include "parameters.hpp"
@@ -26,13 +25,13 @@ namespace detail {
 template <class Policy, class Body>
 void for_chunks_dynamic(Policy policy, Index n, Index chunks, Index workers, Body&& body) {
   if (workers <= 1) {
-    for_chunks(policy, n, chunks, workers, body);
+    exec::for_chunks(policy, n, chunks, workers, body);
     return;
   }
   std::atomic<Index> next{0};
   exec::parallel_for(policy, workers, [&](Index w) {
     for (Index c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) {
-      const auto [b, e] = exec::detail::chunk_range(n, chunks, c);
+      const auto [b, e] = exec::chunk_range(n, chunks, c);
       body(w, c, b, e);
     }
   });
@@ -102,12 +101,12 @@ class Linear {
   }
 
   /// out (rows×out) = in (rows×in)·Wᵀ + b. The mode does not matter here.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
     detail::check_shape(where_, "input", in, -1, in_);
     const Index R = in.rows();
     ensure_shape(out, R, out_);
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
     if (gemm_fwd_.size() < std::size_t(workers)) gemm_fwd_.resize(std::size_t(workers));
     for (Index w = 0; w < workers; ++w) reserve_forward(gemm_fwd_[std::size_t(w)], R);
     detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
@@ -118,9 +117,9 @@ class Linear {
   /// The pieces of forward for callers that run it chunk by chunk (Mlp's fused eval path):
   /// reserve_forward sizes a worker's SerialGemm as forward does for R rows, and forward_block
   /// computes one block of rows (row-major, leading dimensions ld_in, ld_out) with it. Over the
-  /// row chunks of forward (chunk_count(R, product_chunks)) they give forward's values exactly.
+  /// row chunks of forward (exec::chunk_count(R, product_chunks)) they give forward's values exactly.
   void reserve_forward(SerialGemm<S>& gemm, Index R) const {
-    gemm.reserve(detail::max_chunk_rows(R, detail::chunk_count(R, detail::product_chunks)), out_, in_);
+    gemm.reserve(exec::max_chunk_size(R, exec::chunk_count(R, product_chunks)), out_, in_);
   }
   void forward_block(SerialGemm<S>& gemm, Index rows, const S* in, Index ld_in, S* out, Index ld_out) const {
     const ParameterStore<S>& store = *store_;
@@ -132,16 +131,16 @@ class Linear {
   }
 
   /// Adds ∂/∂W = d_outᵀ·in and ∂/∂b = column sums of d_out into the store; d_in = d_out·W.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
     detail::check_shape(where_, "input", in, -1, in_);
     detail::check_shape(where_, "output gradient", d_out, in.rows(), out_);
     const Index R = in.rows();
     const auto W = std::as_const(*store_).value(w_off_, out_, in_);
     if (d_in) {
       ensure_shape(*d_in, R, in_);
-      const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-      reserve(gemm_din_, workers, detail::max_chunk_rows(R, nc), in_, out_);
+      const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+      reserve(gemm_din_, workers, exec::max_chunk_size(R, nc), in_, out_);
       detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
         gemm_din_[std::size_t(w)].run(e - b, in_, out_, d_out.data() + b * d_out.outerStride(), d_out.outerStride(), false, W.data(),
                                       in_, false, d_in->data() + b * in_, in_, false);
@@ -149,8 +148,8 @@ class Linear {
     }
     if (R == 0) return;
     // Weight gradient: one partial product per fixed row chunk, summed in chunk order.
-    const Index nr = detail::chunk_count(R, detail::reduction_chunks), workers = detail::worker_count(policy, nr);
-    reserve(gemm_dw_, workers, out_, in_, detail::max_chunk_rows(R, nr));
+    const Index nr = exec::chunk_count(R, reduction_chunks), workers = exec::worker_count(policy, nr);
+    reserve(gemm_dw_, workers, out_, in_, exec::max_chunk_size(R, nr));
     if (dw_parts_.size() < std::size_t(nr)) dw_parts_.resize(std::size_t(nr));
     for (Index c = 0; c < nr; ++c) ensure_shape(dw_parts_[std::size_t(c)], out_, in_);
     if (has_bias()) ensure_shape(db_parts_, nr, out_);
@@ -186,5 +185,6 @@ class Linear {
   std::vector<Matrix<S>> dw_parts_;
   Matrix<S> db_parts_;
 };
+static_assert(assert_layer<Linear<float>>());
 
 }  // namespace simsr::nn

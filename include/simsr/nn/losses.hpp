@@ -8,7 +8,6 @@
 
 #include <cmath>
 
-#include "detail/chunks.hpp"
 #include "tensor.hpp"
 
 namespace simsr::nn {
@@ -20,10 +19,10 @@ double mean_and_gradient(Policy policy, Index rows, Index cols, Matrix<S>* d, do
   const Index n = rows * cols;
   if (n == 0) throw ArgumentError("nn loss: the input is empty");
   if (d) ensure_shape(*d, rows, cols);
-  const Index nc = chunk_count(n, exec::default_chunks), workers = worker_count(policy, nc);
+  const Index nc = exec::chunk_count(n, exec::default_chunks), workers = exec::worker_count(policy, nc);
   double parts[exec::default_chunks];
   const S g = static_cast<S>(scale / double(n));
-  for_chunks(policy, n, nc, workers, [&](Index, Index c, Index b, Index e) {
+  exec::for_chunks(policy, n, nc, workers, [&](Index, Index c, Index b, Index e) {
     double s = 0;
     for (Index i = b; i < e; ++i) {
       s += term(i / cols, i % cols);
@@ -52,11 +51,6 @@ typename DA::Scalar l1_loss(Policy policy, const Eigen::MatrixBase<DA>& a, const
       policy, a.rows(), a.cols(), d_a, scale, [&](Index r, Index c) { return std::abs(double(a(r, c)) - double(b(r, c))); },
       [&](Index r, Index c) { return detail::sign<S>(a(r, c) - b(r, c)); }));
 }
-template <class DA, class DB>
-typename DA::Scalar l1_loss(const Eigen::MatrixBase<DA>& a, const Eigen::MatrixBase<DB>& b, Matrix<typename DA::Scalar>* d_a = nullptr,
-                            double scale = 1.0) {
-  return l1_loss(exec::seq, a, b, d_a, scale);
-}
 
 /// mean |z| (SPEC §7's latent regularizer); d_z = scale·sign(z)/n.
 template <exec::HostPolicy Policy, class D>
@@ -66,10 +60,6 @@ typename D::Scalar mean_abs(Policy policy, const Eigen::MatrixBase<D>& z, Matrix
       policy, z.rows(), z.cols(), d_z, scale, [&](Index r, Index c) { return std::abs(double(z(r, c))); },
       [&](Index r, Index c) { return detail::sign<S>(z(r, c)); }));
 }
-template <class D>
-typename D::Scalar mean_abs(const Eigen::MatrixBase<D>& z, Matrix<typename D::Scalar>* d_z = nullptr, double scale = 1.0) {
-  return mean_abs(exec::seq, z, d_z, scale);
-}
 
 /// mean z² (the reference implementation's z_reg); d_z = scale·2z/n.
 template <exec::HostPolicy Policy, class D>
@@ -78,10 +68,6 @@ typename D::Scalar mean_square(Policy policy, const Eigen::MatrixBase<D>& z, Mat
   return static_cast<S>(detail::mean_and_gradient<Policy, S>(
       policy, z.rows(), z.cols(), d_z, scale, [&](Index r, Index c) { return double(z(r, c)) * double(z(r, c)); },
       [&](Index r, Index c) { return S(2) * z(r, c); }));
-}
-template <class D>
-typename D::Scalar mean_square(const Eigen::MatrixBase<D>& z, Matrix<typename D::Scalar>* d_z = nullptr, double scale = 1.0) {
-  return mean_square(exec::seq, z, d_z, scale);
 }
 
 }  // namespace simsr::nn

@@ -8,7 +8,7 @@
 ///       nn::MlpStage::linear(7, 128, "conv_weights.0").no_bias().norm("conv_weights.1").then(nn::Act::sine),
 ///       nn::MlpStage::linear(128, 1, "conv_weights.3")};
 ///     nn::Mlp<float> mlp(store, "net_upscale", st, rng);
-///     mlp.forward(nn::Mode::train, q, logits);
+///     mlp.forward(exec::omp, nn::Mode::train, q, logits);
 ///
 /// Names are the caller's (PyTorch nn.Sequential indices differ by profile), prefixed by `prefix.`.
 
@@ -123,25 +123,25 @@ class Mlp {
   /// other (the chunks of Linear::forward), BatchNorm and the activation applied in place on the
   /// chunk (same arithmetic, same values); only the output is stored, and a backward after it
   /// recomputes the stored forward first.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& in, Matrix<S>& out) {
     if (mode == Mode::eval && eval_fusable()) {
-      forward_fused(in, out, policy);
+      forward_fused(policy, in, out);
       lean_ = true;
       return;
     }
     lean_ = false;
-    forward_stored(mode, in, out, policy);
+    forward_stored(policy, mode, in, out);
   }
 
-  /// After forward(…, in, out): parameter gradients added, d_in written when not null.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  /// After forward(policy, …, in, out): parameter gradients added, d_in written when not null.
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in) {
     if (lean_) {  // the fused eval forward kept only the stage outputs: redo it storing everything
-      forward_stored(Mode::eval, in, recomputed_, policy);
+      forward_stored(policy, Mode::eval, in, recomputed_);
       lean_ = false;
     }
-    backward_stored(in, out, d_out, d_in, policy);
+    backward_stored(policy, in, out, d_out, d_in);
   }
 
   /// True when the eval forward can be fused: every BatchNorm uses running statistics in eval.
@@ -161,7 +161,7 @@ class Mlp {
       if (s->bn) s->bn->prepare_eval();
     Index width = 0;
     for (const auto& s : stages_) width = std::max(width, s->spec.out);
-    const Index rows = detail::max_chunk_rows(R, detail::chunk_count(R, detail::product_chunks));
+    const Index rows = exec::max_chunk_size(R, exec::chunk_count(R, product_chunks));
     if (scratch_.size() < std::size_t(workers)) scratch_.resize(std::size_t(workers));
     for (Index w = 0; w < workers; ++w) {
       Scratch& sc = scratch_[std::size_t(w)];
@@ -203,7 +203,7 @@ class Mlp {
 
  private:
   template <class Policy>
-  void forward_stored(Mode mode, const ConstView<S>& in, Matrix<S>& out, Policy policy) {
+  void forward_stored(Policy policy, Mode mode, const ConstView<S>& in, Matrix<S>& out) {
     const ConstView<S>* x = &in;
     std::optional<ConstView<S>> view;
     const std::size_t last = stages_.size() - 1;
@@ -211,16 +211,16 @@ class Mlp {
       Stage& s = *stages_[i];
       // The last stage writes its final activation straight into `out`.
       Matrix<S>& lin_out = (i == last && !s.bn && s.spec.act == Act::none) ? out : s.lin;
-      s.linear->forward(mode, *x, lin_out, policy);
+      s.linear->forward(policy, mode, *x, lin_out);
       const Matrix<S>* y = &lin_out;
       if (s.bn) {
         Matrix<S>& bn_out = (i == last && s.spec.act == Act::none) ? out : s.normed;
-        s.bn->forward(mode, *y, bn_out, policy);
+        s.bn->forward(policy, mode, *y, bn_out);
         y = &bn_out;
       }
       if (s.spec.act != Act::none) {
         Matrix<S>& act_out = i == last ? out : s.activated;
-        activation_forward(s, mode, *y, act_out, policy);
+        activation_forward(policy, s, mode, *y, act_out);
         y = &act_out;
       }
       view.emplace(*y);
@@ -231,11 +231,11 @@ class Mlp {
   /// All stages over each fixed row chunk (the chunks of Linear::forward), with per-worker
   /// scratch: the chunk stays in cache from the first Linear to the last activation.
   template <class Policy>
-  void forward_fused(const ConstView<S>& in, Matrix<S>& out, Policy policy) {
+  void forward_fused(Policy policy, const ConstView<S>& in, Matrix<S>& out) {
     const Index R = in.rows();
     if (in.cols() != in_features()) detail::check_shape("nn::Linear '" + stages_[0]->linear->name() + "'", "input", in, -1, in_features());
     ensure_shape(out, R, out_features());
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
     prepare_eval_blocks(R, workers);
     detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
       eval_block(w, e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out.cols(), out.cols());
@@ -243,7 +243,7 @@ class Mlp {
   }
 
   template <class Policy>
-  void backward_stored(const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy) {
+  void backward_stored(Policy policy, const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in) {
     const std::size_t last = stages_.size() - 1;
     const ConstView<S>* g = &d_out;
     std::optional<ConstView<S>> gview;
@@ -255,18 +255,18 @@ class Mlp {
       const ConstView<S> bn_out = !s.bn ? lin_out : (is_last && s.spec.act == Act::none) ? ConstView<S>(out) : ConstView<S>(s.normed);
       if (s.spec.act != Act::none) {
         const ConstView<S> act_out = is_last ? ConstView<S>(out) : ConstView<S>(s.activated);
-        activation_backward(s, bn_out, act_out, *g, s.g_act, policy);
+        activation_backward(policy, s, bn_out, act_out, *g, s.g_act);
         gview.emplace(s.g_act);
         g = &*gview;
       }
       if (s.bn) {
-        s.bn->backward(lin_out, bn_out, *g, &s.g_bn, policy);
+        s.bn->backward(policy, lin_out, bn_out, *g, &s.g_bn);
         gview.emplace(s.g_bn);
         g = &*gview;
       }
       const ConstView<S> x = ii == 0 ? in : stage_output(ii - 1);
       Matrix<S>* dx = ii == 0 ? d_in : &s.g_in;
-      s.linear->backward(x, lin_out, *g, dx, policy);
+      s.linear->backward(policy, x, lin_out, *g, dx);
       if (ii > 0) {
         gview.emplace(s.g_in);
         g = &*gview;
@@ -295,18 +295,18 @@ class Mlp {
     return s.lin;
   }
   template <class Policy>
-  void activation_forward(Stage& s, Mode mode, const ConstView<S>& x, Matrix<S>& y, Policy policy) {
+  void activation_forward(Policy policy, Stage& s, Mode mode, const ConstView<S>& x, Matrix<S>& y) {
     if (s.spec.act == Act::leaky_relu)
-      s.leaky->forward(mode, x, y, policy);
+      s.leaky->forward(policy, mode, x, y);
     else
-      s.sine->forward(mode, x, y, policy);
+      s.sine->forward(policy, mode, x, y);
   }
   template <class Policy>
-  void activation_backward(Stage& s, const ConstView<S>& x, const ConstView<S>& y, const ConstView<S>& g, Matrix<S>& dx, Policy policy) {
+  void activation_backward(Policy policy, Stage& s, const ConstView<S>& x, const ConstView<S>& y, const ConstView<S>& g, Matrix<S>& dx) {
     if (s.spec.act == Act::leaky_relu)
-      s.leaky->backward(x, y, g, &dx, policy);
+      s.leaky->backward(policy, x, y, g, &dx);
     else
-      s.sine->backward(x, y, g, &dx, policy);
+      s.sine->backward(policy, x, y, g, &dx);
   }
 
   /// Per worker of the fused eval path: ping-pong stage outputs of one chunk, a GEMM per stage.
@@ -320,5 +320,6 @@ class Mlp {
   bool lean_ = false;     ///< the last forward was the fused eval one: only its output is stored
   Matrix<S> recomputed_;  ///< output of the storing forward that an eval backward redoes
 };
+static_assert(assert_layer<Mlp<float>>());
 
 }  // namespace simsr::nn

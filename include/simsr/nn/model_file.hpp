@@ -163,8 +163,8 @@ inline io::NpzArrays read_model_arrays(const std::filesystem::path& path) { retu
 inline ModelData read_model_data(const std::filesystem::path& path) { return model_data(io::read_npz(path), path.string()); }
 
 /// The model file's arrays for `net` and its data (which must be the data `net` was built from).
-template <class S>
-io::NpzArrays model_arrays(const SuperResolutionNet<S>& net, const ModelData& data) {
+template <class S, class Search>
+io::NpzArrays model_arrays(const SuperResolutionNet<S, Search>& net, const ModelData& data) {
   io::NpzArrays out;
   add_state(out, net.store());
   out["config"] = io::make_npy(std::vector<std::string>{net.config().to_json().dump()});
@@ -192,8 +192,8 @@ io::NpzArrays model_arrays(const SuperResolutionNet<S>& net, const ModelData& da
   return out;
 }
 
-template <class S>
-void save_model(const std::filesystem::path& path, const SuperResolutionNet<S>& net, const ModelData& data) {
+template <class S, class Search>
+void save_model(const std::filesystem::path& path, const SuperResolutionNet<S, Search>& net, const ModelData& data) {
   io::write_npz(path, model_arrays(net, data));
 }
 

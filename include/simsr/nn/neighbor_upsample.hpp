@@ -5,16 +5,15 @@
 /// z_j^H = Σ_i w_ji z^L_{idx(j,i)}, w_j· = softmax(logits_j·) (logits from the weighting MLP).
 ///
 ///     nn::NeighborUpsample<float> up(up_indices, N);     // up_indices: M×upK, into [0, N)
-///     up.forward(logits, zL, zH);                          // logits M×upK, zL (B·N)×C → zH (B·M)×C
-///     up.backward(zL, d_zH, &d_logits, &d_zL);
+///     up.forward(exec::omp, logits, zL, zH);                  // logits M×upK, zL (B·N)×C → zH (B·M)×C
+///     up.backward(exec::omp, zL, d_zH, &d_logits, &d_zL);
 ///     // inference: weights depend on rest shapes only
-///     nn::NeighborUpsample<float>::softmax_rows(logits, w);   // once
-///     up.apply(w, zL, zH);                                     // every frame: weighted gather only
+///     nn::NeighborUpsample<float>::softmax_rows(exec::omp, logits, w);   // once
+///     up.apply(exec::omp, w, zL, zH);                                     // every frame: weighted gather only
 
 #include <cmath>
 #include <string>
 
-#include "detail/chunks.hpp"
 #include "graph_features.hpp"
 #include "layer.hpp"
 
@@ -50,12 +49,12 @@ class NeighborUpsample {
   const Matrix<S>& weights() const { return w_; }
 
   /// w = row-wise softmax of `logits` (max subtracted, sum in double).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  static void softmax_rows(const ConstView<S>& logits, Matrix<S>& w, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  static void softmax_rows(Policy policy, const ConstView<S>& logits, Matrix<S>& w) {
     const Index R = logits.rows(), K = logits.cols();
     ensure_shape(w, R, K);
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       for (Index r = b; r < e; ++r) {
         const S m = logits.row(r).maxCoeff();
         double sum = 0;
@@ -66,24 +65,24 @@ class NeighborUpsample {
     });
   }
 
-  /// Training path: weights ← softmax(logits), then apply(weights, z, out).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(const ConstView<S>& logits, const ConstView<S>& z, Matrix<S>& out, Policy policy = {}) {
+  /// Training path: weights ← softmax(logits), then apply(policy, weights, z, out).
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, const ConstView<S>& logits, const ConstView<S>& z, Matrix<S>& out) {
     check_weights("logits", logits, check_z(z));
-    softmax_rows(logits, w_, policy);
-    apply(w_, z, out, policy);
+    softmax_rows(policy, logits, w_);
+    apply(policy, w_, z, out);
   }
 
   /// Inference path (and the gather of forward): out (B·M)×C, out_{b,j} = Σ_i w_ji z_{b, idx(j,i)}
   /// with precomputed weights (M×upK shared, or (B·M)×upK), summed in ascending i.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void apply(const ConstView<S>& weights, const ConstView<S>& z, Matrix<S>& out, Policy policy = {}) const {
+  template <exec::HostPolicy Policy>
+  void apply(Policy policy, const ConstView<S>& weights, const ConstView<S>& z, Matrix<S>& out) const {
     const Index B = check_z(z), M = idx_.rows(), K = idx_.cols();
     const bool shared = check_weights("weights", weights, B);
     ensure_shape(out, B * M, z.cols());
     const Index rows = B * M;
-    const Index nc = detail::chunk_count(rows, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(rows, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
       for (Index r = b; r < e; ++r) {
         const Index item = r / M, j = r % M, wr = shared ? j : r;
         auto o = out.row(r);
@@ -93,11 +92,11 @@ class NeighborUpsample {
     });
   }
 
-  /// After forward(logits, z, …): d_logits (shape of the logits) = w ⊙ (dw − Σ_i w dw) with
+  /// After forward(policy, logits, z, …): d_logits (shape of the logits) = w ⊙ (dw − Σ_i w dw) with
   /// dw_ji = Σ_b d_out_{b,j}·z_{b,idx(j,i)} (the sum over b only for shared logits), and
   /// d_z_{b,n} = Σ_{(j,i): idx(j,i)=n} w_ji d_out_{b,j}. Either output may be null; both are overwritten.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& z, const ConstView<S>& d_out, Matrix<S>* d_logits, Matrix<S>* d_z, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& z, const ConstView<S>& d_out, Matrix<S>* d_logits, Matrix<S>* d_z) {
     const Index B = check_z(z), M = idx_.rows(), K = idx_.cols(), C = z.cols();
     if (w_.size() == 0) throw ArgumentError("nn::NeighborUpsample: backward needs a forward first");
     const bool shared = check_weights("weights (last forward)", w_, B);
@@ -105,8 +104,8 @@ class NeighborUpsample {
     if (d_logits) {
       const Index R = w_.rows();
       ensure_shape(*d_logits, R, K);
-      const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-      detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+      const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+      exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
         for (Index r = b; r < e; ++r) {
           const Index j = r % M, item0 = shared ? 0 : r / M, item1 = shared ? B : item0 + 1;
           auto dl = d_logits->row(r);
@@ -124,8 +123,8 @@ class NeighborUpsample {
     if (d_z) {
       ensure_shape(*d_z, B * n_, C);
       const Index rows = B * n_;
-      const Index nc = detail::chunk_count(rows, detail::product_chunks), workers = detail::worker_count(policy, nc);
-      detail::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
+      const Index nc = exec::chunk_count(rows, product_chunks), workers = exec::worker_count(policy, nc);
+      exec::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
         for (Index r = b; r < e; ++r) {
           const Index item = r / n_, n = r % n_;
           auto g = d_z->row(r);

@@ -27,6 +27,7 @@
 #include "parameters.hpp"
 #include "pooling.hpp"
 #include "positional_encoding.hpp"
+#include "sequential.hpp"
 #include "siren_decoder.hpp"
 #include "super_resolution_loss.hpp"
 #include "super_resolution_net.hpp"

@@ -7,7 +7,7 @@
 ///     nn::Linear<float> fc(store, "fc_out.0", 323, 384, rng, {.bias = false, .kernel_dims = 1});
 ///     for (const auto& e : store.entries()) save(e.name, e.shape, store.values(e));
 ///     store.zero_grad();  // before each backward pass
-///     optimizer.step();   // Adam over store.parameters() / store.gradients()
+///     optimizer.step(exec::omp);   // Adam over store.parameters() / store.gradients()
 
 #include <algorithm>
 #include <numeric>

@@ -10,7 +10,6 @@
 
 #include <vector>
 
-#include "detail/chunks.hpp"
 #include "layer.hpp"
 
 namespace simsr::nn {
@@ -37,13 +36,13 @@ class GroupPool {
   /// Row within its group of each group's maximum, groups × C (max pooling, last forward).
   const Eigen::Matrix<Index, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& argmax() const { return argmax_; }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
     const Index groups = check_rows(in), C = in.cols();
     ensure_shape(out, broadcast_ ? in.rows() : groups, C);
     if (kind_ == PoolKind::max && (argmax_.rows() != groups || argmax_.cols() != C)) argmax_.resize(groups, C);
     ensure_size(pooled_, groups * C);
-    if (kind_ == PoolKind::mean) reserve_sums(sums_, policy, groups, C);
+    if (kind_ == PoolKind::mean) reserve_sums(policy, sums_, groups, C);
     // The rows of a group are visited in order, all channels side by side (contiguous, so the
     // loops vectorize); per channel that is the order of the scalar definition: max replaces on
     // strictly greater (the first maximum wins), mean sums in double in ascending rows.
@@ -75,14 +74,14 @@ class GroupPool {
     });
   }
 
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
     const Index groups = check_rows(in), C = in.cols();
     detail::check_shape("nn::GroupPool", "output gradient", d_out, broadcast_ ? in.rows() : groups, C);
     if (kind_ == PoolKind::max && argmax_.rows() != groups) throw ArgumentError("nn::GroupPool: backward needs the forward of the same input first");
     if (!d_in) return;
     ensure_shape(*d_in, in.rows(), C);
-    if (broadcast_) reserve_sums(grads_, policy, groups, C);
+    if (broadcast_) reserve_sums(policy, grads_, groups, C);
     each_group(policy, groups, [&](Index w, Index g) {
       const Index n = C, G = g_, r0 = g * G;
       // the group's gradient per channel: with broadcast the sum over its rows (in S, ascending)
@@ -120,15 +119,15 @@ class GroupPool {
   /// body(worker, group) for every group, over fixed chunks of groups.
   template <class Policy, class Body>
   void each_group(Policy policy, Index groups, Body&& body) {
-    const Index nc = detail::chunk_count(groups, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, groups, nc, workers, [&](Index w, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(groups, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, groups, nc, workers, [&](Index w, Index, Index b, Index e) {
       for (Index g = b; g < e; ++g) body(w, g);
     });
   }
   /// One C-vector per worker of each_group.
-  template <class T, class Policy>
-  static void reserve_sums(std::vector<Vector<T>>& v, Policy policy, Index groups, Index C) {
-    const Index workers = detail::worker_count(policy, detail::chunk_count(groups, detail::product_chunks));
+  template <class Policy, class T>
+  static void reserve_sums(Policy policy, std::vector<Vector<T>>& v, Index groups, Index C) {
+    const Index workers = exec::worker_count(policy, exec::chunk_count(groups, product_chunks));
     if (v.size() < std::size_t(workers)) v.resize(std::size_t(workers));
     for (Index w = 0; w < workers; ++w) ensure_size(v[std::size_t(w)], C);
   }
@@ -141,5 +140,6 @@ class GroupPool {
   std::vector<Vector<double>> sums_;  ///< per worker: the channel sums of a mean group (forward)
   std::vector<Vector<S>> grads_;      ///< per worker: a broadcast group's gradient (backward)
 };
+static_assert(assert_layer<GroupPool<float>>());
 
 }  // namespace simsr::nn

@@ -4,11 +4,10 @@
 /// h⁰ = [Δx, PE(i)] (SPEC §7, the reference's `PosEmb`, D = 32). Not trained.
 ///
 ///     nn::PositionalEncoding<float> pe(num_lr_vertices);   // D = 32
-///     pe.forward(nn::Mode::train, dx, h0);                 // (B·N)×3 → (B·N)×35
+///     pe.forward(exec::omp, nn::Mode::train, dx, h0);      // (B·N)×3 → (B·N)×35
 
 #include <cmath>
 
-#include "detail/chunks.hpp"
 #include "layer.hpp"
 
 namespace simsr::nn {
@@ -44,13 +43,13 @@ class PositionalEncoding {
   const Matrix<S>& table() const { return table_; }
 
   /// out = [in, PE(row mod N)]: (B·N)×C → (B·N)×(C+D). ShapeError when rows are not a multiple of N.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode, const ConstView<S>& in, Matrix<S>& out, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
     check_rows(in);
     const Index R = in.rows(), C = in.cols();
     ensure_shape(out, R, C + d_);
-    const Index nc = detail::chunk_count(R, detail::product_chunks), workers = detail::worker_count(policy, nc);
-    detail::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
       for (Index r = b; r < e; ++r) {
         out.row(r).head(C) = in.row(r);
         out.row(r).tail(d_) = table_.row(r % n_);
@@ -58,8 +57,8 @@ class PositionalEncoding {
     });
   }
   /// d_in = the first C columns of d_out (the encoding has no gradient).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in, Policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
     detail::check_shape("nn::PositionalEncoding", "output gradient", d_out, in.rows(), in.cols() + d_);
     if (!d_in) return;
     ensure_shape(*d_in, in.rows(), in.cols());
@@ -73,5 +72,6 @@ class PositionalEncoding {
   Index n_, d_;
   Matrix<S> table_;
 };
+static_assert(assert_layer<PositionalEncoding<float>>());
 
 }  // namespace simsr::nn

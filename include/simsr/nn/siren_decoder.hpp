@@ -8,6 +8,7 @@
 /// weights load; it gets no gradient.
 ///
 /// Names: `<prefix>.layers.<i>.fc.{weight,bias}` (nn.Linear), `<prefix>.last_layer.fc.*`.
+/// The decoder is an nn::Sequential of two Mlps (the sine layers, then last_layer).
 
 #include <memory>
 #include <string>
@@ -15,6 +16,7 @@
 
 #include "mlp.hpp"
 #include "network_config.hpp"
+#include "sequential.hpp"
 
 namespace simsr::nn {
 
@@ -23,7 +25,34 @@ class SirenDecoder {
  public:
   using scalar_type = S;
 
-  SirenDecoder(ParameterStore<S>& store, const std::string& prefix, const NetworkConfig& cfg, Rng& rng) {
+  SirenDecoder(ParameterStore<S>& store, const std::string& prefix, const NetworkConfig& cfg, Rng& rng)
+      : net_(build(store, prefix, cfg, rng, dead_)) {}
+
+  Index in_features() const { return net_.template layer<0>().in_features(); }
+  /// Sets `last_layer` to zero, so the decoder starts by predicting 0 (the residual option starts
+  /// exactly at the interpolator it corrects; the hidden layers get gradients from the 2nd step).
+  void zero_output_layer() {
+    net_.template layer<1>().linear(0).weight().setZero();
+    net_.template layer<1>().linear(0).bias().setZero();
+  }
+  Index out_features(Index = -1) const { return net_.template layer<1>().out_features(); }
+
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& zH, Matrix<S>& out) {
+    net_.forward(policy, mode, zH, out);
+  }
+
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& zH, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_zH) {
+    net_.backward(policy, zH, out, d_out, d_zH);
+  }
+
+ private:
+  using Net = Sequential<Mlp<S>, Mlp<S>>;  ///< the sine layers, then last_layer
+
+  /// Registers the sine layers, the dead layer (into `dead`, when the config has it) and
+  /// last_layer, in the official state-dict order.
+  static Net build(ParameterStore<S>& store, const std::string& prefix, const NetworkConfig& cfg, Rng& rng, std::unique_ptr<Mlp<S>>& dead) {
     const auto& d = cfg.decoder_dims;
     if (d.size() < 3) throw ArgumentError("nn::SirenDecoder: decoder_dims needs at least one hidden width (in, hidden…, 3)");
     const std::size_t hidden = d.size() - 2;
@@ -32,40 +61,19 @@ class SirenDecoder {
       const double w0 = i == 0 ? cfg.w0_initial : cfg.w0;
       st.push_back(MlpStage::linear(d[i], d[i + 1], "layers." + std::to_string(i) + ".fc").dims(0).siren(i == 0, w0).then(Act::sine, w0));
     }
-    sines_ = std::make_unique<Mlp<S>>(store, prefix, st, rng);
+    Mlp<S> sines(store, prefix, st, rng);
     if (cfg.decoder_dead_layer)
-      dead_ = std::make_unique<Mlp<S>>(
+      dead = std::make_unique<Mlp<S>>(
           store, prefix,
           std::vector<MlpStage>{MlpStage::linear(d[hidden], d[hidden + 1], "layers." + std::to_string(hidden) + ".fc").dims(0).siren(false, cfg.w0)},
           rng);
-    last_ = std::make_unique<Mlp<S>>(
-        store, prefix, std::vector<MlpStage>{MlpStage::linear(d[hidden], d[hidden + 1], "last_layer.fc").dims(0).siren(false, cfg.w0)}, rng);
+    Mlp<S> last(store, prefix, std::vector<MlpStage>{MlpStage::linear(d[hidden], d[hidden + 1], "last_layer.fc").dims(0).siren(false, cfg.w0)}, rng);
+    return Net(std::move(sines), std::move(last));
   }
 
-  Index in_features() const { return sines_->in_features(); }
-  /// Sets `last_layer` to zero, so the decoder starts by predicting 0 (the residual option starts
-  /// exactly at the interpolator it corrects; the hidden layers get gradients from the 2nd step).
-  void zero_output_layer() {
-    last_->linear(0).weight().setZero();
-    last_->linear(0).bias().setZero();
-  }
-  Index out_features(Index = -1) const { return last_->out_features(); }
-
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& zH, Matrix<S>& out, Policy policy = {}) {
-    sines_->forward(mode, zH, hidden_, policy);
-    last_->forward(mode, hidden_, out, policy);
-  }
-
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& zH, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_zH, Policy policy = {}) {
-    last_->backward(hidden_, out, d_out, &d_hidden_, policy);
-    sines_->backward(zH, hidden_, d_hidden_, d_zH, policy);
-  }
-
- private:
-  std::unique_ptr<Mlp<S>> sines_, dead_, last_;
-  Matrix<S> hidden_, d_hidden_;
+  std::unique_ptr<Mlp<S>> dead_;  ///< registered only (official weights load), never run; before net_ (built first)
+  Net net_;
 };
+static_assert(assert_layer<SirenDecoder<float>>());
 
 }  // namespace simsr::nn

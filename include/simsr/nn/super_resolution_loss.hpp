@@ -8,7 +8,7 @@
 ///
 ///     nn::SuperResolutionLoss<float> loss(cfg, net.hr_rest_normalized(), hr_faces);
 ///     auto t = loss.evaluate(exec::omp, pred, target, net.code(), step, &d_pred, &d_code);
-///     net.backward(d_pred, &d_code, exec::omp);
+///     net.backward(exec::omp, d_pred, &d_code);
 
 #include <string>
 
@@ -49,7 +49,7 @@ class SuperResolutionLoss {
 
   /// Loss of `pred` ((B·M)×3) against `target` with code z ((B·N)×latent) at optimizer step
   /// `step`; with d_pred / d_z, writes the gradients of the total (overwritten).
-  template <exec::HostPolicy Policy = exec::seq_t>
+  template <exec::HostPolicy Policy>
   Terms evaluate(Policy policy, const ConstView<S>& pred, const ConstView<S>& target, const ConstView<S>& z, long step, Matrix<S>* d_pred,
                  Matrix<S>* d_z) {
     detail::check_shape("nn::SuperResolutionLoss", "target", target, pred.rows(), 3);

@@ -6,10 +6,15 @@
 /// One class serves both profiles and the ablations: NetworkConfig says which parts exist.
 ///
 ///     nn::SuperResolutionNet<float> net(nn::NetworkConfig::official(), geometry, rng);
-///     net.forward(nn::Mode::train, ldx, pred, exec::omp);   // ldx (B·N)×3 → pred (B·M)×3
-///     net.backward(d_pred, &d_z_reg, exec::omp);            // gradients into net.store()
+///     net.forward(exec::omp, nn::Mode::train, ldx, pred);   // ldx (B·N)×3 → pred (B·M)×3
+///     net.backward(exec::omp, d_pred, &d_z_reg);            // gradients into net.store()
 ///     net.prepare_inference(exec::omp);                      // upsampling weights, once
-///     net.infer(ldx, pred, exec::omp);                       // eval mode, sparse upsampling
+///     net.infer(exec::omp, ldx, pred);                       // eval mode, sparse upsampling
+///
+/// The dynamic feature-space graph of the embedding's later blocks searches with the second
+/// template parameter, any neighbors::NeighborSearch (neighbors::BruteForceKnn by default):
+/// `SuperResolutionNet<float, MySearch>` swaps it for the whole network (EdgeConv, FeatureEmbedding
+/// and Trainer take it the same way).
 ///
 /// State-dict names are the official ones (`net_feat_emb.*`, `net_upscale.*`, `net_decoder.*`),
 /// registered in PyTorch's order, so ParameterStore::entries() is the official state dict.
@@ -39,10 +44,11 @@ struct NetworkGeometry {
   Eigen::SparseMatrix<double, Eigen::RowMajor> embedding;
 };
 
-template <class S = float>
+template <class S = float, class Search = neighbors::BruteForceKnn<S>>
 class SuperResolutionNet {
  public:
   using scalar_type = S;
+  using search_type = Search;  ///< the dynamic feature graph's neighbors::NeighborSearch
 
   SuperResolutionNet(NetworkConfig cfg, const NetworkGeometry& geo, Rng& rng) : cfg_(std::move(cfg)) {
     cfg_.validate();
@@ -62,7 +68,7 @@ class SuperResolutionNet {
     lr_n_ = normalize_positions<S>(geo.lr_rest, cfg_.norm_mean, cfg_.norm_std);
     hr_n_ = normalize_positions<S>(geo.hr_rest, cfg_.norm_mean, cfg_.norm_std);
     pe_ = std::make_unique<PositionalEncoding<S>>(N, cfg_.pos_feat_dim);
-    if (cfg_.feature_embedding) fe_ = std::make_unique<FeatureEmbedding<S>>(store_, "net_feat_emb", cfg_, N, geo.lr_graph, rng);
+    if (cfg_.feature_embedding) fe_ = std::make_unique<FeatureEmbedding<S, Search>>(store_, "net_feat_emb", cfg_, N, geo.lr_graph, rng);
     const GraphIndices idx = geo.up_indices.leftCols(cfg_.up_k);
     up_ = std::make_unique<CoordinateUpsampling<S>>(store_, "net_upscale", cfg_,
                                                     upsampling_query<S>(hr_n_, lr_n_, idx, geo.up_distances.leftCols(cfg_.up_k)), idx, N, rng);
@@ -89,7 +95,7 @@ class SuperResolutionNet {
   CoordinateUpsampling<S>& upsampling() { return *up_; }
   const CoordinateUpsampling<S>& upsampling() const { return *up_; }
   /// The feature embedding (ArgumentError in the w/o-FE ablation).
-  FeatureEmbedding<S>& feature_embedding() {
+  FeatureEmbedding<S, Search>& feature_embedding() {
     if (!fe_) throw ArgumentError("nn::SuperResolutionNet: this network has no feature embedding (w/o FE)");
     return *fe_;
   }
@@ -100,41 +106,41 @@ class SuperResolutionNet {
 
   /// Training (or eval-mode) forward: ldx (B·N)×3 normalized LR displacements → pred (B·M)×3
   /// normalized HR displacements. f_θ runs once per call, whatever B.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void forward(Mode mode, const ConstView<S>& ldx, Matrix<S>& pred, Policy policy = {}) {
-    encode(mode, ldx, policy);
-    up_->forward(mode, code(), zh_, policy);
-    decode(mode, ldx, pred, policy);
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode mode, const ConstView<S>& ldx, Matrix<S>& pred) {
+    encode(policy, mode, ldx);
+    up_->forward(policy, mode, code(), zh_);
+    decode(policy, mode, ldx, pred);
   }
 
   /// After forward: d_pred (B·M)×3 → parameter gradients (added to the store; zero_grad first).
   /// `d_code`, when given, is an extra gradient on z (the latent regularizer's).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void backward(const ConstView<S>& d_pred, const Matrix<S>* d_code = nullptr, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& d_pred, const Matrix<S>* d_code = nullptr) {
     detail::check_shape("nn::SuperResolutionNet", "prediction gradient", d_pred, zh_.rows(), 3);
-    decoder_->backward(zh_, pred_ref(), d_pred, &d_zh_, policy);
-    up_->backward(code(), d_zh_, &d_z_, policy);
+    decoder_->backward(policy, zh_, pred_ref(), d_pred, &d_zh_);
+    up_->backward(policy, code(), d_zh_, &d_z_);
     if (d_code) {
       detail::check_shape("nn::SuperResolutionNet", "code gradient", *d_code, d_z_.rows(), d_z_.cols());
       d_z_ += *d_code;
     }
-    if (fe_) fe_->backward(h0_, d_z_, policy);
+    if (fe_) fe_->backward(policy, h0_, d_z_);
     up_->invalidate();
   }
 
-  /// Computes the upsampling weights from the rest shapes (eval mode) for infer().
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void prepare_inference(Policy policy = {}) {
+  /// Computes the upsampling weights from the rest shapes (eval mode) for infer(policy, …).
+  template <exec::HostPolicy Policy>
+  void prepare_inference(Policy policy) {
     up_->precompute_weights(policy);
   }
 
   /// Inference: eval mode with the precomputed upsampling (prepare_inference first).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void infer(const ConstView<S>& ldx, Matrix<S>& pred, Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void infer(Policy policy, const ConstView<S>& ldx, Matrix<S>& pred) {
     if (!up_->has_precomputed_weights()) prepare_inference(policy);
-    encode(Mode::eval, ldx, policy);
-    up_->apply(code(), zh_, policy);
-    decode(Mode::eval, ldx, pred, policy);
+    encode(policy, Mode::eval, ldx);
+    up_->apply(policy, code(), zh_);
+    decode(policy, Mode::eval, ldx, pred);
   }
 
   /// Drops precomputed upsampling weights (after loading or changing parameters).
@@ -142,16 +148,16 @@ class SuperResolutionNet {
 
  private:
   template <class Policy>
-  void encode(Mode mode, const ConstView<S>& ldx, Policy policy) {
+  void encode(Policy policy, Mode mode, const ConstView<S>& ldx) {
     detail::check_shape("nn::SuperResolutionNet", "LR displacements ((B·N)×3)", ldx, -1, 3);
     if (ldx.rows() == 0 || ldx.rows() % n_)
       throw ShapeError("nn::SuperResolutionNet: LR displacements (B·" + std::to_string(n_) + " rows)", {-1, 3}, {ldx.rows(), ldx.cols()});
-    pe_->forward(mode, ldx, h0_, policy);
-    if (fe_) fe_->forward(mode, h0_, z_, policy);
+    pe_->forward(policy, mode, ldx, h0_);
+    if (fe_) fe_->forward(policy, mode, h0_, z_);
   }
   template <class Policy>
-  void decode(Mode mode, const ConstView<S>& ldx, Matrix<S>& pred, Policy policy) {
-    decoder_->forward(mode, zh_, pred, policy);
+  void decode(Policy policy, Mode mode, const ConstView<S>& ldx, Matrix<S>& pred) {
+    decoder_->forward(policy, mode, zh_, pred);
     pred_ = &pred;
     if (cfg_.residual) {
       const Index B = ldx.rows() / n_;
@@ -168,7 +174,7 @@ class SuperResolutionNet {
   Index n_ = 0, m_ = 0;
   Matrix<S> lr_n_, hr_n_;
   std::unique_ptr<PositionalEncoding<S>> pe_;
-  std::unique_ptr<FeatureEmbedding<S>> fe_;
+  std::unique_ptr<FeatureEmbedding<S, Search>> fe_;
   std::unique_ptr<CoordinateUpsampling<S>> up_;
   std::unique_ptr<SirenDecoder<S>> decoder_;
   Eigen::SparseMatrix<S, Eigen::RowMajor> embedding_;

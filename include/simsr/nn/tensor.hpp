@@ -45,6 +45,13 @@ using ConstVectorMap = Eigen::Map<const Vector<S>>;
 /// eval: it uses the running averages (PyTorch's module.train() / module.eval()).
 enum class Mode { train, eval };
 
+/// Row chunks of the layers, scheduled by exec::chunk_count / exec::for_chunks: products (GEMM
+/// blocks, elementwise maps) over product_chunks, reductions over rows (weight gradients,
+/// BatchNorm statistics) over reduction_chunks, partial sums merged in chunk order. Fixed numbers
+/// (not the thread count), so exec::seq and exec::omp give the same bits.
+inline constexpr Index product_chunks = 64;
+inline constexpr Index reduction_chunks = 16;
+
 /// The random source of initializers: 64-bit Mersenne twister, the same stream on every platform.
 using Rng = std::mt19937_64;
 

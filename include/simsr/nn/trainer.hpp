@@ -94,10 +94,10 @@ struct TrainerOptions {
   std::function<void(const EpochReport&)> on_epoch;  ///< called after every epoch
 };
 
-template <class S = float>
+template <class S = float, class Search = neighbors::BruteForceKnn<S>>
 class Trainer {
  public:
-  Trainer(SuperResolutionNet<S>& net, const Tris& hr_faces, TrainingFrames<S> frames, TrainerOptions options = {})
+  Trainer(SuperResolutionNet<S, Search>& net, const Tris& hr_faces, TrainingFrames<S> frames, TrainerOptions options = {})
       : net_(&net), data_(std::move(frames)), opt_(std::move(options)), rng_(opt_.seed),
         adam_(net.store(), {.lr = opt_.lr > 0 ? opt_.lr : net.config().lr}),
         loss_(net.config(), net.hr_rest_normalized(), hr_faces, total_steps_estimate()) {
@@ -123,14 +123,14 @@ class Trainer {
   }
 
   /// Trains from the current epoch to epochs().
-  template <exec::HostPolicy Policy = exec::seq_t>
-  void run(Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  void run(Policy policy) {
     while (epoch_ < epochs()) run_epoch(policy);
   }
 
   /// One epoch: a fresh permutation, then every batch (the last one may be smaller).
-  template <exec::HostPolicy Policy = exec::seq_t>
-  EpochReport run_epoch(Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  EpochReport run_epoch(Policy policy) {
     const auto t0 = std::chrono::steady_clock::now();
     adam_.set_lr(current_lr());
     std::vector<Index> order(std::size_t(data_.frames));
@@ -145,9 +145,9 @@ class Trainer {
       gather(order, first, count);
       reseed_dropout();
       net_->store().zero_grad();
-      net_->forward(Mode::train, ldx_, pred_, policy);
+      net_->forward(policy, Mode::train, ldx_, pred_);
       const auto t = loss_.evaluate(policy, pred_, hdx_, net_->code(), long(adam_.steps()), &d_pred_, &d_code_);
-      net_->backward(d_pred_, &d_code_, policy);
+      net_->backward(policy, d_pred_, &d_code_);
       adam_.step(policy);
       if (!std::isfinite(t.total))
         throw ConvergenceError("nn::Trainer", int(adam_.steps()), t.total);
@@ -175,14 +175,14 @@ class Trainer {
   }
 
   /// Mean HR vertex error (raw units: the normalized error × σ) over the held-out frames, eval mode.
-  template <exec::HostPolicy Policy = exec::seq_t>
-  double holdout_error(Policy policy = {}) {
+  template <exec::HostPolicy Policy>
+  double holdout_error(Policy policy) {
     if (holdout_.frames == 0) return -1;
     net_->prepare_inference(policy);
     const Index N = data_.n, M = data_.m;
     double sum = 0;
     for (Index f = 0; f < holdout_.frames; ++f) {
-      net_->infer(holdout_.ldx.middleRows(f * N, N), pred_eval_, policy);
+      net_->infer(policy, holdout_.ldx.middleRows(f * N, N), pred_eval_);
       sum += (pred_eval_ - holdout_.hdx.middleRows(f * M, M)).template cast<double>().rowwise().norm().sum();
     }
     return sum / double(holdout_.frames * M) * net_->config().norm_std;
@@ -213,7 +213,7 @@ class Trainer {
     io::write_npz(path, a);
   }
 
-  /// Restores weights, buffers, optimizer, RNG and counters from save_checkpoint's file: run()
+  /// Restores weights, buffers, optimizer, RNG and counters from save_checkpoint's file: run(policy)
   /// then continues exactly as the saved run would have.
   void load_checkpoint(const std::filesystem::path& path) {
     const io::NpzArrays a = io::read_npz(path);
@@ -289,7 +289,7 @@ class Trainer {
     std::fflush(stderr);
   }
 
-  SuperResolutionNet<S>* net_;
+  SuperResolutionNet<S, Search>* net_;
   TrainingFrames<S> data_, holdout_;
   TrainerOptions opt_;
   Rng rng_;
