@@ -22,6 +22,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 int main(int argc, char** argv) {
   CLI::App app{"simsr: physics-based simulation super-resolution tools"};
   app.require_subcommand(1);
@@ -41,5 +45,12 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : simsr::cli::exit_usage;
   }
-  return simsr::cli::run_guarded(action);
+  const int code = simsr::cli::run_guarded(action);
+  // The JSON goes to stdout: a failed write there (a full disk, /dev/full) is an error too.
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::fprintf(stderr, "simsr: error: <stdout>: write failed%s%s\n", errno ? ": " : "", errno ? std::strerror(errno) : "");
+    return code != 0 ? code : simsr::cli::exit_parse;
+  }
+  return code;
 }

@@ -41,6 +41,21 @@ class ParseError : public Error {
   std::string message_;
 };
 
+/// An output file could not be written (its folder is missing or not writable, the disk is full,
+/// the close or the rename failed): `file()` is the target as given, `message()` says what failed
+/// in the operating system's words, `error_code()` is the errno (0 when none applies). A ParseError
+/// with line 0, so every handler of file errors (the tool's exit code 2 among them) catches it; the
+/// previous file at `file()`, if any, is left as it was (io/atomic_file.hpp).
+class WriteError : public ParseError {
+ public:
+  WriteError(std::string file, const std::string& message, int error_code = 0)
+      : ParseError(std::move(file), 0, message), error_code_(error_code) {}
+  int error_code() const noexcept { return error_code_; }
+
+ private:
+  int error_code_;
+};
+
 /// A mesh is invalid: `element` is the offending element (tet, triangle or vertex, as `kind` says),
 /// -1 when the problem concerns the mesh as a whole.
 class MeshError : public Error {

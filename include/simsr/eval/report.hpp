@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "../core/error.hpp"
+#include "../io/atomic_file.hpp"
 #include "error_statistics.hpp"
 
 namespace simsr::eval {
@@ -26,12 +27,8 @@ struct Series {
 };
 
 namespace detail {
-inline void write_file(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw ParseError(path.string(), 0, "cannot open file for writing");
-  out << text;
-  if (!out) throw ParseError(path.string(), 0, "write failed");
-}
+/// Every file of the area is written atomically (io/atomic_file.hpp): WriteError when it cannot be.
+inline void write_file(const std::filesystem::path& path, const std::string& text) { io::write_file_atomic(path, text); }
 inline std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string q = "\"";

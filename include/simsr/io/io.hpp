@@ -1,6 +1,8 @@
 #pragma once
 /// \file
-/// Umbrella of the io area: every reader and writer, and read_mesh/write_mesh by extension.
+/// Umbrella of the io area: every reader and writer, read_mesh/write_mesh by extension, and the
+/// atomic file writing every writer goes through.
+#include "atomic_file.hpp"
 #include "medit.hpp"
 #include "mesh_io.hpp"
 #include "msh.hpp"

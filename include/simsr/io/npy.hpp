@@ -31,6 +31,7 @@
 
 #include "../core/error.hpp"
 #include "../core/types.hpp"
+#include "atomic_file.hpp"
 #include "detail/npy_convert.hpp"
 #include "detail/npy_header.hpp"
 
@@ -354,15 +355,15 @@ inline std::vector<std::byte> npy_bytes(const NpyArray& a) {
   return out;
 }
 
-/// Writes an array to a .npy file (dtype, byte order and memory order as stored in `a`).
+/// Writes an array to a .npy file (dtype, byte order and memory order as stored in `a`), atomically
+/// (io/atomic_file.hpp): WriteError when it cannot be written, the previous file then unchanged.
 inline void write_npy(const std::filesystem::path& path, const NpyArray& a) {
   a.validate();
   const std::string h = detail::npy_make_header(a.dtype, a.fortran_order, a.shape);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw ParseError(path.string(), 0, "cannot open file for writing");
-  out.write(h.data(), static_cast<std::streamsize>(h.size()));
-  out.write(reinterpret_cast<const char*>(a.bytes.data()), static_cast<std::streamsize>(a.bytes.size()));
-  if (!out) throw ParseError(path.string(), 0, "write failed");
+  AtomicFile out(path);
+  out.write(h);
+  out.write(a.bytes);
+  out.commit();
 }
 
 /// An array of the given shape from `product(shape)` elements at `data`, in C order (or Fortran

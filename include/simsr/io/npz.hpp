@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "../core/error.hpp"
+#include "atomic_file.hpp"
 #include "detail/zip_handle.hpp"
 #include "npy.hpp"
 
@@ -262,24 +263,8 @@ inline void npz_add_members(zip_t* z, const NpzArrays& arrays, NpzCompression c,
   }
 }
 
-}  // namespace detail
-
-/// Writes arrays to an .npz file (replaced if it exists), stored or deflate-compressed.
-inline void write_npz(const std::filesystem::path& path, const NpzArrays& arrays,
-                      NpzCompression compression = NpzCompression::Stored) {
-  const std::string where = path.string();
-  int code = 0;
-  detail::ZipPtr z(zip_open(where.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &code));
-  if (!z) throw ParseError(where, 0, "cannot create archive: " + detail::zip_error_text(code));
-  std::vector<std::vector<std::byte>> hold;
-  detail::npz_add_members(z.get(), arrays, compression, hold, where);
-  if (zip_close(z.get()) != 0) throw ParseError(where, 0, "cannot write archive: " + std::string(zip_strerror(z.get())));
-  (void)z.release();
-}
-
-/// Serializes arrays to .npz bytes in memory.
-inline std::vector<std::byte> npz_bytes(const NpzArrays& arrays, NpzCompression compression = NpzCompression::Stored) {
-  const std::string where = "<memory>";
+/// The archive of `arrays` built in memory; errors name `where`.
+inline std::vector<std::byte> npz_archive(const NpzArrays& arrays, NpzCompression compression, const std::string& where) {
   zip_error_t err;
   zip_error_init(&err);
   detail::ZipSourcePtr src(zip_source_buffer_create(nullptr, 0, 0, &err));
@@ -311,6 +296,22 @@ inline std::vector<std::byte> npz_bytes(const NpzArrays& arrays, NpzCompression 
   zip_source_close(src.get());
   if (got != st.size) throw ParseError(where, 0, "cannot read back the archive");
   return out;
+}
+
+}  // namespace detail
+
+/// Writes arrays to an .npz file, stored or deflate-compressed. The archive is built in memory and
+/// written atomically (io/atomic_file.hpp): WriteError when it cannot be written, the previous file
+/// then unchanged. (Not libzip's own temporary file and rename at zip_close: one path for every
+/// output, special files such as /dev/full included, and one error type.)
+inline void write_npz(const std::filesystem::path& path, const NpzArrays& arrays,
+                      NpzCompression compression = NpzCompression::Stored) {
+  write_file_atomic(path, detail::npz_archive(arrays, compression, path.string()));
+}
+
+/// Serializes arrays to .npz bytes in memory.
+inline std::vector<std::byte> npz_bytes(const NpzArrays& arrays, NpzCompression compression = NpzCompression::Stored) {
+  return detail::npz_archive(arrays, compression, "<memory>");
 }
 
 }  // namespace simsr::io

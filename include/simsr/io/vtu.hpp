@@ -37,6 +37,7 @@
 #include "../core/types.hpp"
 #include "../mesh/tet_mesh.hpp"
 #include "../mesh/tri_mesh.hpp"
+#include "atomic_file.hpp"
 #include "detail/base64.hpp"
 
 namespace simsr::io {
@@ -290,21 +291,14 @@ class VtuGrid {
   std::vector<VtuArray> point_data_, cell_data_;
 };
 
-namespace detail {
-inline void vtu_write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw ParseError(path.string(), 0, "cannot open file for writing");
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  if (!out) throw ParseError(path.string(), 0, "write failed");
-}
-}  // namespace detail
-
-/// Writes a grid to a .vtu file.
+/// Writes a grid to a .vtu file, atomically (io/atomic_file.hpp): WriteError when it cannot be
+/// written, the previous file then unchanged.
 inline void write_vtu(const std::filesystem::path& path, const VtuGrid& grid, VtuFormat fmt = VtuFormat::Binary) {
-  detail::vtu_write_text(path, grid.to_string(fmt));
+  write_file_atomic(path, grid.to_string(fmt));
 }
 
-/// Writes a .pvd collection: one DataSet per (time, file) with `file` relative to the .pvd's folder.
+/// Writes a .pvd collection: one DataSet per (time, file) with `file` relative to the .pvd's folder
+/// (atomically, like write_vtu).
 inline void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames) {
   std::ostringstream out;
   out.imbue(std::locale::classic());
@@ -314,7 +308,7 @@ inline void write_pvd(const std::filesystem::path& path, const std::vector<std::
   for (const auto& [t, file] : frames)
     out << "    <DataSet timestep=\"" << t << "\" group=\"\" part=\"0\" file=\"" << detail::vtu_xml_escape(file) << "\"/>\n";
   out << "  </Collection>\n</VTKFile>\n";
-  detail::vtu_write_text(path, out.str());
+  write_file_atomic(path, out.str());
 }
 
 /// A time series written frame by frame: add() writes `<stem>/<stem>_<index>.vtu` next to the .pvd
@@ -326,7 +320,7 @@ class PvdWriter {
     const auto dir = pvd_.parent_path() / pvd_.stem();
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
-    if (ec) throw ParseError(dir.string(), 0, "cannot create folder: " + ec.message());
+    if (ec) throw WriteError(dir.string(), "cannot create the folder of the frames of " + pvd_.string() + ": " + ec.message(), ec.value());
   }
 
   /// Writes one frame at `time`; returns the path of its .vtu.

@@ -25,6 +25,7 @@
 
 #include "../../core/error.hpp"
 #include "../../core/types.hpp"
+#include "../atomic_file.hpp"
 
 namespace simsr::io::detail {
 
@@ -37,14 +38,9 @@ inline std::string read_text_file(const std::filesystem::path& path) {
   return text;
 }
 
-/// Writes `text` to `path` (replacing it). ParseError(path, 0, ...) when it cannot be written.
-inline void write_text_file(const std::filesystem::path& path, std::string_view text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw ParseError(path.string(), 0, "cannot open file for writing");
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  out.flush();
-  if (!out) throw ParseError(path.string(), 0, "write error");
-}
+/// Writes `text` to `path` (replacing it atomically, io/atomic_file.hpp). WriteError when it cannot
+/// be written.
+inline void write_text_file(const std::filesystem::path& path, std::string_view text) { write_file_atomic(path, text); }
 
 /// A token made printable for an error message: at most 40 characters, control bytes as '?'.
 inline std::string quote(std::string_view tok) {
