@@ -59,6 +59,7 @@
 #include <simsr/discretize/embedding.hpp>
 #include <simsr/io/obj.hpp>
 #include <simsr/mesh/vertex_areas.hpp>
+#include <simsr/physics/dirichlet_boundary.hpp>
 #include <simsr/physics/elastic_energy.hpp>
 #include <simsr/physics/forces/bone_attachment.hpp>
 #include <simsr/physics/forces/embedded_springs.hpp>
@@ -213,12 +214,12 @@ Scene build_scene() {
 
   // Frame A from rest (PCG block-Jacobi, omp): the "previous frame" of every timed frame.
   const double t_mesh = seconds_since(t0);
-  ElasticEnergy<TeranMuscle<>, exec::omp_t> elastic(m, TeranMuscle<>(), s.elements_a, exec::omp);
+  ElasticEnergy<TeranMuscle<>> elastic(m, TeranMuscle<>(), s.elements_a);
   s.springs->set_targets(s.targets_a);
-  using Pcg = ConjugateGradient<BlockJacobi<>, exec::omp_t>;
-  QuasistaticSolver<Pcg, exec::omp_t> newton(m.num_vertices(), m.T, NewtonOptions{}, Pcg({.tolerance = kCgTolerance}, exec::omp), exec::omp);
+  using Pcg = ConjugateGradient<BlockJacobi<>>;
+  QuasistaticSolver<Pcg> newton(m.num_vertices(), m.T, NewtonOptions{}, Pcg({.tolerance = kCgTolerance}));
   s.x_a = m.V;
-  const NewtonReport r = newton.solve(s.x_a, s.bc_a, elastic, *s.gravity, *s.springs);
+  const NewtonReport r = newton.solve(exec::omp, s.x_a, s.bc_a, elastic, *s.gravity, *s.springs);
   s.setup_iterations = r.iterations;
   std::fprintf(stderr,
                "bench_physics scene: %s, h = %.5f m -> %lld tets, %lld vertices (bbox %.3f x %.3f x %.3f m); cranium %lld, jaw %lld "
@@ -228,7 +229,7 @@ Scene build_scene() {
                (long long)s.bones->vertices("cranium").size(), (long long)s.bones->vertices("jaw").size(),
                (long long)std::count(s.muscle.begin(), s.muscle.end(), char(1)), (long long)s.springs->num_springs(),
                s.gravity->total_mass(), t_mesh, (long long)r.iterations, seconds_since(t0) - t_mesh,
-               (long long)elastic.count_inverted(s.x_a));
+               (long long)elastic.count_inverted(exec::omp, s.x_a));
   return s;
 }
 
@@ -248,7 +249,7 @@ void scene_counters(benchmark::State& state) {
 /// levels here, once per mesh like the gather lists: not timed).
 template <class Linear>
 Linear make_linear() {
-  return make_linear_solver<Linear>(scene().mesh, {.tolerance = kCgTolerance});
+  return make_linear_solver<Linear>(exec::omp, scene().mesh, {.tolerance = kCgTolerance});
 }
 
 /// The multigrid levels' sizes as counters (vertices of level 1 and of the coarsest level).
@@ -268,16 +269,16 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 template <class Linear, class Policy>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
-  ElasticEnergy<TeranMuscle<>, Policy> elastic(s.mesh, TeranMuscle<>(), s.elements_a, Policy{});
+  ElasticEnergy<TeranMuscle<>> elastic(s.mesh, TeranMuscle<>(), s.elements_a);
   EmbeddedSprings<> springs = *s.springs;
-  QuasistaticSolver<Linear, Policy> newton(s.mesh.num_vertices(), s.mesh.T, NewtonOptions{}, make_linear<Linear>(), Policy{});
+  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, NewtonOptions{}, make_linear<Linear>());
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
   const auto frame = [&] {
     x = s.x_a;                         // previous frame's converged solution
     elastic.set_elements(s.elements_b);  // this frame's activations
     springs.set_targets(s.targets_b);    // this frame's track targets
-    report = newton.solve(x, s.bc_b, elastic, *s.gravity, springs);  // jaw at this frame's angle
+    report = newton.solve(Policy{}, x, s.bc_b, elastic, *s.gravity, springs);  // jaw at this frame's angle
   };
   // Warm-up: one Newton iteration of the frame (gather lists, the Cholesky's symbolic analysis,
   // buffers), cut short by max_iterations = 1 (which reports as a ConvergenceError).
@@ -301,25 +302,21 @@ void BM_frame(benchmark::State& state) {
 }
 
 using Cholesky = SparseCholesky<>;
-template <class P>
-using PcgJacobi = ConjugateGradient<Jacobi<>, P>;
-template <class P>
-using PcgBlockJacobi = ConjugateGradient<BlockJacobi<>, P>;
-template <class P>
-using PcgIncompleteCholesky = ConjugateGradient<IncompleteCholesky<>, P>;
-template <class P>
-using PcgMultigrid = ConjugateGradient<Multigrid<>, P>;
+using PcgJacobi = ConjugateGradient<Jacobi<>>;
+using PcgBlockJacobi = ConjugateGradient<BlockJacobi<>>;
+using PcgIncompleteCholesky = ConjugateGradient<IncompleteCholesky<>>;
+using PcgMultigrid = ConjugateGradient<Multigrid<>>;
 
 BENCHMARK_TEMPLATE(BM_frame, Cholesky, exec::seq_t)->Name("BM_frame_73k/cholesky/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK_TEMPLATE(BM_frame, Cholesky, exec::omp_t)->Name("BM_frame_73k/cholesky/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_TEMPLATE(BM_frame, PcgJacobi<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgJacobi<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_ichol/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid<exec::seq_t>, exec::seq_t)->Name("BM_frame_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid<exec::omp_t>, exec::omp_t)->Name("BM_frame_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgJacobi, exec::seq_t)->Name("BM_frame_73k/pcg_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgJacobi, exec::omp_t)->Name("BM_frame_73k/pcg_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi, exec::seq_t)->Name("BM_frame_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgBlockJacobi, exec::omp_t)->Name("BM_frame_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky, exec::seq_t)->Name("BM_frame_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky, exec::omp_t)->Name("BM_frame_73k/pcg_ichol/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::seq_t)->Name("BM_frame_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t)->Name("BM_frame_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 // ---------------------------------------------------------------------------------------------
 // Kernels, at frame A's solution with frame B's controls (the start of a timed frame).
@@ -339,20 +336,20 @@ Points<> frame_start(std::vector<char>& fixed) {
 template <class Policy>
 void BM_energy_gradient(benchmark::State& state) {
   const Scene& s = scene();
-  ElasticEnergy<TeranMuscle<>, Policy> elastic(s.mesh, TeranMuscle<>(), s.elements_b, Policy{});
+  ElasticEnergy<TeranMuscle<>> elastic(s.mesh, TeranMuscle<>(), s.elements_b);
   std::vector<char> fixed;
   const Points<> x = frame_start(fixed);
   Points<> g(s.mesh.num_vertices(), 3);
   double e = 0;
   for (int warm = 0; warm < 2; ++warm) {
-    e = elastic.energy(x);
+    e = elastic.energy(Policy{}, x);
     g.setZero();
-    elastic.add_gradient(x, g);
+    elastic.add_gradient(Policy{}, x, g);
   }
   for (auto _ : state) {
-    e = elastic.energy(x);
+    e = elastic.energy(Policy{}, x);
     g.setZero();
-    elastic.add_gradient(x, g);
+    elastic.add_gradient(Policy{}, x, g);
     benchmark::DoNotOptimize(e);
     benchmark::DoNotOptimize(g.data());
     benchmark::ClobberMemory();
@@ -366,13 +363,13 @@ BENCHMARK_TEMPLATE(BM_energy_gradient, exec::omp_t)->Name("BM_kernel_73k/energy+
 template <class Policy>
 void BM_hessian(benchmark::State& state) {
   const Scene& s = scene();
-  ElasticEnergy<TeranMuscle<>, Policy> elastic(s.mesh, TeranMuscle<>(), s.elements_b, Policy{});
+  ElasticEnergy<TeranMuscle<>> elastic(s.mesh, TeranMuscle<>(), s.elements_b);
   std::vector<char> fixed;
   const Points<> x = frame_start(fixed);
   BlockHessian<> H(s.mesh.num_vertices(), s.mesh.T);
   const auto assemble = [&]() -> const SparseMatrix<>& {
     H.set_zero();
-    elastic.add_hessian(x, H, Definiteness::project);
+    elastic.add_hessian(Policy{}, x, H, Definiteness::project);
     return H.assemble(Policy{}, fixed);
   };
   assemble();  // warm-up: gather lists
@@ -401,20 +398,18 @@ const NewtonSystem& newton_system() {
     NewtonSystem out;
     std::vector<char> fixed;
     const Points<> x = frame_start(fixed);
-    ElasticEnergy<TeranMuscle<>, exec::omp_t> elastic(s.mesh, TeranMuscle<>(), s.elements_b, exec::omp);
+    ElasticEnergy<TeranMuscle<>> elastic(s.mesh, TeranMuscle<>(), s.elements_b);
     EmbeddedSprings<> springs = *s.springs;
     springs.set_targets(s.targets_b);
     out.H = BlockHessian<>(s.mesh.num_vertices(), s.mesh.T);
     out.H.set_zero();
-    elastic.add_hessian(x, out.H, Definiteness::project);
-    BlockTriplets<> trip;
-    springs.add_hessian(x, trip);
-    out.H.add(trip);
+    elastic.add_hessian(exec::omp, x, out.H, Definiteness::project);
+    springs.add_hessian(exec::omp, x, out.H, Definiteness::project);
     out.A = out.H.assemble(exec::omp, fixed);
     Points<> g = Points<>::Zero(s.mesh.num_vertices(), 3);
-    elastic.add_gradient(x, g);
-    s.gravity->add_gradient(x, g);
-    springs.add_gradient(x, g);
+    elastic.add_gradient(exec::omp, x, g);
+    s.gravity->add_gradient(exec::omp, x, g);
+    springs.add_gradient(exec::omp, x, g);
     out.b = -Eigen::Map<const VecX<>>(g.data(), g.size());
     for (std::size_t d = 0; d < fixed.size(); ++d)
       if (fixed[d]) out.b[Index(d)] = 0;
@@ -423,7 +418,7 @@ const NewtonSystem& newton_system() {
   return sys;
 }
 
-template <class Linear, bool Symbolic>
+template <class Linear, class Policy, bool Symbolic>
 void BM_linear(benchmark::State& state) {
   const NewtonSystem& sys = newton_system();
   Linear linear = make_linear<Linear>();
@@ -431,13 +426,13 @@ void BM_linear(benchmark::State& state) {
   LinearSolveInfo info;
   std::uint64_t version = 1;
   if (!Symbolic) {  // warm-up (and the symbolic analysis of the numeric-only case)
-    linear.compute(sys.A, version);
-    info = linear.solve(sys.b, d);
+    linear.compute(Policy{}, sys.A, version);
+    info = linear.solve(Policy{}, sys.b, d);
   }
   for (auto _ : state) {
     if (Symbolic) ++version;  // a new pattern version: SparseCholesky redoes analyzePattern
-    linear.compute(sys.A, version);
-    info = linear.solve(sys.b, d);
+    linear.compute(Policy{}, sys.A, version);
+    info = linear.solve(Policy{}, sys.b, d);
     benchmark::DoNotOptimize(d.data());
     benchmark::ClobberMemory();
   }
@@ -448,15 +443,15 @@ void BM_linear(benchmark::State& state) {
   state.counters["rel_residual"] = info.relative_residual;
   multigrid_counters(state, linear);
 }
-BENCHMARK_TEMPLATE(BM_linear, Cholesky, false)->Name("BM_linear_73k/cholesky")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_TEMPLATE(BM_linear, Cholesky, true)->Name("BM_linear_73k/cholesky_symbolic")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_TEMPLATE(BM_linear, PcgJacobi<exec::seq_t>, false)->Name("BM_linear_73k/pcg_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_linear, PcgJacobi<exec::omp_t>, false)->Name("BM_linear_73k/pcg_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi<exec::seq_t>, false)->Name("BM_linear_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi<exec::omp_t>, false)->Name("BM_linear_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_linear, PcgIncompleteCholesky<exec::seq_t>, false)->Name("BM_linear_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid<exec::seq_t>, false)->Name("BM_linear_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid<exec::omp_t>, false)->Name("BM_linear_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, Cholesky, exec::seq_t, false)->Name("BM_linear_73k/cholesky")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_TEMPLATE(BM_linear, Cholesky, exec::seq_t, true)->Name("BM_linear_73k/cholesky_symbolic")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_TEMPLATE(BM_linear, PcgJacobi, exec::seq_t, false)->Name("BM_linear_73k/pcg_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgJacobi, exec::omp_t, false)->Name("BM_linear_73k/pcg_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi, exec::seq_t, false)->Name("BM_linear_73k/pcg_block_jacobi/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi, exec::omp_t, false)->Name("BM_linear_73k/pcg_block_jacobi/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgIncompleteCholesky, exec::seq_t, false)->Name("BM_linear_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid, exec::seq_t, false)->Name("BM_linear_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid, exec::omp_t, false)->Name("BM_linear_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 }  // namespace
 

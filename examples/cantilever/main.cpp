@@ -27,11 +27,11 @@ using namespace simsr;
 using namespace simsr::physics;
 
 template <class Policy>
-CantileverResult solve_with(const std::string& solver, const CantileverOptions& o, Policy policy) {
-  if (solver == "cholesky") return solve_cantilever<SparseCholesky<>, Policy>(o, policy);
-  if (solver == "pcg-jacobi") return solve_cantilever<ConjugateGradient<Jacobi<>, Policy>, Policy>(o, policy);
-  if (solver == "pcg-multigrid") return solve_cantilever<ConjugateGradient<Multigrid<>, Policy>, Policy>(o, policy);
-  return solve_cantilever<ConjugateGradient<BlockJacobi<>, Policy>, Policy>(o, policy);
+CantileverResult solve_with(Policy policy, const std::string& solver, const CantileverOptions& o) {
+  if (solver == "cholesky") return solve_cantilever<SparseCholesky<>>(policy, o);
+  if (solver == "pcg-jacobi") return solve_cantilever<ConjugateGradient<Jacobi<>>>(policy, o);
+  if (solver == "pcg-multigrid") return solve_cantilever<ConjugateGradient<Multigrid<>>>(policy, o);
+  return solve_cantilever<ConjugateGradient<BlockJacobi<>>>(policy, o);
 }
 
 }  // namespace
@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "newton %ld: energy %.9e J, |gradient| %.3e N, step %g%s, %ld linear iterations\n", long(it.iteration),
                          it.energy, it.gradient_norm, it.step_length, it.projected ? " (projected Hessian)" : "", long(it.linear_iterations));
           };
-        const CantileverResult r = omp ? solve_with(solver, o, exec::omp) : solve_with(solver, o, exec::seq);
+        const CantileverResult r = omp ? solve_with(exec::omp, solver, o) : solve_with(exec::seq, solver, o);
         const nlohmann::ordered_json j = {{"tip_deflection", r.tip_deflection},
                                           {"euler_bernoulli", r.euler_bernoulli},
                                           {"relative_error", r.relative_error},

@@ -1,4 +1,6 @@
-// Must NOT compile: a type without stress_derivative is not a physics::Material, and the error says so.
+// expect: is not a physics::Material: it lacks stress_derivative
+// Must NOT compile: a type without stress_derivative is not a physics::Material, and ElasticEnergy
+// (a library template constrained by the concept) says so in one sentence.
 #include <simsr/mesh/generators.hpp>
 #include <simsr/physics/elastic_energy.hpp>
 struct HalfMaterial {

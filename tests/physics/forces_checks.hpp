@@ -3,32 +3,36 @@
 /// Test helpers for EnergyTerms: dense Hessian assembly, central finite differences of the energy
 /// and of the gradient, smallest eigenvalue.
 
+#include <simsr/core/parallel.hpp>
 #include <simsr/physics/energy_term.hpp>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <random>
+#include <vector>
 
 namespace simsr::test {
 
-/// Sums the blocks into a dense 3n×3n matrix (row 3i + a: vertex i, coordinate a).
-inline Eigen::MatrixXd dense_hessian(const physics::BlockTriplets<double>& H, Index n) {
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  for (Index k = 0; k < H.size(); ++k) D.block<3, 3>(3 * H.row(k), 3 * H.col(k)) += H.block(k);
-  return D;
+/// The assembled matrix of H as a dense 3n×3n matrix (row 3i + a: vertex i, coordinate a).
+inline Eigen::MatrixXd dense_hessian(physics::BlockHessian<double>& H) {
+  const std::vector<char> free(std::size_t(3 * H.num_vertices()), 0);
+  return Eigen::MatrixXd(H.assemble(exec::seq, free));
 }
 
+/// The term's Hessian at x (its one add_hessian form, into a BlockHessian that grows to the
+/// blocks it adds), dense.
 template <class Term>
-Eigen::MatrixXd assembled_hessian(const Term& t, const Points<>& x) {
-  physics::BlockTriplets<double> H;
-  t.add_hessian(x, H);
-  return dense_hessian(H, x.rows());
+Eigen::MatrixXd assembled_hessian(const Term& t, const Points<>& x, physics::Definiteness d = physics::Definiteness::project) {
+  physics::BlockHessian<double> H(x.rows());
+  H.set_zero();
+  t.add_hessian(exec::seq, x, H, d);
+  return dense_hessian(H);
 }
 
 template <class Term>
 Points<> gradient(const Term& t, const Points<>& x) {
   Points<> g = Points<>::Zero(x.rows(), 3);
-  t.add_gradient(x, g);
+  t.add_gradient(exec::seq, x, g);
   return g;
 }
 
@@ -39,9 +43,9 @@ Points<> fd_gradient(const Term& t, const Points<>& x, double h) {
   for (Index i = 0; i < x.rows(); ++i)
     for (int a = 0; a < 3; ++a) {
       y(i, a) = x(i, a) + h;
-      const double ep = t.energy(y);
+      const double ep = t.energy(exec::seq, y);
       y(i, a) = x(i, a) - h;
-      const double em = t.energy(y);
+      const double em = t.energy(exec::seq, y);
       y(i, a) = x(i, a);
       g(i, a) = (ep - em) / (2 * h);
     }

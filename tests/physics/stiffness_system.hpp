@@ -28,7 +28,7 @@ inline StiffnessSystem stiffness_system(simsr::Index nx, simsr::Index ny, unsign
   physics::ElasticEnergy<StVK> E(s.mesh, {1.0, 2.0});
   s.H = physics::BlockHessian<>(s.mesh.num_vertices(), s.mesh.T);
   s.H.set_zero();
-  E.add_hessian(s.mesh.V, s.H);
+  E.add_hessian(exec::seq, s.mesh.V, s.H, physics::Definiteness::project);
   s.fixed.assign(std::size_t(3 * s.mesh.num_vertices()), 0);
   for (Index v = 0; v < s.mesh.num_vertices(); ++v)
     if (s.mesh.V(v, 0) == 0.0)

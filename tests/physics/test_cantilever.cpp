@@ -12,7 +12,7 @@ TEST_CASE("cantilever under gravity converges to Euler–Bernoulli on conforming
   for (Index n : {2, 4, 6}) {
     CantileverOptions o;
     o.cells_through_height = n;
-    const auto r = solve_cantilever(o);
+    const auto r = solve_cantilever(exec::seq, o);
     MESSAGE("conforming n=" << n << ": tip " << r.tip_deflection << " m, Euler–Bernoulli " << r.euler_bernoulli << ", error " << r.relative_error);
     CHECK(r.tip_deflection < r.euler_bernoulli);  // stiff from locking, never softer
     CHECK(r.relative_error < previous / 1.8);
@@ -20,14 +20,14 @@ TEST_CASE("cantilever under gravity converges to Euler–Bernoulli on conforming
   }
   CantileverOptions fine;
   fine.cells_through_height = 10;
-  const auto r10 = solve_cantilever<ConjugateGradient<BlockJacobi<>>>(fine);
+  const auto r10 = solve_cantilever<ConjugateGradient<BlockJacobi<>>>(exec::omp, fine);
   MESSAGE("conforming n=10: error " << r10.relative_error);
   CHECK(r10.relative_error < 0.03);
 
   CantileverOptions bcc;
   bcc.discretization = BeamDiscretization::embedded_bcc;
   bcc.cells_through_height = 6;
-  const auto rb = solve_cantilever(bcc);
+  const auto rb = solve_cantilever(exec::seq, bcc);
   MESSAGE("BCC n=6: error " << rb.relative_error);
   CHECK(rb.relative_error < 0.03);
   CHECK(euler_bernoulli_tip_deflection(bcc) == doctest::Approx(1000 * 9.81 * 0.1 * 0.1 * 1.0 / (8 * 1e8 * 0.1 * 0.001 / 12)));
@@ -37,7 +37,7 @@ TEST_CASE("cantilever: lengths must be multiples of the cell size") {
   CantileverOptions o;
   o.cells_through_height = 3;
   o.width = 0.05;
-  CHECK_THROWS_AS(solve_cantilever(o), ArgumentError);
+  CHECK_THROWS_AS(solve_cantilever(exec::seq, o), ArgumentError);
   o.cells_through_height = 0;
-  CHECK_THROWS_AS(solve_cantilever(o), ArgumentError);
+  CHECK_THROWS_AS(solve_cantilever(exec::seq, o), ArgumentError);
 }

@@ -21,9 +21,21 @@ Points<> perturbed(const Points<>& V, double amount, unsigned seed) {
   return x;
 }
 
-Eigen::MatrixXd dense(const BlockTriplets<>& h, Index n) {
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  for (Index k = 0; k < h.size(); ++k) H.block<3, 3>(3 * h.row(k), 3 * h.col(k)) += h.block(k);
+/// The dense 3V×3V matrix of H (no fixed DOFs).
+Eigen::MatrixXd dense(BlockHessian<>& H, auto policy) {
+  const std::vector<char> free(std::size_t(3 * H.num_vertices()), 0);
+  return Eigen::MatrixXd(H.assemble(policy, free));
+}
+
+/// Σ_t of the element Hessians scattered into a dense 3V×3V matrix: the reference for the gather.
+template <class M>
+Eigen::MatrixXd element_sum(const ElasticEnergy<M>& E, const Points<>& x, Definiteness d) {
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3 * E.num_vertices(), 3 * E.num_vertices());
+  for (Index t = 0; t < E.num_tets(); ++t) {
+    const Mat12<> K = E.element_hessian(x, t, d);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) H.block<3, 3>(3 * E.tets()(t, a), 3 * E.tets()(t, b)) += K.block<3, 3>(3 * a, 3 * b);
+  }
   return H;
 }
 
@@ -31,19 +43,19 @@ Eigen::MatrixXd dense(const BlockTriplets<>& h, Index n) {
 
 TEST_CASE("tet_rest_data: volumes and Dm⁻¹; flat and inverted rest tets are MeshErrors naming the tet") {
   const auto mesh = box_tet_mesh<double>(2, 1, 1, Vec3<>(0, 0, 0), Vec3<>(2, 1, 1));
-  const auto rest = tet_rest_data(mesh.V, mesh.T);
+  const auto rest = tet_rest_data(exec::seq, mesh.V, mesh.T);
   CHECK(rest.volume.sum() == doctest::Approx(2.0));
   for (Index t = 0; t < mesh.num_tets(); ++t)  // F(rest) = I
     CHECK((deformation_gradient(mesh.V, mesh.T, t, rest.Dm_inv[std::size_t(t)]) - Mat3<>::Identity()).norm() < 1e-14);
   auto bad = mesh;
   std::swap(bad.T(3, 1), bad.T(3, 2));
-  CHECK_THROWS_WITH_AS(tet_rest_data(bad.V, bad.T), doctest::Contains("tet 3: inverted"), MeshError);
+  CHECK_THROWS_WITH_AS(tet_rest_data(exec::seq, bad.V, bad.T), doctest::Contains("tet 3: inverted"), MeshError);
   bad = mesh;
   bad.V.row(bad.T(5, 3)) = bad.V.row(bad.T(5, 0));
-  CHECK_THROWS_AS(tet_rest_data(bad.V, bad.T), MeshError);
+  CHECK_THROWS_AS(tet_rest_data(exec::seq, bad.V, bad.T), MeshError);
   bad = mesh;
   bad.T(2, 0) = 99;
-  CHECK_THROWS_WITH_AS(tet_rest_data(bad.V, bad.T), doctest::Contains("out of range"), MeshError);
+  CHECK_THROWS_WITH_AS(tet_rest_data(exec::seq, bad.V, bad.T), doctest::Contains("out of range"), MeshError);
 }
 
 TEST_CASE("ElasticEnergy: gradient is the finite difference of the energy, Hessian that of the gradient") {
@@ -54,28 +66,29 @@ TEST_CASE("ElasticEnergy: gradient is the finite difference of the energy, Hessi
   for (unsigned seed = 1; seed <= 5; ++seed) {
     const Points<> x = perturbed(mesh.V, 0.15, seed);
     Points<> g = Points<>::Zero(n, 3);
-    E.add_gradient(x, g);
+    E.add_gradient(exec::seq, x, g);
     const double h = 1e-6;
     double worst = 0;
     for (Index i = 0; i < 3 * n; ++i) {
       Points<> xp = x, xm = x;
       xp.data()[i] += h;
       xm.data()[i] -= h;
-      const double fd = (E.energy(xp) - E.energy(xm)) / (2 * h);
+      const double fd = (E.energy(exec::seq, xp) - E.energy(exec::seq, xm)) / (2 * h);
       worst = std::max(worst, std::abs(fd - g.data()[i]));
     }
     CHECK(worst < 1e-7 * std::max(1.0, g.cwiseAbs().maxCoeff()));
 
-    BlockTriplets<> trip;
-    E.add_hessian(x, trip);
-    const Eigen::MatrixXd H = dense(trip, n);
+    BlockHessian<> HB(n, mesh.T);
+    HB.set_zero();
+    E.add_hessian(exec::seq, x, HB, Definiteness::exact);
+    const Eigen::MatrixXd H = dense(HB, exec::seq);
     double worst_h = 0;
     for (Index i = 0; i < 3 * n; ++i) {
       Points<> xp = x, xm = x, gp = Points<>::Zero(n, 3), gm = Points<>::Zero(n, 3);
       xp.data()[i] += h;
       xm.data()[i] -= h;
-      E.add_gradient(xp, gp);
-      E.add_gradient(xm, gm);
+      E.add_gradient(exec::seq, xp, gp);
+      E.add_gradient(exec::seq, xm, gm);
       const Eigen::VectorXd col = (Eigen::Map<Eigen::VectorXd>(gp.data(), 3 * n) - Eigen::Map<Eigen::VectorXd>(gm.data(), 3 * n)) / (2 * h);
       // Points is vertex-major (row-major #V×3): data index i = 3v + c, the Hessian's DOF order.
       worst_h = std::max(worst_h, (col - H.col(i)).cwiseAbs().maxCoeff());
@@ -85,32 +98,31 @@ TEST_CASE("ElasticEnergy: gradient is the finite difference of the energy, Hessi
   }
 }
 
-TEST_CASE("ElasticEnergy: the fast BlockHessian path equals the triplet path; seq and omp agree bitwise") {
+TEST_CASE("ElasticEnergy: the gathered Hessian is the sum of the element Hessians; seq and omp agree bitwise") {
   const auto mesh = box_tet_mesh<double>(3, 2, 2);
   const Points<> x = perturbed(mesh.V, 0.1, 7);
-  ElasticEnergy<simsr_test::StVK> seq(mesh, {});
-  ElasticEnergy<simsr_test::StVK, exec::omp_t> omp(mesh, {});
-  BlockTriplets<> trip;
-  seq.add_hessian(x, trip);
-  BlockHessian<> ref(mesh.num_vertices(), mesh.T);
-  ref.set_zero();
-  ref.add(trip);
+  ElasticEnergy<simsr_test::StVK> E(mesh, {});
+  const Eigen::MatrixXd A = element_sum(E, x, Definiteness::project);
   BlockHessian<> fast(mesh.num_vertices(), mesh.T), fast_omp(mesh.num_vertices(), mesh.T);
   fast.set_zero();
-  seq.add_hessian(x, fast);
+  E.add_hessian(exec::seq, x, fast, Definiteness::project);
   fast_omp.set_zero();
-  omp.add_hessian(x, fast_omp);
-  std::vector<char> free(std::size_t(3 * mesh.num_vertices()), 0);
-  const Eigen::MatrixXd A = Eigen::MatrixXd(ref.assemble(exec::seq, free));
-  const Eigen::MatrixXd B = Eigen::MatrixXd(fast.assemble(exec::seq, free));
-  const Eigen::MatrixXd C = Eigen::MatrixXd(fast_omp.assemble(exec::omp, free));
+  E.add_hessian(exec::omp, x, fast_omp, Definiteness::project);
+  const Eigen::MatrixXd B = dense(fast, exec::seq);
+  const Eigen::MatrixXd C = dense(fast_omp, exec::omp);
   CHECK((A - B).cwiseAbs().maxCoeff() < 1e-12 * A.cwiseAbs().maxCoeff());
   CHECK((B - C).cwiseAbs().maxCoeff() == 0.0);
+  // added onto what is there, in the pattern of the tets only
+  E.add_hessian(exec::seq, x, fast, Definiteness::project);
+  CHECK((dense(fast, exec::seq) - 2 * B).cwiseAbs().maxCoeff() < 1e-12 * A.cwiseAbs().maxCoeff());
+  BlockHessian<> diagonal_only(mesh.num_vertices());
+  CHECK_THROWS_AS(E.add_hessian(exec::seq, x, diagonal_only, Definiteness::project), MeshError);
   Points<> g1 = Points<>::Zero(mesh.num_vertices(), 3), g2 = g1;
-  seq.add_gradient(x, g1);
-  omp.add_gradient(x, g2);
+  E.add_gradient(exec::seq, x, g1);
+  E.add_gradient(exec::omp, x, g2);
   CHECK((g1 - g2).cwiseAbs().maxCoeff() == 0.0);
-  CHECK(seq.energy(x) == omp.energy(x));
+  CHECK(E.energy(exec::seq, x) == E.energy(exec::omp, x));
+  CHECK(E.count_inverted(exec::seq, x) == E.count_inverted(exec::omp, x));
 }
 
 TEST_CASE("BlockHessian: blocks outside the pattern grow it, keep every value and change the version") {
@@ -146,5 +158,5 @@ TEST_CASE("ElasticEnergy: element data count is checked") {
   const auto mesh = box_tet_mesh<double>(1, 1, 1);
   CHECK_THROWS_AS(ElasticEnergy<simsr_test::StVK>(mesh, {}, std::vector<NoElementData>(3)), ShapeError);
   ElasticEnergy<simsr_test::StVK> E(mesh, {});
-  CHECK_THROWS_AS(E.energy(Points<>::Zero(3, 3)), ShapeError);
+  CHECK_THROWS_AS(E.energy(exec::seq, Points<>::Zero(3, 3)), ShapeError);
 }

@@ -17,7 +17,7 @@ TetMesh<> unit_box() { return box_tet_mesh<double>(2, 2, 2); }
 
 EmbeddedSprings<> random_springs(const TetMesh<>& m, std::mt19937& rng, Index q) {
   const Points<> P = test::random_points(q, 0.05, 0.95, rng);
-  const Embedding<> e = embed(m, P);
+  const Embedding<> e = embed(exec::seq, m, P);
   std::uniform_real_distribution<double> k(0.0, 100.0);
   VecX<> K(q);
   for (Index s = 0; s < q; ++s) K[s] = k(rng);
@@ -48,7 +48,7 @@ TEST_CASE("EmbeddedSprings: force magnitude is k times the stretch") {
   const TetMesh<> m = unit_box();
   SUBCASE("vertex spring") {
     EmbeddedSprings<> s = vertex_springs(m.V, IndexVector::Constant(1, 13), 50.0);
-    CHECK(s.energy(m.V) == 0.0);
+    CHECK(s.energy(exec::seq, m.V) == 0.0);
     Points<> y = m.V.row(13);
     y(0, 1) += 0.03;
     s.set_targets(y);
@@ -56,13 +56,13 @@ TEST_CASE("EmbeddedSprings: force magnitude is k times the stretch") {
     CHECK(g.row(13).norm() == doctest::Approx(50.0 * 0.03).epsilon(1e-12));
     CHECK(g(13, 1) < 0);  // ∂E/∂x points away from the target: the force pulls towards it
     CHECK(g.norm() == doctest::Approx(g.row(13).norm()));
-    CHECK(s.energy(m.V) == doctest::Approx(50.0 / 2 * 0.03 * 0.03));
+    CHECK(s.energy(exec::seq, m.V) == doctest::Approx(50.0 / 2 * 0.03 * 0.03));
   }
   SUBCASE("embedded point spring") {
     Points<> p(1, 3);
     p << 0.31, 0.47, 0.62;
-    EmbeddedSprings<> s = point_springs(m, p, 20.0);
-    CHECK(s.energy(m.V) == doctest::Approx(0.0).epsilon(1e-24));
+    EmbeddedSprings<> s = point_springs(exec::seq, m, p, 20.0);
+    CHECK(s.energy(exec::seq, m.V) == doctest::Approx(0.0).epsilon(1e-24));
     CHECK((s.points(m.V) - p).norm() < 1e-14);
     const Vec3<> u(0.01, -0.02, 0.005);
     Points<> x = m.V;
@@ -84,14 +84,14 @@ TEST_CASE("track_springs: total stiffness is stiffness per area times surface ar
   const Index levels[2] = {2, 4};
   for (int i = 0; i < 2; ++i) {
     const TriMesh<> sphere = icosphere<double>(levels[i], 1.0);
-    const Embedding<> e = embed(box, sphere.V);
-    const EmbeddedSprings<> s = track_springs(e, box, sphere, kappa);
-    CHECK(s.energy(box.V) < 1e-20);
+    const Embedding<> e = embed(exec::seq, box, sphere.V);
+    const EmbeddedSprings<> s = track_springs(exec::seq, e, box, sphere, kappa);
+    CHECK(s.energy(exec::seq, box.V) < 1e-20);
     const double area = voronoi_areas(sphere.V, sphere.F).sum();
-    total[i] = 2 * s.energy(x) / u.squaredNorm();  // uniform translation: every spring stretched by u
+    total[i] = 2 * s.energy(exec::seq, x) / u.squaredNorm();  // uniform translation: every spring stretched by u
     CHECK(total[i] == doctest::Approx(kappa * area).epsilon(1e-12));
     CHECK(s.stiffness().sum() == doctest::Approx(kappa * area).epsilon(1e-12));
-    const EmbeddedSprings<> b = track_springs(e, box, sphere, kappa, MassType::barycentric);
+    const EmbeddedSprings<> b = track_springs(exec::seq, e, box, sphere, kappa, MassType::barycentric);
     CHECK(b.stiffness().sum() == doctest::Approx(kappa * area).epsilon(1e-12));
   }
   MESSAGE("track springs: total stiffness coarse " << total[0] << ", fine " << total[1] << ", κ·4π " << kappa * 4 * M_PI);
@@ -103,7 +103,7 @@ TEST_CASE("EmbeddedSprings: bad input throws typed errors") {
   const TetMesh<> m = unit_box();
   Points<> p(2, 3);
   p << 0.2, 0.2, 0.2, 0.7, 0.6, 0.5;
-  const Embedding<> e = embed(m, p);
+  const Embedding<> e = embed(exec::seq, m, p);
   const VecX<> k = VecX<>::Constant(2, 1.0);
   CHECK_NOTHROW(EmbeddedSprings<>(e, m.T, m.num_vertices(), k, p));
   CHECK_THROWS_AS(EmbeddedSprings<>(e, m.T, m.num_vertices(), VecX<>::Constant(3, 1.0), p), ShapeError);
@@ -128,13 +128,13 @@ TEST_CASE("EmbeddedSprings: bad input throws typed errors") {
   EmbeddedSprings<> s(e, m.T, m.num_vertices(), k, p);
   CHECK_THROWS_AS(s.set_targets(Points<>(3, 3)), ShapeError);
   CHECK_THROWS_AS(s.set_targets(pnan), ArgumentError);
-  CHECK_THROWS_AS(s.energy(Points<>(m.V.topRows(5))), ShapeError);
+  CHECK_THROWS_AS(s.energy(exec::seq, Points<>(m.V.topRows(5))), ShapeError);
   Points<> g = Points<>::Zero(5, 3);
-  CHECK_THROWS_AS(s.add_gradient(m.V, g), ShapeError);
+  CHECK_THROWS_AS(s.add_gradient(exec::seq, m.V, g), ShapeError);
   CHECK_THROWS_AS(vertex_springs(m.V, IndexVector::Constant(1, -1), 1.0), ArgumentError);
   CHECK_THROWS_AS(vertex_springs(m.V, IndexVector::Constant(1, VIndex(m.num_vertices())), 1.0), ArgumentError);
   CHECK_THROWS_AS(vertex_springs(m.V, IndexVector::Constant(1, 0), -2.0), ArgumentError);
-  CHECK_THROWS_AS(point_springs(m, p, std::nan("")), ArgumentError);
-  CHECK_THROWS_AS(track_springs(e, m, VecX<>::Ones(3), 1.0), ShapeError);
-  CHECK_THROWS_AS(track_springs(e, m, VecX<>::Ones(2), -1.0), ArgumentError);
+  CHECK_THROWS_AS(point_springs(exec::seq, m, p, std::nan("")), ArgumentError);
+  CHECK_THROWS_AS(track_springs(exec::seq, e, m, VecX<>::Ones(3), 1.0), ShapeError);
+  CHECK_THROWS_AS(track_springs(exec::seq, e, m, VecX<>::Ones(2), -1.0), ArgumentError);
 }

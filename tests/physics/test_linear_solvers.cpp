@@ -18,15 +18,15 @@ namespace {
 simsr_test::StiffnessSystem make_system(unsigned seed) { return simsr_test::stiffness_system(4, 2, seed); }
 
 template <class L>
-void check_solver(L solver, double tol) {
+void check_solver(L solver, double tol, auto policy) {
   for (unsigned seed = 1; seed <= 4; ++seed) {
     auto s = make_system(seed);
     const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
     const Eigen::MatrixXd Ad(A);
     const VecX<> ref = Ad.ldlt().solve(s.b);
-    solver.compute(A, s.H.pattern_version());
+    solver.compute(policy, A, s.H.pattern_version());
     VecX<> x;
-    const LinearSolveInfo info = solver.solve(s.b, x);
+    const LinearSolveInfo info = solver.solve(policy, s.b, x);
     CHECK(info.converged);
     CHECK((x - ref).norm() <= tol * ref.norm());
     CHECK((Ad * x - s.b).norm() <= 10 * tol * s.b.norm());
@@ -37,35 +37,38 @@ void check_solver(L solver, double tol) {
 
 TEST_CASE("linear solvers model the concept") {
   static_assert(LinearSolver<SparseCholesky<>>);
-  static_assert(LinearSolver<ConjugateGradient<Jacobi<>, exec::seq_t>>);
-  static_assert(LinearSolver<ConjugateGradient<BlockJacobi<>, exec::omp_t>>);
-  static_assert(LinearSolver<ConjugateGradient<IncompleteCholesky<>, exec::omp_t>>);
+  static_assert(LinearSolver<ConjugateGradient<Jacobi<>>>);
+  static_assert(LinearSolver<ConjugateGradient<BlockJacobi<>>>);
+  static_assert(LinearSolver<ConjugateGradient<IncompleteCholesky<>>>);
+  static_assert(LinearSolver<ConjugateGradient<Multigrid<>>>);
+  static_assert(assert_linear_solver<ConjugateGradient<Multigrid<float>, float>>());
 }
 
 TEST_CASE("SparseCholesky and PCG (Jacobi, block-Jacobi; seq, omp) solve stiffness systems like a dense LDLT") {
-  check_solver(SparseCholesky<>{}, 1e-10);
-  check_solver(ConjugateGradient<Jacobi<>, exec::seq_t>({.tolerance = 1e-11}), 1e-8);
-  check_solver(ConjugateGradient<BlockJacobi<>, exec::seq_t>({.tolerance = 1e-11}), 1e-8);
-  check_solver(ConjugateGradient<BlockJacobi<>, exec::omp_t>({.tolerance = 1e-11}), 1e-8);
-  check_solver(ConjugateGradient<IncompleteCholesky<>, exec::seq_t>({.tolerance = 1e-11}), 1e-8);
+  check_solver(SparseCholesky<>{}, 1e-10, exec::seq);
+  check_solver(SparseCholesky<>{}, 1e-10, exec::omp);
+  check_solver(ConjugateGradient<Jacobi<>>({.tolerance = 1e-11}), 1e-8, exec::seq);
+  check_solver(ConjugateGradient<BlockJacobi<>>({.tolerance = 1e-11}), 1e-8, exec::seq);
+  check_solver(ConjugateGradient<BlockJacobi<>>({.tolerance = 1e-11}), 1e-8, exec::omp);
+  check_solver(ConjugateGradient<IncompleteCholesky<>>({.tolerance = 1e-11}), 1e-8, exec::seq);
 }
 
 TEST_CASE("PCG: block-Jacobi needs no more iterations than Jacobi, incomplete Cholesky fewer still; seq and omp iterate identically") {
   auto s = make_system(9);
   const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
-  ConjugateGradient<Jacobi<>, exec::seq_t> jac({.tolerance = 1e-8});
-  ConjugateGradient<BlockJacobi<>, exec::seq_t> blk({.tolerance = 1e-8});
-  ConjugateGradient<BlockJacobi<>, exec::omp_t> blk_omp({.tolerance = 1e-8});
+  ConjugateGradient<Jacobi<>> jac({.tolerance = 1e-8});
+  ConjugateGradient<BlockJacobi<>> blk({.tolerance = 1e-8});
+  ConjugateGradient<BlockJacobi<>> blk_omp({.tolerance = 1e-8});
   VecX<> x1, x2, x3;
-  jac.compute(A);
-  blk.compute(A);
-  blk_omp.compute(A);
-  const auto i1 = jac.solve(s.b, x1), i2 = blk.solve(s.b, x2), i3 = blk_omp.solve(s.b, x3);
+  jac.compute(exec::seq, A);
+  blk.compute(exec::seq, A);
+  blk_omp.compute(exec::omp, A);
+  const auto i1 = jac.solve(exec::seq, s.b, x1), i2 = blk.solve(exec::seq, s.b, x2), i3 = blk_omp.solve(exec::omp, s.b, x3);
   CHECK(i2.iterations <= i1.iterations);
-  ConjugateGradient<IncompleteCholesky<>, exec::seq_t> ic({.tolerance = 1e-8});
-  ic.compute(A);
+  ConjugateGradient<IncompleteCholesky<>> ic({.tolerance = 1e-8});
+  ic.compute(exec::seq, A);
   VecX<> x4;
-  const auto i4 = ic.solve(s.b, x4);
+  const auto i4 = ic.solve(exec::seq, s.b, x4);
   CHECK(i4.converged);
   CHECK(i4.iterations < i2.iterations);  // a stronger preconditioner: fewer (but sequential) iterations
   CHECK(i2.iterations == i3.iterations);
@@ -75,14 +78,14 @@ TEST_CASE("PCG: block-Jacobi needs no more iterations than Jacobi, incomplete Ch
 TEST_CASE("PCG reports non-convergence; Cholesky of a singular matrix is a ConvergenceError; b = 0 gives x = 0") {
   auto s = make_system(3);
   const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
-  ConjugateGradient<Jacobi<>, exec::seq_t> pcg({.tolerance = 1e-12, .max_iterations = 3});
-  pcg.compute(A);
+  ConjugateGradient<Jacobi<>> pcg({.tolerance = 1e-12, .max_iterations = 3});
+  pcg.compute(exec::seq, A);
   VecX<> x;
-  const auto info = pcg.solve(s.b, x);
+  const auto info = pcg.solve(exec::seq, s.b, x);
   CHECK_FALSE(info.converged);
   CHECK(info.iterations == 3);
   CHECK(info.relative_residual > 1e-12);
-  CHECK(pcg.solve(VecX<>::Zero(s.b.size()), x).converged);
+  CHECK(pcg.solve(exec::seq, VecX<>::Zero(s.b.size()), x).converged);
   CHECK(x.norm() == 0.0);
 
   // rank 2 in exact arithmetic: every symmetric pivot order meets an exact zero pivot
@@ -90,7 +93,7 @@ TEST_CASE("PCG reports non-convergence; Cholesky of a singular matrix is a Conve
   Sd << 1, 1, 0, 1, 1, 0, 0, 0, 1;
   const SparseMatrix<> singular = Eigen::MatrixXd(Sd).sparseView();
   SparseCholesky<> chol;
-  CHECK_THROWS_WITH_AS(chol.compute(singular, 1), doctest::Contains("SparseCholesky"), ConvergenceError);
-  chol.compute(A, s.H.pattern_version());
-  CHECK_THROWS_AS(chol.solve(VecX<>::Zero(5), x), ShapeError);
+  CHECK_THROWS_WITH_AS(chol.compute(exec::seq, singular, 1), doctest::Contains("SparseCholesky"), ConvergenceError);
+  chol.compute(exec::seq, A, s.H.pattern_version());
+  CHECK_THROWS_AS(chol.solve(exec::seq, VecX<>::Zero(5), x), ShapeError);
 }

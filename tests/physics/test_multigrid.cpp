@@ -23,7 +23,7 @@ TEST_CASE("lattice_hierarchy: levels shrink, weights sum to 1 and reproduce affi
   for (const bool lattice_mesh : {false, true}) {
     const auto box = box_tet_mesh<double>(16, 8, 8, Vec3<>(0, 0, 0), Vec3<>(2, 1, 1));
     const TetMesh<double> mesh = lattice_mesh ? discretize::bcc_lattice(box, 0.0625).mesh : box;
-    const auto levels = lattice_hierarchy(mesh, {.max_coarse_vertices = 60});
+    const auto levels = lattice_hierarchy(exec::seq, mesh, {.max_coarse_vertices = 60});
     CAPTURE(lattice_mesh);
     REQUIRE(levels.num_levels() >= 3);
     REQUIRE(levels.prolongations.size() + 1 == levels.vertices.size());
@@ -51,14 +51,14 @@ TEST_CASE("lattice_hierarchy: levels shrink, weights sum to 1 and reproduce affi
       CHECK((P * affine(coarse) - affine(fine)).cwiseAbs().maxCoeff() < 1e-11);
     }
   }
-  CHECK_THROWS_AS(lattice_hierarchy(TetMesh<double>{}), ArgumentError);
-  CHECK_THROWS_AS(lattice_hierarchy(box_tet_mesh<double>(2, 2, 2), {.h = -1}), ArgumentError);
+  CHECK_THROWS_AS(lattice_hierarchy(exec::seq, TetMesh<double>{}), ArgumentError);
+  CHECK_THROWS_AS(lattice_hierarchy(exec::seq, box_tet_mesh<double>(2, 2, 2), {.h = -1}), ArgumentError);
 }
 
 TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG's requirement); seq == omp bitwise") {
   auto s = stiffness_system(16, 4, 3);
   const SparseMatrix<>& A = s.A();
-  Multigrid<> mg(lattice_hierarchy(s.mesh, {.max_coarse_vertices = 40}).prolongations);
+  Multigrid<> mg(lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations);
   mg.compute(exec::seq, A);
   REQUIRE(mg.num_levels() >= 3);
   for (Index l = 0; l + 1 < mg.num_levels(); ++l) {
@@ -77,7 +77,8 @@ TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG
     CHECK(a.dot(Ma) > 0);
     CHECK(b.dot(Mb) > 0);
   }
-  Multigrid<> mg_omp(lattice_hierarchy(s.mesh, {.max_coarse_vertices = 40}).prolongations);
+  const auto levels_omp = lattice_hierarchy(exec::omp, s.mesh, {.max_coarse_vertices = 40});
+  Multigrid<> mg_omp(levels_omp.prolongations);
   mg_omp.compute(exec::omp, A);
   VecX<> z_seq, z_omp;
   mg.apply(exec::seq, s.b, z_seq);
@@ -94,13 +95,13 @@ TEST_CASE("PCG + multigrid solves stiffness systems like a dense LDLT, in far fe
     const SparseMatrix<>& A = s.A();
     const Eigen::MatrixXd Ad(A);
     const VecX<> ref = Ad.ldlt().solve(s.b);
-    ConjugateGradient<Multigrid<>, exec::omp_t> mg({.tolerance = 1e-10}, Multigrid<>(lattice_hierarchy(s.mesh, {.max_coarse_vertices = 40}).prolongations));
-    ConjugateGradient<BlockJacobi<>, exec::omp_t> bj({.tolerance = 1e-10});
-    mg.compute(A);
-    bj.compute(A);
+    ConjugateGradient<Multigrid<>> mg({.tolerance = 1e-10}, Multigrid<>(lattice_hierarchy(exec::omp, s.mesh, {.max_coarse_vertices = 40}).prolongations));
+    ConjugateGradient<BlockJacobi<>> bj({.tolerance = 1e-10});
+    mg.compute(exec::omp, A);
+    bj.compute(exec::omp, A);
     VecX<> x_mg, x_bj;
-    const auto i_mg = mg.solve(s.b, x_mg);
-    const auto i_bj = bj.solve(s.b, x_bj);
+    const auto i_mg = mg.solve(exec::omp, s.b, x_mg);
+    const auto i_bj = bj.solve(exec::omp, s.b, x_bj);
     CAPTURE(i_mg.iterations);
     CAPTURE(i_bj.iterations);
     CHECK(i_mg.converged);
@@ -110,10 +111,10 @@ TEST_CASE("PCG + multigrid solves stiffness systems like a dense LDLT, in far fe
   }
   // no coarse level: the "V-cycle" is the exact solve, PCG converges in one iteration
   auto s = stiffness_system(4, 2, 5);
-  ConjugateGradient<Multigrid<>, exec::seq_t> direct({.tolerance = 1e-10}, Multigrid<>(std::vector<SparseMatrix<>>{}));
-  direct.compute(s.A());
+  ConjugateGradient<Multigrid<>> direct({.tolerance = 1e-10}, Multigrid<>(std::vector<SparseMatrix<>>{}));
+  direct.compute(exec::seq, s.A());
   VecX<> x;
-  CHECK(direct.solve(s.b, x).iterations == 1);
+  CHECK(direct.solve(exec::seq, s.b, x).iterations == 1);
 }
 
 TEST_CASE("Newton with multigrid PCG reaches Cholesky's equilibrium (hanging neo-Hookean block, BCC lattice)") {
@@ -123,24 +124,26 @@ TEST_CASE("Newton with multigrid PCG reaches Cholesky's equilibrium (hanging neo
   Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
   BoneAttachments<> top(mesh.V);
   top.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.2 - 1e-9; }));
-  auto solve = [&](auto linear) {
-    QuasistaticSolver<decltype(linear), exec::omp_t> newton(mesh.num_vertices(), mesh.T, NewtonOptions{}, std::move(linear), exec::omp);
+  auto solve = [&](auto policy, auto linear) {
+    QuasistaticSolver<decltype(linear)> newton(mesh.num_vertices(), mesh.T, NewtonOptions{}, std::move(linear));
     Points<double> x = mesh.V;
-    const auto report = newton.solve(x, top.boundary(), flesh, gravity);
+    const auto report = newton.solve(policy, x, top.boundary(), flesh, gravity);
     CHECK(report.converged);
     return x;
   };
-  using Pcg = ConjugateGradient<Multigrid<>, exec::omp_t>;
-  const Points<double> x_mg = solve(Pcg({.tolerance = 1e-6}, Multigrid<>(lattice_hierarchy(mesh, {.max_coarse_vertices = 30}).prolongations)));
-  const Points<double> x_ch = solve(SparseCholesky<>{});
+  using Pcg = ConjugateGradient<Multigrid<>>;
+  const Points<double> x_mg = solve(exec::omp, make_linear_solver<Pcg>(exec::omp, mesh, {.tolerance = 1e-6}, {.max_coarse_vertices = 30}));
+  const Points<double> x_mg_seq = solve(exec::seq, make_linear_solver<Pcg>(exec::seq, mesh, {.tolerance = 1e-6}, {.max_coarse_vertices = 30}));
+  const Points<double> x_ch = solve(exec::seq, SparseCholesky<>{});
   const double sag = (mesh.V - x_ch).cwiseAbs().maxCoeff();
   CHECK(sag > 1e-3);
   CHECK((x_mg - x_ch).cwiseAbs().maxCoeff() <= 1e-6 * sag);
+  CHECK(x_mg == x_mg_seq);  // the whole Newton solve, multigrid included: seq == omp bitwise
 }
 
 TEST_CASE("Multigrid: bad input is a typed error") {
   auto s = stiffness_system(8, 2, 1);
-  auto P = lattice_hierarchy(s.mesh, {.max_coarse_vertices = 10}).prolongations;
+  auto P = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 10}).prolongations;
   REQUIRE(P.size() >= 1);
   CHECK_THROWS_AS(Multigrid<>(P, {.smoothing_sweeps = 0}), ArgumentError);
   CHECK_THROWS_AS(Multigrid<>(P, {.damping = 2.5}), ArgumentError);

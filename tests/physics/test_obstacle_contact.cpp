@@ -93,21 +93,21 @@ TEST_CASE("ObstacleContact: analytic plane and moving sphere") {
   IndexVector v(2);
   v << 0, 1;
   ObstacleContact plane(Plane<>(Vec3<>::Zero(), Vec3<>(0, 0, 3)), v, 2, 100.0);
-  CHECK(plane.energy(x) == doctest::Approx(50.0 * 1e-4));
+  CHECK(plane.energy(exec::seq, x) == doctest::Approx(50.0 * 1e-4));
   const Points<> g = test::gradient(plane, x);
   CHECK((g.row(0) - Eigen::RowVector3d(0, 0, -1.0)).norm() < 1e-12);  // force +1 N along the normal
   CHECK(g.row(1).norm() == 0.0);
 
   ObstacleContact sphere(Sphere<>(Vec3<>(0, 0, 1.0), 0.4), v, 2, 10.0);
-  CHECK(sphere.energy(x) == 0.0);
+  CHECK(sphere.energy(exec::seq, x) == 0.0);
   CHECK(sphere.active(x).empty());
   sphere.obstacle().set_centre(Vec3<>(0, 0, 0.8));  // pushed in: vertex 1 is 0.3 from the centre
   REQUIRE(sphere.active(x).size() == 1);
-  CHECK(sphere.energy(x) == doctest::Approx(5.0 * 0.1 * 0.1));
+  CHECK(sphere.energy(exec::seq, x) == doctest::Approx(5.0 * 0.1 * 0.1));
   CHECK((test::gradient(sphere, x).row(1) - Eigen::RowVector3d(0, 0, 10.0 * 0.1)).norm() < 1e-12);  // pushed towards −z
   // the centre itself: finite energy, gradient along +z by convention
   sphere.obstacle().set_centre(Vec3<>(0, 0, 0.5));
-  CHECK(sphere.energy(x) == doctest::Approx(5.0 * 0.16));
+  CHECK(sphere.energy(exec::seq, x) == doctest::Approx(5.0 * 0.16));
   CHECK(test::gradient(sphere, x).allFinite());
 }
 
@@ -125,6 +125,6 @@ TEST_CASE("ObstacleContact: bad input throws typed errors") {
   CHECK_THROWS_AS(ObstacleContact(s, v, 4, VecX<>::Ones(3)), ShapeError);
   CHECK_THROWS_AS(ObstacleContact(s, v, 4, VecX<>::Constant(2, std::nan(""))), ArgumentError);
   ObstacleContact c(s, v, 4, 1.0);
-  CHECK_THROWS_AS(c.energy(Points<>::Zero(3, 3)), ShapeError);
+  CHECK_THROWS_AS(c.energy(exec::seq, Points<>::Zero(3, 3)), ShapeError);
   CHECK_THROWS_AS(c.obstacle().set_centre(Vec3<>::Constant(INFINITY)), ArgumentError);
 }

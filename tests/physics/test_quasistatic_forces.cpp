@@ -62,7 +62,7 @@ TEST_CASE("self-contact in Newton: a block pressed onto another stops on it; the
   QuasistaticSolver<SparseCholesky<>> newton(n, mesh.T);
   const auto version = newton.hessian().pattern_version();
   Points<> x = mesh.V;
-  const auto report = newton.solve(x, bones.boundary(), elastic, contact);
+  const auto report = newton.solve(exec::seq, x, bones.boundary(), elastic, contact);
   CHECK(report.converged);
   CHECK(newton.hessian().pattern_version() != version);  // contact pairs across the two meshes
   // Every pressed vertex rests on the (deformed) lower surface: above its closest point, within d̂.
@@ -83,7 +83,7 @@ TEST_CASE("self-contact in Newton: a block pressed onto another stops on it; the
   // Without contact the upper block passes through the lower one.
   Points<> y = mesh.V;
   QuasistaticSolver<SparseCholesky<>> free_fall(n, mesh.T);
-  free_fall.solve(y, bones.boundary(), elastic);
+  free_fall.solve(exec::seq, y, bones.boundary(), elastic);
   CHECK(y(contact_vertices[0], 2) < 0.47);
   CHECK(lowest > y(contact_vertices[0], 2) + 0.02);
 }
@@ -101,7 +101,7 @@ TEST_CASE("obstacle contact in Newton: a rigid sphere pushed into a block dents 
   double previous_dent = 0;
   for (double push : {0.02, 0.05, 0.08}) {  // the sphere moves down frame by frame (warm starts)
     contact.obstacle().set_centre(Vec3<>(0.5, 0.5, 0.5 + radius - push));
-    const auto report = newton.solve(x, floor.boundary(), elastic, contact);
+    const auto report = newton.solve(exec::seq, x, floor.boundary(), elastic, contact);
     CHECK(report.converged);
     const Index middle = select_vertices(mesh.V, [](const Vec3<>& p) { return (p - Vec3<>(0.5, 0.5, 0.5)).norm() < 1e-12; })[0];
     const double dent = 0.5 - x(middle, 2);
@@ -123,8 +123,8 @@ TEST_CASE("track springs, a point spring on a 'lip corner' and a hinged jaw in o
   bones.set_transform(jaw, hinge_rotation(Vec3<>(0.08, 0, 0.04), Vec3<>(0, 1, 0), angle));
   // Track springs on the top surface, pulling it 5 mm up; a point spring pulling a top corner sideways.
   const TriMesh<> skin{mesh.V, faces_where(mesh, [](const Vec3<>& p) { return p.z() > 0.04 - 1e-12; })};
-  const auto emb = embed(mesh, skin.V);
-  auto tracks = track_springs(emb, mesh, skin, 1e6);
+  const auto emb = embed(exec::seq, mesh, skin.V);
+  auto tracks = track_springs(exec::seq, emb, mesh, skin, 1e6);
   Points<> targets = skin.V;
   targets.col(2).array() += 0.005;
   const IndexVector top = select_vertices(mesh.V, [](const Vec3<>& p) { return p.z() > 0.04 - 1e-12; });
@@ -132,14 +132,14 @@ TEST_CASE("track springs, a point spring on a 'lip corner' and a hinged jaw in o
   tracks.set_targets(targets);
   Points<> corner(1, 3);
   corner << 0.08, 0.04, 0.04;
-  auto lip = point_springs(mesh, corner, 200.0);
+  auto lip = point_springs(exec::seq, mesh, corner, 200.0);
   Points<> lip_target = corner;
   lip_target(0, 1) += 0.01;
   lip.set_targets(lip_target);
 
   QuasistaticSolver<ConjugateGradient<BlockJacobi<>>> newton(n, mesh.T);
   Points<> x = mesh.V;
-  const auto report = newton.solve(x, bones.boundary(), flesh, tracks, lip);
+  const auto report = newton.solve(exec::omp, x, bones.boundary(), flesh, tracks, lip);
   CHECK(report.converged);
   // Bones: exactly where their transforms put them.
   const auto bc = bones.boundary();
@@ -164,6 +164,6 @@ TEST_CASE("track springs, a point spring on a 'lip corner' and a hinged jaw in o
   CHECK(lip.points(x)(0, 1) > corner(0, 1) + 1e-4);
   // Equilibrium: removing the lip spring's pull changes the solution (it was doing work).
   Points<> y = mesh.V;
-  newton.solve(y, bones.boundary(), flesh, tracks);
+  newton.solve(exec::seq, y, bones.boundary(), flesh, tracks);
   CHECK(lip.points(x)(0, 1) > lip.points(y)(0, 1) + 1e-4);
 }

@@ -84,7 +84,7 @@ TEST_CASE("SelfContact: a vertex hovering over a triangle's interior") {
   REQUIRE(pairs.size() == 1);
   CHECK(pairs[0].distance == doctest::Approx(h));
   CHECK((pairs[0].barycentric - Vec3<>(0.6, 0.2, 0.2)).norm() < 1e-14);
-  CHECK(c.energy(x) == doctest::Approx(k / 2 * (dhat - h) * (dhat - h)));
+  CHECK(c.energy(exec::seq, x) == doctest::Approx(k / 2 * (dhat - h) * (dhat - h)));
   const Points<> g = test::gradient(c, x);
   CHECK((g.row(3) - Eigen::RowVector3d(0, 0, -k * (dhat - h))).norm() < 1e-12);  // force k(d̂−h) along +n
   CHECK((g.row(0) - Eigen::RowVector3d(0, 0, 0.6 * k * (dhat - h))).norm() < 1e-12);
@@ -96,7 +96,7 @@ TEST_CASE("SelfContact: a vertex hovering over a triangle's interior") {
   // above d̂: nothing
   x(3, 2) = 0.0101;
   CHECK(c.pairs(x).empty());
-  CHECK(c.energy(x) == 0.0);
+  CHECK(c.energy(exec::seq, x) == 0.0);
 }
 
 TEST_CASE("closest_point_barycentric: all 7 regions agree with dense sampling of the triangle") {
@@ -222,10 +222,10 @@ TEST_CASE("SelfContact: bad input throws typed errors") {
   opt.cell_size = -1;
   CHECK_THROWS_AS(SelfContact<>(v, F, 4, 1.0, 0.1, opt), ArgumentError);
   const SelfContact<> c(v, F, 4, 1.0, 0.1);
-  CHECK_THROWS_AS(c.energy(Points<>::Zero(3, 3)), ShapeError);
+  CHECK_THROWS_AS(c.energy(exec::seq, Points<>::Zero(3, 3)), ShapeError);
   CHECK_THROWS_AS(c.pairs(Points<>::Zero(5, 3)), ShapeError);
   // a wild configuration does not hang or throw: a far-away corner makes the triangle span many cells
   Points<> x(4, 3);
   x << 0, 0, 0, 1e9, 0, 0, 0, 1e9, 1e9, 0.1, 0.1, 0.01;
-  CHECK_NOTHROW(c.energy(x));
+  CHECK_NOTHROW(c.energy(exec::seq, x));
 }

@@ -3,14 +3,16 @@
 /// Hyperelastic energy of a tet mesh for any Material: E(x) = Σ_t V_t ψ(F_t) (SPEC §3; parameters
 /// are per unit rest volume, so coarse and fine meshes of one body agree in bulk).
 ///
-///     physics::ElasticEnergy<physics::NeoHookean<>, exec::omp_t> elastic(mesh, material);
-///     double e = elastic.energy(x);   elastic.add_gradient(x, g);   elastic.add_hessian(x, H);
+///     physics::ElasticEnergy<physics::NeoHookean<>> elastic(mesh, material);
+///     double e = elastic.energy(exec::omp, x);
+///     elastic.add_gradient(exec::omp, x, g);
+///     elastic.add_hessian(exec::omp, x, H, Definiteness::exact);   // H: BlockHessian built from mesh.T
 ///
 /// Assembly is deterministic and free of atomics: element forces and stiffnesses go to per-tet
 /// buffers in parallel, then every vertex (gradient) or block (Hessian) gathers its own
 /// contributions in a fixed order, so seq and omp give bitwise-identical results. The buffers
 /// are owned by the object and reused (const methods mutate them: one object, one thread of
-/// calls at a time).
+/// calls at a time). The constructor's one-time setup (rest shapes, O(#T)) is sequential.
 
 #include <algorithm>
 #include <cstdint>
@@ -38,21 +40,21 @@ concept ChecksElements = requires(const M& m, const typename M::Element& e) { m.
 }  // namespace detail
 
 /// Σ_t V_t ψ(F_t) over the tets of a rest mesh (see the file comment).
-template <class M, exec::HostPolicy Policy = exec::seq_t>
+template <class M>
 class ElasticEnergy {
-  static_assert(Material<M>, "ElasticEnergy<M>: M must model physics::Material (materials/material.hpp): types scalar_type "
-                             "and Element, and const methods energy(F, element), stress(F, element) -> Mat3 and "
-                             "stress_derivative(F, element, Definiteness) -> Mat9");
+  static_assert(assert_material<M>());
 
  public:
-  using S = typename M::scalar_type;
-  using Element = typename M::Element;
+  using S = typename detail::material_types<M>::scalar_type;
+  using Element = typename detail::material_types<M>::Element;
   using material_type = M;
 
   /// `elements`: one per tet (fibre directions, activations), or empty for default elements.
-  ElasticEnergy(const TetMesh<S>& rest, M material, std::vector<Element> elements = {}, Policy policy = {})
-      : T_(rest.T), n_(rest.num_vertices()), material_(std::move(material)), policy_(policy) {
-    rest_ = tet_rest_data(policy_, rest.V, rest.T);
+  /// Throws MeshError for a flat or inverted rest tet (naming the first), ShapeError for an
+  /// element count other than #T.
+  ElasticEnergy(const TetMesh<S>& rest, M material, std::vector<Element> elements = {})
+      : T_(rest.T), n_(rest.num_vertices()), material_(std::move(material)) {
+    rest_ = tet_rest_data(exec::seq, rest.V, rest.T);
     if (elements.empty()) elements.resize(std::size_t(T_.rows()));
     set_elements(std::move(elements));
     D_.resize(std::size_t(T_.rows()));
@@ -98,24 +100,26 @@ class ElasticEnergy {
   }
 
   /// Σ_t V_t ψ(F_t) (J).
-  S energy(const Points<S>& x) const {
+  template <exec::HostPolicy P>
+  S energy(P policy, const Points<S>& x) const {
     physics::detail::require_positions("ElasticEnergy::energy: x", x, n_);
     return exec::parallel_reduce(
-        policy_, T_.rows(), S(0),
+        policy, T_.rows(), S(0),
         [&](Index t) { return rest_.volume[t] * material_.energy(deformation_gradient(x, t), elements_[std::size_t(t)]); },
         [](S a, S b) { return a + b; });
   }
 
   /// g += ∂E/∂x (#V×3, N).
-  void add_gradient(const Points<S>& x, Points<S>& g) const {
+  template <exec::HostPolicy P>
+  void add_gradient(P policy, const Points<S>& x, Points<S>& g) const {
     physics::detail::require_positions("ElasticEnergy::add_gradient: x", x, n_);
     physics::detail::require_positions("ElasticEnergy::add_gradient: g", g, n_);
     forces_.resize(3, 4 * T_.rows());
-    exec::parallel_for(policy_, T_.rows(), [&](Index t) {
-      const Mat3<S> P = material_.stress(deformation_gradient(x, t), elements_[std::size_t(t)]);
-      forces_.template middleCols<4>(4 * t).noalias() = rest_.volume[t] * P * D_[std::size_t(t)].transpose();
+    exec::parallel_for(policy, T_.rows(), [&](Index t) {
+      const Mat3<S> stress = material_.stress(deformation_gradient(x, t), elements_[std::size_t(t)]);
+      forces_.template middleCols<4>(4 * t).noalias() = rest_.volume[t] * stress * D_[std::size_t(t)].transpose();
     });
-    exec::parallel_for(policy_, n_, [&](Index v) {
+    exec::parallel_for(policy, n_, [&](Index v) {
       Vec3<S> sum = Vec3<S>::Zero();
       for (Index k = vertex_offsets_[std::size_t(v)]; k < vertex_offsets_[std::size_t(v) + 1]; ++k) sum += forces_.col(vertex_entries_[std::size_t(k)]);
       g.row(v) += sum.transpose();
@@ -129,25 +133,19 @@ class ElasticEnergy {
     return element_stiffness(A, D_[std::size_t(t)], rest_.volume[t]);
   }
 
-  /// Generic path (EnergyTerm): every element's 16 blocks as triplets.
-  void add_hessian(const Points<S>& x, BlockTriplets<S>& H, Definiteness d = Definiteness::project) const {
-    physics::detail::require_positions("ElasticEnergy::add_hessian: x", x, n_);
-    for (Index t = 0; t < T_.rows(); ++t) {
-      const Mat12<S> K = element_hessian(x, t, d);
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b) H.add(T_(t, a), T_(t, b), K.template block<3, 3>(3 * a, 3 * b));
-    }
-  }
-
-  /// Fast path: element stiffnesses computed in parallel, then gathered block by block into H's
-  /// pattern (which must contain the tets' blocks, as BlockHessian(num_vertices, T) does).
-  void add_hessian(const Points<S>& x, BlockHessian<S>& H, Definiteness d = Definiteness::project) const {
+  /// H += Σ_t element_hessian(x, t, d) (EnergyTerm): element stiffnesses computed in parallel,
+  /// then gathered block by block into H's slots, each block summing its tets in a fixed order
+  /// (no allocation once the gather lists exist; they are rebuilt when H's pattern version
+  /// changes). H's pattern must contain the tets' blocks, as BlockHessian(num_vertices, T) does
+  /// (MeshError naming the first tet whose block is missing).
+  template <exec::HostPolicy P>
+  void add_hessian(P policy, const Points<S>& x, BlockHessian<S>& H, Definiteness d) const {
     physics::detail::require_positions("ElasticEnergy::add_hessian: x", x, n_);
     if (H.num_vertices() != n_) throw ShapeError("ElasticEnergy::add_hessian: Hessian vertices", {n_}, {H.num_vertices()});
-    if (gather_version_ != H.pattern_version()) build_gather(H);
+    if (gather_version_ != H.pattern_version()) build_gather(policy, H);
     stiffness_.resize(std::size_t(T_.rows()));
-    exec::parallel_for(policy_, T_.rows(), [&](Index t) { stiffness_[std::size_t(t)] = element_hessian(x, t, d); });
-    exec::parallel_for(policy_, H.num_blocks(), [&](Index s) {
+    exec::parallel_for(policy, T_.rows(), [&](Index t) { stiffness_[std::size_t(t)] = element_hessian(x, t, d); });
+    exec::parallel_for(policy, H.num_blocks(), [&](Index s) {
       Mat3<S> sum = Mat3<S>::Zero();
       for (Index k = gather_offsets_[std::size_t(s)]; k < gather_offsets_[std::size_t(s) + 1]; ++k) {
         const std::int64_t e = gather_entries_[std::size_t(k)];
@@ -159,17 +157,20 @@ class ElasticEnergy {
   }
 
   /// Number of tets with det F ≤ 0 at x.
-  Index count_inverted(const Points<S>& x) const {
+  template <exec::HostPolicy P>
+  Index count_inverted(P policy, const Points<S>& x) const {
+    physics::detail::require_positions("ElasticEnergy::count_inverted: x", x, n_);
     return exec::parallel_reduce(
-        policy_, T_.rows(), Index(0), [&](Index t) { return Index(deformation_gradient(x, t).determinant() <= S(0)); },
+        policy, T_.rows(), Index(0), [&](Index t) { return Index(deformation_gradient(x, t).determinant() <= S(0)); },
         [](Index a, Index b) { return a + b; });
   }
 
  private:
-  void build_gather(const BlockHessian<S>& H) const {
+  template <exec::HostPolicy P>
+  void build_gather(P policy, const BlockHessian<S>& H) const {
     const Index nb = H.num_blocks();
     std::vector<Index> slots(std::size_t(16 * T_.rows()));
-    exec::parallel_for(policy_, T_.rows(), [&](Index t) {
+    exec::parallel_for(policy, T_.rows(), [&](Index t) {
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b) {
           const Index s = H.slot(T_(t, a), T_(t, b));
@@ -189,7 +190,6 @@ class ElasticEnergy {
   Tets T_;
   Index n_ = 0;
   M material_;
-  Policy policy_;
   TetRestData<S> rest_;
   std::vector<Element> elements_;
   std::vector<Eigen::Matrix<S, 4, 3>, Eigen::aligned_allocator<Eigen::Matrix<S, 4, 3>>> D_;

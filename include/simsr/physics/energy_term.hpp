@@ -2,63 +2,72 @@
 /// \file
 /// The EnergyTerm concept: one potential of a quasistatic problem (elasticity, springs, gravity,
 /// contact). The solver minimizes the sum of the terms it is given, over the positions x (#V×3).
+/// Every term implements the same three calls, the execution policy first:
 ///
-///     double e = term.energy(x);
-///     term.add_gradient(x, g);        // g += ∂E/∂x, #V×3
-///     term.add_hessian(x, H);         // H += a positive semi-definite approximation of ∂²E/∂x²
+///     double e = term.energy(policy, x);
+///     term.add_gradient(policy, x, g);        // g += ∂E/∂x, #V×3
+///     term.add_hessian(policy, x, H, d);      // H += ∂²E/∂x² (BlockHessian, hessian.hpp)
+///
+/// `d` is always passed: Definiteness::exact asks for the true Hessian where the term has one
+/// (the elastic energy), Definiteness::project for a positive semi-definite one (Newton's fallback);
+/// terms whose Hessian is PSD anyway (springs, contact, gravity) give the same blocks for both.
+/// H is the one Hessian sink: scattered blocks go through `H.add(i, j, block)` (any vertex pair;
+/// pairs outside the pattern grow it), a term that fills the tets' pattern writes
+/// `H.block(H.slot(i, j))` directly (the elastic energy's allocation-free parallel gather).
 ///
 /// Terms are stateless between calls (they may own scratch buffers) and never throw on a
-/// configuration the solver can reach (inverted elements included).
+/// configuration the solver can reach (inverted elements included). A term may ignore the policy
+/// (sequential springs); it still takes it, so one call shape serves every term.
 
 #include <concepts>
-#include <vector>
 
 #include <Eigen/Core>
 
 #include "../core/error.hpp"
+#include "../core/exec/policy.hpp"
 #include "../core/types.hpp"
+#include "hessian.hpp"
+#include "materials/material.hpp"
 
 namespace simsr::physics {
 
-/// 3×3 blocks (row vertex, column vertex, block) of a Hessian; duplicates are summed on assembly.
-/// Terms that touch few vertices (springs, contact) add their blocks here.
-template <class S = Scalar>
-class BlockTriplets {
- public:
-  void add(VIndex row, VIndex col, const Mat3<S>& block) {
-    rows_.push_back(row);
-    cols_.push_back(col);
-    blocks_.push_back(block);
-  }
-  /// Adds the blocks of a dense (3n×3n) matrix over `vertices` (n of them), e.g. a 12×12 element Hessian.
-  template <class D, class I>
-  void add_dense(const I& vertices, const Eigen::MatrixBase<D>& H) {
-    const Index n = Index(std::size(vertices));
-    for (Index a = 0; a < n; ++a)
-      for (Index b = 0; b < n; ++b) add(VIndex(vertices[std::size_t(a)]), VIndex(vertices[std::size_t(b)]), H.template block<3, 3>(3 * a, 3 * b));
-  }
-  void clear() {
-    rows_.clear();
-    cols_.clear();
-    blocks_.clear();
-  }
-  Index size() const { return Index(rows_.size()); }
-  VIndex row(Index k) const { return rows_[std::size_t(k)]; }
-  VIndex col(Index k) const { return cols_[std::size_t(k)]; }
-  const Mat3<S>& block(Index k) const { return blocks_[std::size_t(k)]; }
-
- private:
-  std::vector<VIndex> rows_, cols_;
-  std::vector<Mat3<S>, Eigen::aligned_allocator<Mat3<S>>> blocks_;
+namespace detail {
+template <class T, class S>
+concept HasTermEnergy = requires(const T& t, const Points<S>& x) {
+  { t.energy(exec::seq, x) } -> std::convertible_to<S>;
+  { t.energy(exec::omp, x) } -> std::convertible_to<S>;
 };
+template <class T, class S>
+concept HasTermGradient = requires(const T& t, const Points<S>& x, Points<S>& g) {
+  t.add_gradient(exec::seq, x, g);
+  t.add_gradient(exec::omp, x, g);
+};
+template <class T, class S>
+concept HasTermHessian = requires(const T& t, const Points<S>& x, BlockHessian<S>& H, Definiteness d) {
+  t.add_hessian(exec::seq, x, H, d);
+  t.add_hessian(exec::omp, x, H, d);
+};
+}  // namespace detail
 
 /// A potential the quasistatic solver can minimize (see the file comment).
 template <class T, class S = Scalar>
-concept EnergyTerm = requires(const T& t, const Points<S>& x, Points<S>& g, BlockTriplets<S>& h) {
-  { t.energy(x) } -> std::convertible_to<S>;
-  t.add_gradient(x, g);
-  t.add_hessian(x, h);
-};
+concept EnergyTerm = detail::HasTermEnergy<T, S> && detail::HasTermGradient<T, S> && detail::HasTermHessian<T, S>;
+
+/// `static_assert(assert_energy_term<T, S>())`: a type that is not an EnergyTerm stops the build
+/// with one sentence naming the first call it lacks (and nothing else: the function returns true
+/// once its own assertion has spoken).
+template <class T, class S = Scalar>
+constexpr bool assert_energy_term() {
+  using namespace detail;
+  constexpr int lacks = !HasTermEnergy<T, S> ? 0 : !HasTermGradient<T, S> ? 1 : !HasTermHessian<T, S> ? 2 : -1;
+  static_assert(lacks != 0, "this type is not a physics::EnergyTerm: it lacks energy(policy, const Points& x) const -> scalar for exec::seq "
+                            "and exec::omp");
+  static_assert(lacks != 1, "this type is not a physics::EnergyTerm: it lacks add_gradient(policy, const Points& x, Points& g) const for "
+                            "exec::seq and exec::omp");
+  static_assert(lacks != 2, "this type is not a physics::EnergyTerm: it lacks add_hessian(policy, const Points& x, BlockHessian& H, "
+                            "Definiteness d) const for exec::seq and exec::omp, the one Hessian form every term implements");
+  return true;
+}
 
 namespace detail {
 /// Throws ShapeError unless x is #V×3 with the expected vertex count.

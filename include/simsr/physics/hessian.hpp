@@ -1,16 +1,22 @@
 #pragma once
 /// \file
-/// The global Hessian of a quasistatic problem: a symmetric matrix of 3×3 vertex blocks whose
-/// pattern (every vertex pair sharing a tet) is built once, plus a scalar CSR copy with a fixed
-/// structure for the linear solvers, so a Newton iteration allocates nothing.
+/// The global Hessian of a quasistatic problem, and the one sink every EnergyTerm adds its
+/// Hessian to: a symmetric matrix of 3×3 vertex blocks whose pattern (every vertex pair sharing a
+/// tet) is built once, plus a scalar CSR copy with a fixed structure for the linear solvers, so a
+/// Newton iteration allocates nothing.
 ///
 ///     physics::BlockHessian<> H(num_vertices, mesh.T);   // pattern from the tets
-///     H.set_zero();  elastic.add_hessian(x, H);  H.add(triplets);
-///     const auto& A = H.assemble(exec::omp, fixed_dof_mask);  // Eigen RowMajor CSR, 3V×3V
+///     H.set_zero();
+///     elastic.add_hessian(exec::omp, x, H, Definiteness::exact);   // every term, one form
+///     const auto& A = H.assemble(exec::omp, fixed_dof_mask);       // Eigen RowMajor CSR, 3V×3V
 ///
-/// Blocks outside the pattern (self-contact between far-apart vertices) grow the pattern: the
-/// matrix is rebuilt and `pattern_version()` changes, which tells users of slots (the elastic
-/// energy's gather lists, a Cholesky's symbolic analysis) to refresh.
+/// Two ways in, one object: terms that touch few vertices (springs, contact) call `add(i, j,
+/// block)` like a triplet list; a term that fills the pattern (the elastic energy) looks up
+/// `slot(i, j)` once and writes `block(slot)` directly, in parallel over slots. Blocks outside the
+/// pattern (self-contact between far-apart vertices) grow the pattern: the matrix is rebuilt and
+/// `pattern_version()` changes, which tells users of slots (the elastic energy's gather lists, a
+/// Cholesky's symbolic analysis) to refresh. `BlockHessian(n)` starts from the diagonal only and
+/// grows to whatever is added (a term's Hessian on its own, e.g. in a test).
 
 #include <algorithm>
 #include <atomic>
@@ -25,9 +31,33 @@
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
 #include "../core/types.hpp"
-#include "energy_term.hpp"
 
 namespace simsr::physics {
+
+/// 3×3 blocks (row vertex, column vertex, block) in the order added; duplicates are summed when
+/// added to a BlockHessian (which keeps its out-of-pattern blocks here until it grows).
+template <class S = Scalar>
+class BlockTriplets {
+ public:
+  void add(VIndex row, VIndex col, const Mat3<S>& block) {
+    rows_.push_back(row);
+    cols_.push_back(col);
+    blocks_.push_back(block);
+  }
+  void clear() {
+    rows_.clear();
+    cols_.clear();
+    blocks_.clear();
+  }
+  Index size() const { return Index(rows_.size()); }
+  VIndex row(Index k) const { return rows_[std::size_t(k)]; }
+  VIndex col(Index k) const { return cols_[std::size_t(k)]; }
+  const Mat3<S>& block(Index k) const { return blocks_[std::size_t(k)]; }
+
+ private:
+  std::vector<VIndex> rows_, cols_;
+  std::vector<Mat3<S>, Eigen::aligned_allocator<Mat3<S>>> blocks_;
+};
 
 /// Scalar sparse matrix handed to linear solvers (symmetric; row-major CSR).
 template <class S = Scalar>
@@ -38,6 +68,9 @@ template <class S = Scalar>
 class BlockHessian {
  public:
   BlockHessian() = default;
+
+  /// Pattern: the diagonal blocks only; every other block added grows it.
+  explicit BlockHessian(Index num_vertices) : BlockHessian(num_vertices, Tets(0, 4)) {}
 
   /// Pattern: every (i, j) with i and j in a common tet of T (diagonal included).
   BlockHessian(Index num_vertices, const Tets& T) : n_(num_vertices) {
@@ -78,10 +111,12 @@ class BlockHessian {
   }
 
   /// Adds blocks (duplicates summed). Blocks outside the pattern are kept and merged into the
-  /// pattern by the next assemble().
+  /// pattern by the next assemble(). Not thread-safe: one caller at a time (direct writes to
+  /// distinct slots through block(slot) may run in parallel).
   void add(const BlockTriplets<S>& h) {
     for (Index k = 0; k < h.size(); ++k) add(h.row(k), h.col(k), h.block(k));
   }
+  /// Adds `b` to block (i, j). ShapeError for a vertex outside [0, num_vertices).
   void add(VIndex i, VIndex j, const Mat3<S>& b) {
     if (i < 0 || j < 0 || i >= n_ || j >= n_)
       throw ShapeError("BlockHessian::add: block (" + std::to_string(i) + ", " + std::to_string(j) + ")", {n_, n_}, {i, j});

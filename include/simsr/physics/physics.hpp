@@ -5,6 +5,7 @@
 /// bones, gravity, obstacle and self contact), the elastic energy over a tet mesh, the Newton
 /// quasistatic solver with its linear-solver policies, and the cantilever verification.
 
+#include "dirichlet_boundary.hpp"
 #include "elastic_energy.hpp"
 #include "energy_term.hpp"
 #include "forces/forces.hpp"

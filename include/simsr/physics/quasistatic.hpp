@@ -3,14 +3,17 @@
 /// Quasistatic solver (SPEC §3, Park et al. 2023 §4: both simulators are quasistatic): minimize
 /// the total potential Σ E_k(x) over the free vertices, bones held by Dirichlet conditions, by
 /// Newton's method with a backtracking (Armijo) line search on the total energy. The Hessian is
-/// the terms' definiteness-fixed one, so every Newton direction descends. Warm start: x comes in
-/// as the previous frame's solution and leaves as this frame's.
+/// the terms' exact one where it is positive definite and their definiteness-fixed one otherwise,
+/// so every Newton direction descends. Warm start: x comes in as the previous frame's solution and
+/// leaves as this frame's.
 ///
-///     physics::QuasistaticSolver<physics::SparseCholesky<>, exec::omp_t> newton(mesh.num_vertices(), mesh.T);
-///     auto report = newton.solve(x, bones.boundary(), elastic, gravity, tracks);   // throws ConvergenceError
+///     physics::QuasistaticSolver<physics::SparseCholesky<>> newton(mesh.num_vertices(), mesh.T);
+///     auto report = newton.solve(exec::omp, x, bones.boundary(), elastic, gravity, tracks);   // throws ConvergenceError
 ///
-/// The linear solver is a policy (LinearSolver concept): SparseCholesky, or ConjugateGradient with
-/// Jacobi / BlockJacobi preconditioning under seq or omp.
+/// The linear solver is a type (LinearSolver concept): SparseCholesky, or ConjugateGradient with
+/// Jacobi / BlockJacobi / IncompleteCholesky / Multigrid preconditioning. The execution policy is
+/// the first argument of solve() and reaches everything the solve runs: every term's energy,
+/// gradient and Hessian, the assembly, and the linear solver's compute and solve.
 
 #include <algorithm>
 #include <cmath>
@@ -25,8 +28,8 @@
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
 #include "../core/types.hpp"
+#include "dirichlet_boundary.hpp"
 #include "energy_term.hpp"
-#include "forces/bone_attachment.hpp"
 #include "hessian.hpp"
 #include "linear_solvers/linear_solvers.hpp"
 
@@ -83,40 +86,52 @@ struct NewtonReport {
 };
 
 /// Newton with line search over a sum of EnergyTerms (see the file comment).
-template <class Linear = SparseCholesky<Scalar>, exec::HostPolicy Policy = exec::seq_t>
+template <class Linear = SparseCholesky<Scalar>>
 class QuasistaticSolver {
-  static_assert(LinearSolver<Linear>, "QuasistaticSolver<Linear>: Linear must model physics::LinearSolver "
-                                      "(linear_solvers/linear_solver.hpp): a scalar_type, compute(A, pattern_version) and "
-                                      "solve(b, x) -> LinearSolveInfo, e.g. SparseCholesky<> or ConjugateGradient<BlockJacobi<>>");
+  static_assert(assert_linear_solver<Linear>());
 
  public:
-  using S = typename Linear::scalar_type;
+  using S = typename detail::linear_scalar<Linear>::type;
 
   /// The Hessian pattern comes from the tets (every term coupling vertices within one tet fits it).
-  QuasistaticSolver(Index num_vertices, const Tets& T, NewtonOptions options = {}, Linear linear = {}, Policy policy = {})
-      : n_(num_vertices), options_(std::move(options)), linear_(std::move(linear)), policy_(policy), H_(num_vertices, T) {}
+  QuasistaticSolver(Index num_vertices, const Tets& T, NewtonOptions options = {}, Linear linear = {})
+      : n_(num_vertices), options_(std::move(options)), linear_(std::move(linear)), H_(num_vertices, T) {}
 
   NewtonOptions& options() { return options_; }
   Linear& linear_solver() { return linear_; }
   const BlockHessian<S>& hessian() const { return H_; }
 
-  /// Minimizes Σ terms over x (#V×3, in/out: the warm start), with x of the boundary's vertices
-  /// set to their targets first. Throws ConvergenceError (iterations, gradient norm) when the
-  /// tolerance is not met within max_iterations or the line search cannot decrease the energy.
-  template <class... Terms>
-  NewtonReport solve(Points<S>& x, const DirichletBoundary<S>& boundary, const Terms&... terms) {
+  /// Minimizes Σ terms over x (#V×3, in/out: the warm start) under `policy`, with x of the
+  /// boundary's vertices set to their targets first. Every term must be a physics::EnergyTerm.
+  /// Throws ConvergenceError (iterations, gradient norm) when the tolerance is not met within
+  /// max_iterations or the line search cannot decrease the energy. seq and omp give bitwise
+  /// identical iterates.
+  template <exec::HostPolicy P, class... Terms>
+  NewtonReport solve(P policy, Points<S>& x, const DirichletBoundary<S>& boundary, const Terms&... terms) {
     static_assert(sizeof...(Terms) > 0, "QuasistaticSolver::solve needs at least one energy term");
-    static_assert((EnergyTerm<Terms, S> && ...), "every term passed to QuasistaticSolver::solve must model physics::EnergyTerm "
-                                                 "(energy(x), add_gradient(x, g), add_hessian(x, BlockTriplets&))");
+    static_assert((assert_energy_term<Terms, S>() && ...));
+    if constexpr ((EnergyTerm<Terms, S> && ...))
+      return newton(policy, x, boundary, terms...);
+    else
+      return {};
+  }
+
+  /// ∂E/∂x at the last iterate of the last solve (free DOFs; fixed ones 0), 3V, vertex-major.
+  const VecX<S>& gradient() const { return g_; }
+
+ private:
+  /// The Newton loop of solve(), once every term is known to be an EnergyTerm.
+  template <class P, class... Terms>
+  NewtonReport newton(P policy, Points<S>& x, const DirichletBoundary<S>& boundary, const Terms&... terms) {
     detail::require_positions("QuasistaticSolver::solve: x", x, n_);
     apply_boundary(x, boundary);
     NewtonReport report;
     double reference = 0;
     const double size = double((x.colwise().maxCoeff() - x.colwise().minCoeff()).norm());
     for (Index it = 0;; ++it) {
-      const double E = total_energy(x, terms...);
+      const double E = total_energy(policy, x, terms...);
       if (!std::isfinite(E)) throw ConvergenceError("quasistatic Newton (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
-      const double balance = compute_gradient(x, terms...);
+      const double balance = compute_gradient(policy, x, terms...);
       const double gnorm = double(g_.norm());
       if (it == 0) {
         report.initial_gradient_norm = gnorm;
@@ -138,14 +153,14 @@ class QuasistaticSolver {
       LinearSolveInfo info;
       double slope = 0;
       if (!projected) {
-        projected = !newton_direction(x, Definiteness::exact, info, terms...);
+        projected = !newton_direction(policy, x, Definiteness::exact, info, terms...);
         if (!projected) {
           slope = double(g_.dot(d_));
           projected = !(slope < 0) || !d_.allFinite();
         }
       }
       if (projected) {
-        newton_direction(x, Definiteness::project, info, terms...);
+        newton_direction(policy, x, Definiteness::project, info, terms...);
         slope = double(g_.dot(d_));
       }
       if (!(slope < 0) || !d_.allFinite()) {  // still no descent (an unconverged iterative solve): fall back to −g
@@ -164,7 +179,7 @@ class QuasistaticSolver {
       for (;; ++backtracks) {
         trial_ = x;
         Eigen::Map<VecX<S>>(trial_.data(), 3 * n_) += S(alpha) * d_;
-        const double Et = total_energy(trial_, terms...);
+        const double Et = total_energy(policy, trial_, terms...);
         if (std::isfinite(Et) && Et <= E + options_.armijo * alpha * slope + noise) break;
         if (backtracks >= options_.max_backtracks)
           throw ConvergenceError("quasistatic Newton (line search: no decrease along the Newton direction at iteration " + std::to_string(it) + ")",
@@ -179,16 +194,12 @@ class QuasistaticSolver {
     }
   }
 
-  /// ∂E/∂x at the last iterate of the last solve (free DOFs; fixed ones 0), 3V, vertex-major.
-  const VecX<S>& gradient() const { return g_; }
-
- private:
   /// Σ terms' energies at x (J).
-  template <class... Terms>
-  double total_energy(const Points<S>& x, const Terms&... terms) {
+  template <class P, class... Terms>
+  double total_energy(P policy, const Points<S>& x, const Terms&... terms) {
     double sum = 0, mag = 0;
     const auto one = [&](const auto& t) {
-      const double e = double(t.energy(x));
+      const double e = double(t.energy(policy, x));
       sum += e;
       mag += std::abs(e);
     };
@@ -199,13 +210,13 @@ class QuasistaticSolver {
 
   /// Sets g_ to ∂E/∂x over the free DOFs (fixed ones zeroed), a 3V vector, vertex-major,
   /// and returns Σ_k ‖∂E_k/∂x‖ over the terms (free DOFs), the scale of the forces in balance.
-  template <class... Terms>
-  double compute_gradient(const Points<S>& x, const Terms&... terms) {
+  template <class P, class... Terms>
+  double compute_gradient(P policy, const Points<S>& x, const Terms&... terms) {
     g_.setZero(3 * n_);
     double balance = 0;
     const auto one = [&](const auto& term) {
       term_grad_.setZero(n_, 3);
-      term.add_gradient(x, term_grad_);
+      term.add_gradient(policy, x, term_grad_);
       const Eigen::Map<const VecX<S>> tg(term_grad_.data(), 3 * n_);
       double sq = 0;
       for (Index k = 0; k < 3 * n_; ++k)
@@ -232,50 +243,32 @@ class QuasistaticSolver {
     if (!x.allFinite()) throw ShapeError("QuasistaticSolver: x has non-finite entries", {n_, 3}, {x.rows(), x.cols()});
   }
 
-  /// Assembles the Hessian (terms that offer an exact one get `d`; the others give their PSD
-  /// one) and solves H d = rhs_. False when the system turned out not positive definite.
-  template <class... Terms>
-  bool newton_direction(const Points<S>& x, Definiteness d, LinearSolveInfo& info, const Terms&... terms) {
+  /// Assembles the Hessian (every term with definiteness `d`, in the order given) and solves
+  /// H d = rhs_. False when the system turned out not positive definite.
+  template <class P, class... Terms>
+  bool newton_direction(P policy, const Points<S>& x, Definiteness d, LinearSolveInfo& info, const Terms&... terms) {
     H_.set_zero();
-    (add_hessian(x, terms, d), ...);
-    const SparseMatrix<S>& A = H_.assemble(policy_, fixed_);
+    (terms.add_hessian(policy, x, H_, d), ...);
+    const SparseMatrix<S>& A = H_.assemble(policy, fixed_);
     try {
-      linear_.compute(A, H_.pattern_version());
+      linear_.compute(policy, A, H_.pattern_version());
     } catch (const ConvergenceError&) {
       if (d == Definiteness::project) throw;
       return false;
     }
     if constexpr (requires { linear_.positive_definite(); })
       if (d == Definiteness::exact && !linear_.positive_definite()) return false;
-    const LinearSolveInfo one = linear_.solve(rhs_, d_);
+    const LinearSolveInfo one = linear_.solve(policy, rhs_, d_);
     info.iterations += one.iterations;
     info.relative_residual = one.relative_residual;
     info.converged = one.converged;
     return one.converged || d == Definiteness::project;
   }
 
-  template <class T>
-  void add_hessian(const Points<S>& x, const T& term, Definiteness d) {
-    if constexpr (requires { term.add_hessian(x, H_, d); }) {
-      term.add_hessian(x, H_, d);
-    } else if constexpr (requires { term.add_hessian(x, H_); }) {
-      term.add_hessian(x, H_);
-    } else {
-      triplets_.clear();
-      if constexpr (requires { term.add_hessian(x, triplets_, d); })
-        term.add_hessian(x, triplets_, d);
-      else
-        term.add_hessian(x, triplets_);
-      H_.add(triplets_);
-    }
-  }
-
   Index n_;
   NewtonOptions options_;
   Linear linear_;
-  Policy policy_;
   BlockHessian<S> H_;
-  BlockTriplets<S> triplets_;
   std::vector<char> fixed_;
   Points<S> term_grad_, trial_;
   VecX<S> g_, rhs_, d_;

@@ -3,7 +3,7 @@
 /// Linear tetrahedral elements: the rest-shape data every FEM term needs (Dm⁻¹ and rest volume,
 /// Sifakis & Barbič 2012 §4) and the maps between vertex positions, F, forces and stiffness.
 ///
-///     auto rest = physics::tet_rest_data(mesh.V, mesh.T);     // throws MeshError on a flat/inverted rest tet
+///     auto rest = physics::tet_rest_data(exec::seq, mesh.V, mesh.T);   // throws MeshError on a flat/inverted rest tet
 ///     Mat3<> F  = physics::deformation_gradient(x, mesh.T, t, rest.Dm_inv[t]);
 ///
 /// F = Ds Dm⁻¹ with Ds = [x1−x0, x2−x0, x3−x0]; writing D (4×3) for the rows (−1ᵀDm⁻¹; Dm⁻¹),
@@ -36,7 +36,8 @@ struct TetRestData {
 };
 
 /// Computes Dm⁻¹ and the rest volume of every tet. A tet whose rest volume is not positive
-/// (inverted, or flat below `relative_tolerance`·(mean edge length)³) is a MeshError naming it.
+/// (inverted, or flat below `relative_tolerance`·(mean edge length)³) is a MeshError naming it
+/// (under exec::seq the first such tet; under exec::omp any one).
 template <exec::HostPolicy P, class DV>
 TetRestData<typename DV::Scalar> tet_rest_data(P policy, const Eigen::MatrixBase<DV>& V, const Tets& T,
                                                double relative_tolerance = 1e-12) {
@@ -66,12 +67,6 @@ TetRestData<typename DV::Scalar> tet_rest_data(P policy, const Eigen::MatrixBase
     r.volume[t] = det / S(6);
   });
   return r;
-}
-
-/// Sequential tet_rest_data.
-template <class DV>
-TetRestData<typename DV::Scalar> tet_rest_data(const Eigen::MatrixBase<DV>& V, const Tets& T, double relative_tolerance = 1e-12) {
-  return tet_rest_data(exec::seq, V, T, relative_tolerance);
 }
 
 /// F of tet t at positions x (#V×3).

@@ -2,7 +2,8 @@
 /// \file
 /// Bone attachments (SPEC §3, Park et al. 2023 §4): flesh vertices glued to a static cranium and a
 /// jaw rotating about its hinge. They are Dirichlet constraints, not energies: the solver takes
-/// the DirichletBoundary (sorted vertices and their prescribed positions) and eliminates them.
+/// the DirichletBoundary (dirichlet_boundary.hpp: sorted vertices and their prescribed positions) and
+/// eliminates them.
 ///
 ///     physics::BoneAttachments<> bones(hr_rest.V);
 ///     bones.add_bone("cranium", cranium_vertices);
@@ -22,6 +23,7 @@
 
 #include "../../core/error.hpp"
 #include "../../core/types.hpp"
+#include "../dirichlet_boundary.hpp"
 #include "detail/checks.hpp"
 
 namespace simsr::physics {
@@ -60,16 +62,6 @@ RigidTransform<S> hinge_rotation(const Vec3<std::type_identity_t<S>>& axis_point
   r.t = axis_point - r.R * axis_point;
   return r;
 }
-
-/// Prescribed positions of constrained vertices: vertices (#B, sorted, unique) and targets.row(b)
-/// the position of vertices[b] (#B×3, m). What the quasistatic solver consumes.
-template <class S = Scalar>
-struct DirichletBoundary {
-  IndexVector vertices;
-  Points<S> targets;
-
-  Index size() const { return vertices.size(); }
-};
 
 /// Named rigid bones, each a set of attached vertices with their rest positions and a current
 /// RigidTransform (identity until set: a static cranium never needs one). A vertex belongs to at

@@ -7,8 +7,8 @@
 ///
 ///     E(x) = Σ_s k_s/2 ‖Σ_i w_si x_{a_si} − y_s‖²           (J)
 ///
-///     auto emb = simsr::embed(lr_rest, hr_surface.V);                    // HR skin in the LR mesh
-///     auto springs = physics::track_springs(emb, lr_rest, hr_surface, 1e4);  // κ = 1e4 N/m³
+///     auto emb = simsr::embed(exec::omp, lr_rest, hr_surface.V);                    // HR skin in the LR mesh
+///     auto springs = physics::track_springs(exec::omp, emb, lr_rest, hr_surface, 1e4);  // κ = 1e4 N/m³
 ///     springs.set_targets(blendshape_positions);                         // each frame, #Q×3
 ///
 /// The Hessian, (w_s w_sᵀ ⊗ I₃) k_s per spring, is exact and positive semi-definite.
@@ -85,14 +85,17 @@ class EmbeddedSprings {
     return p;
   }
 
-  S energy(const Points<S>& x) const {
+  /// Σ_s k_s/2 ‖residual‖² (J), over the springs in order (the policy is taken for the EnergyTerm form).
+  template <exec::HostPolicy P>
+  S energy(P, const Points<S>& x) const {
     detail::require_positions("EmbeddedSprings: x", x, n_);
     S e = S(0);
     for (Index s = 0; s < num_springs(); ++s) e += k_[s] / S(2) * residual(x, s).squaredNorm();
     return e;
   }
 
-  void add_gradient(const Points<S>& x, Points<S>& g) const {
+  template <exec::HostPolicy P>
+  void add_gradient(P, const Points<S>& x, Points<S>& g) const {
     detail::require_positions("EmbeddedSprings: x", x, n_);
     detail::require_positions("EmbeddedSprings: gradient", g, n_);
     for (Index s = 0; s < num_springs(); ++s) {
@@ -101,8 +104,10 @@ class EmbeddedSprings {
     }
   }
 
-  /// Adds k_s w_si w_sj I₃ for every pair of non-zero weights (exact, PSD).
-  void add_hessian(const Points<S>& x, BlockTriplets<S>& H) const {
+  /// Adds k_s w_si w_sj I₃ for every pair of non-zero weights (exact and PSD: the same for both
+  /// Definiteness values).
+  template <exec::HostPolicy P>
+  void add_hessian(P, const Points<S>& x, BlockHessian<S>& H, Definiteness) const {
     detail::require_positions("EmbeddedSprings: x", x, n_);
     for (Index s = 0; s < num_springs(); ++s)
       for (int i = 0; i < 4; ++i) {
@@ -133,40 +138,41 @@ class EmbeddedSprings {
   Points<S> y_;
 };
 
-static_assert(EnergyTerm<EmbeddedSprings<double>, double>);
+static_assert(assert_energy_term<EmbeddedSprings<double>, double>());
 
 /// Track springs (Cong 2016 directability): one spring per embedded surface point, k_s =
 /// stiffness_per_area (N/m³) × areas[s] (m², the surface area point s stands for), so meshes of
 /// any resolution pull alike in bulk (total stiffness = κ × surface area). Targets start at the
-/// points' rest positions (zero energy at rest); `mesh` is the rest mesh the points are embedded in.
-template <class S>
-EmbeddedSprings<S> track_springs(const Embedding<S>& e, const TetMesh<S>& mesh, const VecX<std::type_identity_t<S>>& areas,
+/// points' rest positions (zero energy at rest, computed under `policy`); `mesh` is the rest mesh
+/// the points are embedded in.
+template <exec::HostPolicy P, class S>
+EmbeddedSprings<S> track_springs(P policy, const Embedding<S>& e, const TetMesh<S>& mesh, const VecX<std::type_identity_t<S>>& areas,
                                  std::type_identity_t<S> stiffness_per_area) {
   detail::require_nonnegative("track_springs: stiffness per area", stiffness_per_area);
   detail::require_nonnegative_each("track_springs: areas", areas, e.size());
-  return EmbeddedSprings<S>(e, mesh.T, mesh.num_vertices(), VecX<S>(stiffness_per_area * areas), deform(e, mesh.T, mesh.V));
+  return EmbeddedSprings<S>(e, mesh.T, mesh.num_vertices(), VecX<S>(stiffness_per_area * areas), deform(policy, e, mesh.T, mesh.V));
 }
 
 /// Track springs on the vertices of `surface` (embedded as `e`, one point per surface vertex), with
 /// areas = mixed Voronoi (default) or barycentric vertex areas of the surface (simsr::vertex_areas).
-template <class S>
-EmbeddedSprings<S> track_springs(const Embedding<S>& e, const TetMesh<S>& mesh, const TriMesh<S>& surface,
+template <exec::HostPolicy P, class S>
+EmbeddedSprings<S> track_springs(P policy, const Embedding<S>& e, const TetMesh<S>& mesh, const TriMesh<S>& surface,
                                  std::type_identity_t<S> stiffness_per_area, MassType areas = MassType::voronoi) {
   if (surface.num_vertices() != e.size())
     throw ShapeError("track_springs: surface vertices (one per embedded point)", {e.size(), 3}, {surface.V.rows(), surface.V.cols()});
   detail::require_vertex_indices("track_springs: surface triangles", surface.F, surface.num_vertices());
   const VecX<S> a = areas == MassType::voronoi ? voronoi_areas(surface.V, surface.F) : barycentric_areas(surface.V, surface.F);
-  return track_springs(e, mesh, a, stiffness_per_area);
+  return track_springs(policy, e, mesh, a, stiffness_per_area);
 }
 
 /// Springs of stiffness k (N/m) on a few arbitrary rest points (#P×3, e.g. a lip corner), embedded
-/// in `mesh` (points outside it get extrapolated weights of the nearest tet). Targets start at the
-/// points themselves; move them with set_targets.
-template <class S, class DP>
-EmbeddedSprings<S> point_springs(const TetMesh<S>& mesh, const Eigen::MatrixBase<DP>& points, std::type_identity_t<S> k) {
+/// in `mesh` under `policy` (points outside it get extrapolated weights of the nearest tet). Targets
+/// start at the points themselves; move them with set_targets.
+template <exec::HostPolicy P, class S, class DP>
+EmbeddedSprings<S> point_springs(P policy, const TetMesh<S>& mesh, const Eigen::MatrixBase<DP>& points, std::type_identity_t<S> k) {
   detail::require_nonnegative("point_springs: stiffness", k);
   const Points<S> p = points.template cast<S>();
-  const Embedding<S> e = embed(mesh, p);
+  const Embedding<S> e = embed(policy, mesh, p);
   return EmbeddedSprings<S>(e, mesh.T, mesh.num_vertices(), VecX<S>::Constant(e.size(), k), p);
 }
 

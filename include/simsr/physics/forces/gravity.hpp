@@ -61,23 +61,30 @@ class Gravity {
   /// Per-vertex forces m_i g (#V×3, N): minus the gradient.
   Points<S> forces() const { return m_ * g_.transpose(); }
 
-  S energy(const Points<S>& x) const {
+  /// −Σ m_i g·x_i (J). Sequential (the policy is taken for the EnergyTerm form).
+  template <exec::HostPolicy P>
+  S energy(P, const Points<S>& x) const {
     detail::require_positions("Gravity: x", x, num_vertices());
     return -(m_.transpose() * (x * g_))(0);
   }
-  void add_gradient(const Points<S>& x, Points<S>& g) const {
+  /// g −= m_i g per vertex (N).
+  template <exec::HostPolicy P>
+  void add_gradient(P, const Points<S>& x, Points<S>& g) const {
     detail::require_positions("Gravity: x", x, num_vertices());
     detail::require_positions("Gravity: gradient", g, num_vertices());
     g.noalias() -= m_ * g_.transpose();
   }
   /// Adds nothing: the energy is linear.
-  void add_hessian(const Points<S>& x, BlockTriplets<S>&) const { detail::require_positions("Gravity: x", x, num_vertices()); }
+  template <exec::HostPolicy P>
+  void add_hessian(P, const Points<S>& x, BlockHessian<S>&, Definiteness) const {
+    detail::require_positions("Gravity: x", x, num_vertices());
+  }
 
  private:
   VecX<S> m_;
   Vec3<S> g_;
 };
 
-static_assert(EnergyTerm<Gravity<double>, double>);
+static_assert(assert_energy_term<Gravity<double>, double>());
 
 }  // namespace simsr::physics

@@ -141,7 +141,8 @@ class ObstacleContact {
     return a;
   }
 
-  S energy(const Points<S>& x) const {
+  template <exec::HostPolicy P>
+  S energy(P, const Points<S>& x) const {
     detail::require_positions("ObstacleContact: x", x, n_);
     S e = S(0);
     for (Index i = 0; i < v_.size(); ++i) {
@@ -151,7 +152,8 @@ class ObstacleContact {
     return e;
   }
 
-  void add_gradient(const Points<S>& x, Points<S>& g) const {
+  template <exec::HostPolicy P>
+  void add_gradient(P, const Points<S>& x, Points<S>& g) const {
     detail::require_positions("ObstacleContact: x", x, n_);
     detail::require_positions("ObstacleContact: gradient", g, n_);
     for (Index i = 0; i < v_.size(); ++i) {
@@ -161,7 +163,9 @@ class ObstacleContact {
     }
   }
 
-  void add_hessian(const Points<S>& x, BlockTriplets<S>& H) const {
+  /// The PSD-projected blocks of the class comment, for both Definiteness values.
+  template <exec::HostPolicy P>
+  void add_hessian(P, const Points<S>& x, BlockHessian<S>& H, Definiteness) const {
     detail::require_positions("ObstacleContact: x", x, n_);
     for (Index i = 0; i < v_.size(); ++i) {
       const Vec3<S> p = pos(x, i);
@@ -194,6 +198,6 @@ template <class O, class K>
 ObstacleContact(O, IndexVector, Index, K) -> ObstacleContact<O>;
 
 static_assert(Obstacle<Plane<double>> && Obstacle<Sphere<double>>);
-static_assert(EnergyTerm<ObstacleContact<Sphere<double>>, double>);
+static_assert(assert_energy_term<ObstacleContact<Sphere<double>>, double>());
 
 }  // namespace simsr::physics

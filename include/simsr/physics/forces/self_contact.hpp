@@ -103,14 +103,16 @@ class SelfContact {
     return out;
   }
 
-  S energy(const Points<S>& x) const {
+  template <exec::HostPolicy P>
+  S energy(P, const Points<S>& x) const {
     detail::require_positions("SelfContact: x", x, n_);
     S e = S(0);
     for_each_pair(x, [&](const SelfContactPair<S>& c, const Vec3<S>&) { e += k_ / S(2) * (dhat_ - c.distance) * (dhat_ - c.distance); });
     return e;
   }
 
-  void add_gradient(const Points<S>& x, Points<S>& g) const {
+  template <exec::HostPolicy P>
+  void add_gradient(P, const Points<S>& x, Points<S>& g) const {
     detail::require_positions("SelfContact: x", x, n_);
     detail::require_positions("SelfContact: gradient", g, n_);
     for_each_pair(x, [&](const SelfContactPair<S>& c, const Vec3<S>& n) {
@@ -120,8 +122,10 @@ class SelfContact {
     });
   }
 
-  /// Gauss–Newton blocks k c_a c_b n nᵀ, c = (1, −β₀, −β₁, −β₂) over (vertex, corners).
-  void add_hessian(const Points<S>& x, BlockTriplets<S>& H) const {
+  /// Gauss–Newton blocks k c_a c_b n nᵀ, c = (1, −β₀, −β₁, −β₂) over (vertex, corners), for both
+  /// Definiteness values (PSD; see the file comment).
+  template <exec::HostPolicy P>
+  void add_hessian(P, const Points<S>& x, BlockHessian<S>& H, Definiteness) const {
     detail::require_positions("SelfContact: x", x, n_);
     for_each_pair(x, [&](const SelfContactPair<S>& c, const Vec3<S>& n) {
       const VIndex idx[4] = {c.vertex, F_(c.triangle, 0), F_(c.triangle, 1), F_(c.triangle, 2)};
@@ -288,6 +292,6 @@ class SelfContact {
   mutable std::vector<Index> start_, fill_;
 };
 
-static_assert(EnergyTerm<SelfContact<double>, double>);
+static_assert(assert_energy_term<SelfContact<double>, double>());
 
 }  // namespace simsr::physics

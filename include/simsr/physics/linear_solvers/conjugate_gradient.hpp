@@ -1,11 +1,13 @@
 #pragma once
 /// \file
-/// Preconditioned conjugate gradients under an execution policy, with Jacobi (1/A_ii),
-/// block-Jacobi (the inverse 3×3 vertex blocks), incomplete Cholesky or Multigrid (multigrid.hpp)
-/// preconditioning. Products and dot products run under the policy with fixed chunking, so seq
-/// and omp iterate identically.
+/// Preconditioned conjugate gradients with Jacobi (1/A_ii), block-Jacobi (the inverse 3×3 vertex
+/// blocks), incomplete Cholesky or Multigrid (multigrid.hpp) preconditioning. compute() and solve()
+/// take the execution policy first; products and dot products run under it with fixed chunking,
+/// so seq and omp iterate identically.
 ///
-///     physics::ConjugateGradient<physics::BlockJacobi<>, exec::omp_t> pcg({.tolerance = 1e-6});
+///     physics::ConjugateGradient<physics::BlockJacobi<>> pcg({.tolerance = 1e-6});
+///     pcg.compute(exec::omp, A);
+///     LinearSolveInfo info = pcg.solve(exec::omp, b, x);
 
 #include <algorithm>
 #include <cmath>
@@ -85,26 +87,30 @@ struct ConjugateGradientOptions {
 };
 
 /// PCG from x = 0 (see the file comment). Buffers are kept between solves.
-template <class Preconditioner = BlockJacobi<Scalar>, exec::HostPolicy Policy = exec::seq_t, class S = Scalar>
+template <class Preconditioner = BlockJacobi<Scalar>, class S = Scalar>
 class ConjugateGradient {
  public:
   using scalar_type = S;
   ConjugateGradient() = default;
-  explicit ConjugateGradient(ConjugateGradientOptions options, Policy policy = {}) : options_(options), policy_(policy) {}
+  explicit ConjugateGradient(ConjugateGradientOptions options) : options_(options) {}
   /// With a preconditioner that needs more than the matrix (Multigrid: its prolongations).
-  ConjugateGradient(ConjugateGradientOptions options, Preconditioner preconditioner, Policy policy = {})
-      : options_(options), policy_(policy), preconditioner_(std::move(preconditioner)) {}
+  ConjugateGradient(ConjugateGradientOptions options, Preconditioner preconditioner)
+      : options_(options), preconditioner_(std::move(preconditioner)) {}
 
   ConjugateGradientOptions& options() { return options_; }
   Preconditioner& preconditioner() { return preconditioner_; }
 
-  void compute(const SparseMatrix<S>& A, std::uint64_t /*pattern_version*/ = 0) {
+  /// Keeps A (which must outlive the solves) and sets the preconditioner up for it.
+  template <exec::HostPolicy P>
+  void compute(P policy, const SparseMatrix<S>& A, std::uint64_t /*pattern_version*/ = 0) {
     if (A.rows() != A.cols()) throw ShapeError("ConjugateGradient: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
     A_ = &A;
-    preconditioner_.compute(policy_, A);
+    preconditioner_.compute(policy, A);
   }
 
-  LinearSolveInfo solve(const VecX<S>& b, VecX<S>& x) {
+  /// x = A⁻¹ b to the relative tolerance, from x = 0.
+  template <exec::HostPolicy P>
+  LinearSolveInfo solve(P policy, const VecX<S>& b, VecX<S>& x) {
     if (!A_) throw Error("ConjugateGradient::solve called before compute");
     const Index n = A_->rows();
     if (b.size() != n) throw ShapeError("ConjugateGradient: right-hand side", {n}, {b.size()});
@@ -113,35 +119,35 @@ class ConjugateGradient {
     z_.resize(n);
     p_.resize(n);
     q_.resize(n);
-    const S bnorm = std::sqrt(dot(b, b));
+    const S bnorm = std::sqrt(physics::dot(policy, b, b));
     LinearSolveInfo info;
     if (bnorm == S(0)) return info;
     const Index max_it = options_.max_iterations > 0 ? options_.max_iterations : n;
-    preconditioner_.apply(policy_, r_, z_);
+    preconditioner_.apply(policy, r_, z_);
     p_ = z_;
-    S rz = dot(r_, z_);
+    S rz = physics::dot(policy, r_, z_);
     S rnorm = bnorm;
     for (Index it = 0; it < max_it; ++it) {
-      multiply(p_, q_);
-      const S pq = dot(p_, q_);
+      sparse_multiply(policy, *A_, p_, q_);
+      const S pq = physics::dot(policy, p_, q_);
       if (!(pq > S(0))) {  // zero or negative curvature along p: A is not positive definite
         info.converged = false;
         info.relative_residual = double(rnorm / bnorm);
         return info;
       }
       const S alpha = rz / pq;
-      exec::parallel_for(policy_, n, [&](Index i) {
+      exec::parallel_for(policy, n, [&](Index i) {
         x[i] += alpha * p_[i];
         r_[i] -= alpha * q_[i];
       });
       info.iterations = it + 1;
-      rnorm = std::sqrt(dot(r_, r_));
+      rnorm = std::sqrt(physics::dot(policy, r_, r_));
       if (rnorm <= S(options_.tolerance) * bnorm) break;
-      preconditioner_.apply(policy_, r_, z_);
-      const S rz_new = dot(r_, z_);
+      preconditioner_.apply(policy, r_, z_);
+      const S rz_new = physics::dot(policy, r_, z_);
       const S beta = rz_new / rz;
       rz = rz_new;
-      exec::parallel_for(policy_, n, [&](Index i) { p_[i] = z_[i] + beta * p_[i]; });
+      exec::parallel_for(policy, n, [&](Index i) { p_[i] = z_[i] + beta * p_[i]; });
     }
     info.relative_residual = double(rnorm / bnorm);
     info.converged = info.relative_residual <= options_.tolerance;
@@ -149,11 +155,7 @@ class ConjugateGradient {
   }
 
  private:
-  S dot(const VecX<S>& a, const VecX<S>& b) const { return physics::dot(policy_, a, b); }
-  void multiply(const VecX<S>& v, VecX<S>& out) const { sparse_multiply(policy_, *A_, v, out); }
-
   ConjugateGradientOptions options_;
-  Policy policy_;
   Preconditioner preconditioner_;
   const SparseMatrix<S>* A_ = nullptr;
   VecX<S> r_, z_, p_, q_;

@@ -5,7 +5,7 @@
 /// solves are sequential whatever the policy; it pays where it saves more PCG iterations than the
 /// parallel block-Jacobi loses in per-iteration speed.
 ///
-///     physics::ConjugateGradient<physics::IncompleteCholesky<>, exec::omp_t> pcg({.tolerance = 1e-4});
+///     physics::ConjugateGradient<physics::IncompleteCholesky<>> pcg({.tolerance = 1e-4});
 
 #include <memory>
 

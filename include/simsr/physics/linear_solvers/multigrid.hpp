@@ -18,10 +18,10 @@
 ///   sweep count, so the V-cycle is a symmetric positive definite operator, as PCG requires.
 /// - The coarsest level is solved exactly (Eigen's sparse LDLᵀ).
 ///
-///     auto levels = physics::lattice_hierarchy(mesh);                 // once per mesh
-///     using Pcg = physics::ConjugateGradient<physics::Multigrid<>, exec::omp_t>;
-///     physics::QuasistaticSolver<Pcg, exec::omp_t> newton(mesh.num_vertices(), mesh.T, {},
-///         Pcg({.tolerance = 1e-4}, physics::Multigrid<>(levels.prolongations), exec::omp), exec::omp);
+///     using Pcg = physics::ConjugateGradient<physics::Multigrid<>>;
+///     physics::QuasistaticSolver<Pcg> newton(mesh.num_vertices(), mesh.T, {},
+///         physics::make_linear_solver<Pcg>(exec::omp, mesh, {.tolerance = 1e-4}));   // levels: once per mesh
+///     newton.solve(exec::omp, x, boundary, terms...);
 ///
 /// Why: block-Jacobi PCG needs ~400 iterations per Newton system on the 73k-tet face lattice
 /// (its error in smooth, long-wavelength modes decays slowly); the V-cycle removes those modes on
@@ -71,10 +71,11 @@ struct LatticeHierarchy {
 
 /// BCC lattices of cell size h, 2h, 4h, … covering a tet mesh, and the prolongations between
 /// them (see the file comment and LatticeHierarchy). Stops at `max_coarse_vertices`, at
-/// `max_levels`, or when a level would not shrink below 60 % of the one before. Throws
-/// ArgumentError for an empty mesh or a bad h.
-template <class S>
-LatticeHierarchy<S> lattice_hierarchy(const TetMesh<S>& mesh, const LatticeHierarchyOptions& options = {}) {
+/// `max_levels`, or when a level would not shrink below 60 % of the one before. Each level's
+/// vertices are embedded in the next lattice under `policy` (same result under seq and omp).
+/// Throws ArgumentError for an empty mesh or a bad h.
+template <exec::HostPolicy Policy, class S>
+LatticeHierarchy<S> lattice_hierarchy(Policy policy, const TetMesh<S>& mesh, const LatticeHierarchyOptions& options = {}) {
   if (mesh.num_vertices() == 0 || mesh.num_tets() == 0) throw ArgumentError("lattice_hierarchy: the mesh has no tets");
   double h = options.h;
   if (h == 0) {
@@ -92,7 +93,7 @@ LatticeHierarchy<S> lattice_hierarchy(const TetMesh<S>& mesh, const LatticeHiera
   TetMesh<S> current = mesh;
   for (int level = 0; level < options.max_levels && current.num_vertices() > options.max_coarse_vertices; ++level, h *= 2) {
     const TetMesh<S> lattice = discretize::bcc_lattice(current, h).mesh;
-    const Embedding<S> emb = embed(exec::seq, lattice, current.V);
+    const Embedding<S> emb = embed(policy, lattice, current.V);
     // keep only the lattice vertices some finer vertex uses (with a nonzero weight)
     std::vector<VIndex> renumber(std::size_t(lattice.num_vertices()), VIndex(-1));
     Index used = 0;
@@ -196,7 +197,7 @@ class Multigrid {
         L.v.resize(0);
       }
       if (l + 1 == levels_.size()) {
-        factorize_coarsest(Al, l > 0 ? levels_[l - 1].galerkin.structure_version() : ++direct_version_);
+        factorize_coarsest(policy, Al, l > 0 ? levels_[l - 1].galerkin.structure_version() : ++direct_version_);
         break;
       }
       L.smoother.compute(policy, Al);
@@ -282,9 +283,10 @@ class Multigrid {
   /// are factorized with a diagonal shift of 1e-10 × the largest diagonal entry. Directions in P's
   /// null space never reach the fine level (P maps them to 0), so the shift changes nothing else;
   /// an indefinite A still shows up as a negative pivot.
-  void factorize_coarsest(const SparseMatrix<S>& A, std::uint64_t structure) {
+  template <exec::HostPolicy P>
+  void factorize_coarsest(P policy, const SparseMatrix<S>& A, std::uint64_t structure) {
     if (!coarse_solver_) coarse_solver_.emplace(levels_.size() > 1 ? 1e-10 : 0.0);
-    coarse_solver_->compute(A, structure);
+    coarse_solver_->compute(policy, A, structure);
     if (!coarse_solver_->positive_definite())
       throw ConvergenceError("Multigrid: the coarsest level (" + std::to_string(A.rows()) + " DOFs) is not positive definite, so neither is A",
                              0, std::numeric_limits<double>::quiet_NaN());
@@ -335,7 +337,7 @@ class Multigrid {
   void cycle(P policy, std::size_t l) {
     Level& L = levels_[l];
     if (l + 1 == levels_.size()) {
-      coarse_solver_->solve(L.b, L.x);
+      coarse_solver_->solve(policy, L.b, L.x);
       return;
     }
     const SparseMatrix<S>& A = L.matrix();
@@ -376,15 +378,18 @@ class Multigrid {
 /// see make_linear_solver).
 template <class L>
 inline constexpr bool is_multigrid_pcg = false;
-template <class S, exec::HostPolicy P>
-inline constexpr bool is_multigrid_pcg<ConjugateGradient<Multigrid<S>, P, S>> = true;
+template <class S>
+inline constexpr bool is_multigrid_pcg<ConjugateGradient<Multigrid<S>, S>> = true;
 
 /// A linear solver for Newton on `mesh`: Linear{} (with `options` where Linear is a
-/// ConjugateGradient), or, for PCG with Multigrid, one with the mesh's lattice hierarchy.
-template <LinearSolver Linear, class S>
-Linear make_linear_solver(const TetMesh<S>& mesh, const ConjugateGradientOptions& options = {}, const LatticeHierarchyOptions& levels = {}) {
+/// ConjugateGradient), or, for PCG with Multigrid, one with the mesh's lattice hierarchy (built
+/// under `policy`: lattice_hierarchy).
+template <class Linear, exec::HostPolicy P, class S>
+Linear make_linear_solver(P policy, const TetMesh<S>& mesh, const ConjugateGradientOptions& options = {},
+                          const LatticeHierarchyOptions& levels = {}) {
+  static_assert(assert_linear_solver<Linear>());
   if constexpr (is_multigrid_pcg<Linear>)
-    return Linear(options, Multigrid<typename Linear::scalar_type>(lattice_hierarchy(mesh, levels).prolongations));
+    return Linear(options, Multigrid<typename Linear::scalar_type>(lattice_hierarchy(policy, mesh, levels).prolongations));
   else if constexpr (requires { Linear(options); })
     return Linear(options);
   else

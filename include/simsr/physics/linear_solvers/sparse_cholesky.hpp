@@ -3,7 +3,12 @@
 /// Sparse direct solver: Eigen's simplicial LDLᵀ with AMD ordering. The symbolic analysis is
 /// redone only when the Hessian's pattern changes; each Newton iteration refactorizes.
 ///
-///     physics::QuasistaticSolver<physics::SparseCholesky<>> newton;
+///     physics::QuasistaticSolver<physics::SparseCholesky<>> newton(mesh.num_vertices(), mesh.T);
+///     chol.compute(exec::seq, A, pattern_version);  chol.solve(exec::seq, b, x);
+///
+/// The factorization and the triangular solves are sequential whatever the policy; the policy
+/// runs the residual check ‖b − A x‖ (under exec::seq no thread is started: Eigen's own sparse
+/// product would start OpenMP threads).
 
 #include <cmath>
 #include <cstdint>
@@ -14,8 +19,10 @@
 #include <Eigen/SparseCore>
 
 #include "../../core/error.hpp"
+#include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
 #include "linear_solver.hpp"
+#include "sparse_ops.hpp"
 
 namespace simsr::physics {
 
@@ -33,7 +40,8 @@ class SparseCholesky {
 
   /// Throws ConvergenceError (0 iterations, residual NaN) when the factorization breaks down
   /// (a zero pivot: the matrix is singular, e.g. rigid motions left unconstrained).
-  void compute(const SparseMatrix<S>& A, std::uint64_t pattern_version = 0) {
+  template <exec::HostPolicy P>
+  void compute(P, const SparseMatrix<S>& A, std::uint64_t pattern_version = 0) {
     if (A.rows() != A.cols()) throw ShapeError("SparseCholesky: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
     // A symmetric row-major CSR read as column-major is its transpose, i.e. itself.
     const Eigen::Map<const Eigen::SparseMatrix<S, Eigen::ColMajor, int>> Ac(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(),
@@ -56,13 +64,15 @@ class SparseCholesky {
   /// Whether the last factorized matrix was positive definite (every pivot of D > 0).
   bool positive_definite() const { return ldlt_ && (ldlt_->vectorD().array() > S(0)).all(); }
 
-  LinearSolveInfo solve(const VecX<S>& b, VecX<S>& x) {
+  /// x = A⁻¹ b; the relative residual is computed under `policy`.
+  template <exec::HostPolicy P>
+  LinearSolveInfo solve(P policy, const VecX<S>& b, VecX<S>& x) {
     if (!A_) throw Error("SparseCholesky::solve called before compute");
     if (b.size() != rows_) throw ShapeError("SparseCholesky: right-hand side", {rows_}, {b.size()});
     x = ldlt_->solve(b);
     LinearSolveInfo info;
     const S bn = b.norm();
-    Ax_.noalias() = (*A_) * x;  // into a kept buffer: no allocation per Newton iteration
+    sparse_multiply(policy, *A_, x, Ax_);  // into a kept buffer: no allocation per Newton iteration
     info.relative_residual = bn > S(0) ? double((b - Ax_).norm() / bn) : 0.0;
     info.converged = std::isfinite(info.relative_residual);
     return info;

@@ -35,15 +35,60 @@ enum class Definiteness {
 /// Per-element data of a material that has none (isotropic models).
 struct NoElementData {};
 
+namespace detail {
+template <class M>
+concept HasMaterialTypes = requires {
+  typename M::scalar_type;
+  typename M::Element;
+};
+template <class M>
+concept HasMaterialEnergy = HasMaterialTypes<M> && requires(const M& m, const Mat3<typename M::scalar_type>& F, const typename M::Element& e) {
+  { m.energy(F, e) } -> std::convertible_to<typename M::scalar_type>;
+};
+template <class M>
+concept HasMaterialStress = HasMaterialTypes<M> && requires(const M& m, const Mat3<typename M::scalar_type>& F, const typename M::Element& e) {
+  { m.stress(F, e) } -> std::convertible_to<Mat3<typename M::scalar_type>>;
+};
+template <class M>
+concept HasMaterialStressDerivative =
+    HasMaterialTypes<M> && requires(const M& m, const Mat3<typename M::scalar_type>& F, const typename M::Element& e, Definiteness d) {
+      { m.stress_derivative(F, e, d) } -> std::convertible_to<Mat9<typename M::scalar_type>>;
+    };
+}  // namespace detail
+
 /// A hyperelastic material: energy density ψ(F) per unit rest volume, P = ∂ψ/∂F and ∂P/∂F, all
 /// defined for every F including degenerate and inverted ones (materials say how they extend).
 template <class M>
-concept Material = requires(const M& m, const Mat3<typename M::scalar_type>& F, const typename M::Element& e) {
-  typename M::scalar_type;
-  typename M::Element;
-  { m.energy(F, e) } -> std::convertible_to<typename M::scalar_type>;
-  { m.stress(F, e) } -> std::convertible_to<Mat3<typename M::scalar_type>>;
-  { m.stress_derivative(F, e, Definiteness::project) } -> std::convertible_to<Mat9<typename M::scalar_type>>;
+concept Material = detail::HasMaterialTypes<M> && detail::HasMaterialEnergy<M> && detail::HasMaterialStress<M> &&
+                   detail::HasMaterialStressDerivative<M>;
+
+/// `static_assert(assert_material<M>())`: a type that is not a Material stops the build with one
+/// sentence naming the first thing it lacks (and nothing else: the function returns true once its
+/// own assertion has spoken).
+template <class M>
+constexpr bool assert_material() {
+  using namespace detail;
+  constexpr int lacks = !HasMaterialTypes<M> ? 0 : !HasMaterialEnergy<M> ? 1 : !HasMaterialStress<M> ? 2 : !HasMaterialStressDerivative<M> ? 3 : -1;
+  static_assert(lacks != 0, "this type is not a physics::Material: it lacks the member types scalar_type and Element (NoElementData for none)");
+  static_assert(lacks != 1, "this type is not a physics::Material: it lacks energy(const Mat3& F, const Element&) const -> scalar_type (psi)");
+  static_assert(lacks != 2, "this type is not a physics::Material: it lacks stress(const Mat3& F, const Element&) const -> Mat3 (P = dpsi/dF)");
+  static_assert(lacks != 3, "this type is not a physics::Material: it lacks stress_derivative(const Mat3& F, const Element&, Definiteness) const -> Mat9");
+  return true;
+}
+
+namespace detail {
+/// M's scalar_type and Element, or stand-ins when M lacks them (so a class that asserts
+/// Material<M> reports that sentence and no follow-on error).
+template <class M>
+struct material_types {
+  using scalar_type = Scalar;
+  using Element = NoElementData;
 };
+template <HasMaterialTypes M>
+struct material_types<M> {
+  using scalar_type = typename M::scalar_type;
+  using Element = typename M::Element;
+};
+}  // namespace detail
 
 }  // namespace simsr::physics

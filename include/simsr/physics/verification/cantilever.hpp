@@ -6,7 +6,8 @@
 /// I = W H³ / 12. Small load (δ/L ≈ 1.5 % by default) and ν = 0, so linear beam theory is the
 /// right reference up to shear (≈ 0.7 % at L/H = 10, Timoshenko) and discretization error.
 ///
-///     auto r = physics::solve_cantilever({.cells_through_height = 8});   // r.relative_error
+///     auto r = physics::solve_cantilever(exec::seq, {.cells_through_height = 8});   // r.relative_error
+///     auto p = physics::solve_cantilever<physics::ConjugateGradient<physics::Multigrid<>>>(exec::omp, options);
 
 #include <chrono>
 #include <cmath>
@@ -64,9 +65,11 @@ inline double euler_bernoulli_tip_deflection(const CantileverOptions& o) {
   return q * std::pow(o.length, 4) / (8 * o.young * I);
 }
 
-/// Builds, solves (Newton from rest; sparse Cholesky unless Linear says otherwise) and measures the beam.
-template <LinearSolver Linear = SparseCholesky<Scalar>, exec::HostPolicy Policy = exec::seq_t>
-CantileverResult solve_cantilever(const CantileverOptions& o, Policy policy = {}) {
+/// Builds, solves (Newton from rest under `policy`; sparse Cholesky unless Linear says otherwise)
+/// and measures the beam. Throws ArgumentError for a resolution that does not fit the beam.
+template <class Linear = SparseCholesky<Scalar>, exec::HostPolicy P>
+CantileverResult solve_cantilever(P policy, const CantileverOptions& o) {
+  static_assert(assert_linear_solver<Linear>());
   if (o.cells_through_height < 1) throw ArgumentError("solve_cantilever: cells_through_height must be ≥ 1");
   const auto t0 = std::chrono::steady_clock::now();
   const double h = o.height / double(o.cells_through_height);
@@ -82,7 +85,7 @@ CantileverResult solve_cantilever(const CantileverOptions& o, Policy policy = {}
   if (o.discretization == BeamDiscretization::embedded_bcc) mesh = discretize::bcc_lattice(boundary_surface(box), h).mesh;
 
   const auto material = NeoHookean<>::from_young_poisson(o.young, o.poisson);
-  ElasticEnergy<NeoHookean<>, Policy> elastic(mesh, material, {}, policy);
+  ElasticEnergy<NeoHookean<>> elastic(mesh, material);
   Gravity<> gravity(mesh, o.density, Vec3<>(0, 0, -o.gravity));
   BoneAttachments<> clamp(mesh.V);
   clamp.add_bone("wall", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.x() <= 1e-9 * o.length; }));
@@ -90,12 +93,12 @@ CantileverResult solve_cantilever(const CantileverOptions& o, Policy policy = {}
   const IndexVector tip = select_vertices(box.V, [&](const Vec3<>& p) { return p.x() >= o.length * (1 - 1e-9); });
   Points<> tip_rest(tip.size(), 3);
   for (Index k = 0; k < tip.size(); ++k) tip_rest.row(k) = box.V.row(tip[k]);
-  const auto emb = embed(mesh, tip_rest);
+  const auto emb = embed(policy, mesh, tip_rest);
 
-  QuasistaticSolver<Linear, Policy> newton(mesh.num_vertices(), mesh.T, o.newton, make_linear_solver<Linear>(mesh), policy);
+  QuasistaticSolver<Linear> newton(mesh.num_vertices(), mesh.T, o.newton, make_linear_solver<Linear>(policy, mesh));
   Points<> x = mesh.V;
-  const NewtonReport rep = newton.solve(x, clamp.boundary(), elastic, gravity);
-  const Points<> tip_now = deform(emb, mesh.T, x);
+  const NewtonReport rep = newton.solve(policy, x, clamp.boundary(), elastic, gravity);
+  const Points<> tip_now = deform(policy, emb, mesh.T, x);
 
   CantileverResult r;
   r.tip_deflection = -(tip_now.col(2) - tip_rest.col(2)).mean();
