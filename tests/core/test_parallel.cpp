@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <random>
 #include <stdexcept>
@@ -13,6 +15,28 @@
 using namespace simsr;
 
 namespace {
+/// Sets exec::omp's fork mode for a scope (adaptive again afterwards).
+struct ForkMode {
+  explicit ForkMode(exec::OmpFork mode) { exec::set_omp_fork(mode); }
+  ~ForkMode() { exec::set_omp_fork(exec::OmpFork::adaptive); }
+};
+
+/// For a scope, parallel regions look ruinously dear to the adaptive exec::omp (no probe is due
+/// either), so every omp loop runs on the calling thread, as beside a busy process.
+struct OmpOnCaller {
+  ForkMode adaptive{exec::OmpFork::adaptive};
+  double excess = exec::detail::region_cost.excess_ns.load();
+  std::int64_t last = exec::detail::region_cost.last_region_ns.load();
+  OmpOnCaller() {
+    exec::detail::region_cost.excess_ns = 1e15;
+    exec::detail::region_cost.last_region_ns = exec::detail::now_ns() + std::int64_t(1e15);
+  }
+  ~OmpOnCaller() {
+    exec::detail::region_cost.excess_ns = excess;
+    exec::detail::region_cost.last_region_ns = last;
+  }
+};
+
 std::vector<double> random_values(Index n, unsigned seed) {
   std::mt19937_64 rng(seed);
   std::lognormal_distribution<double> d(0.0, 3.0);  // wide dynamic range: rounding order matters
@@ -72,6 +96,10 @@ TEST_CASE("for_chunks: every chunk once, per-worker ranges, the same chunks unde
 }
 
 TEST_CASE("parallel_for: seq and omp write the same values") {
+  exec::OmpFork mode = exec::OmpFork::adaptive;
+  SUBCASE("exec::omp forking always") { mode = exec::OmpFork::always; }
+  SUBCASE("exec::omp adaptive") {}
+  const ForkMode fork(mode);
   for (unsigned seed = 0; seed < 20; ++seed) {
     const Index n = 1 + Index(seed) * 997;
     auto x = random_values(n, seed);
@@ -84,6 +112,10 @@ TEST_CASE("parallel_for: seq and omp write the same values") {
 }
 
 TEST_CASE("parallel_reduce: seq and omp are bitwise identical and match a plain sum closely") {
+  exec::OmpFork mode = exec::OmpFork::adaptive;
+  SUBCASE("exec::omp forking always") { mode = exec::OmpFork::always; }
+  SUBCASE("exec::omp adaptive") {}
+  const ForkMode fork(mode);
   for (unsigned seed = 0; seed < 50; ++seed) {
     const Index n = Index(seed) * 4111 + Index(seed % 7);
     auto x = random_values(n, 100 + seed);
@@ -103,6 +135,10 @@ TEST_CASE("parallel_reduce: seq and omp are bitwise identical and match a plain 
 }
 
 TEST_CASE("parallel_reduce with a non-commutative-safe combine (max with index)") {
+  exec::OmpFork mode = exec::OmpFork::adaptive;
+  SUBCASE("exec::omp forking always") { mode = exec::OmpFork::always; }
+  SUBCASE("exec::omp adaptive") {}
+  const ForkMode fork(mode);
   auto x = random_values(100000, 7);
   using P = std::pair<double, Index>;
   auto map = [&](Index i) { return P{x[i], i}; };
@@ -115,6 +151,10 @@ TEST_CASE("parallel_reduce with a non-commutative-safe combine (max with index)"
 }
 
 TEST_CASE("parallel_for_accumulate: scatter-add like FEM assembly, seq == omp bitwise") {
+  exec::OmpFork mode = exec::OmpFork::adaptive;
+  SUBCASE("exec::omp forking always") { mode = exec::OmpFork::always; }
+  SUBCASE("exec::omp adaptive") {}
+  const ForkMode fork(mode);
   // Random "elements" scattering values into a shared vector, as element gradients do.
   std::mt19937 rng(3);
   const Index nodes = 500, elems = 20000;
@@ -140,6 +180,10 @@ TEST_CASE("parallel_for_accumulate: scatter-add like FEM assembly, seq == omp bi
 }
 
 TEST_CASE("an exception thrown inside an omp body reaches the caller") {
+  exec::OmpFork mode = exec::OmpFork::adaptive;
+  SUBCASE("exec::omp forking always") { mode = exec::OmpFork::always; }
+  SUBCASE("exec::omp adaptive") {}
+  const ForkMode fork(mode);
   auto thrower = [](Index i) {
     if (i == 777) throw ArgumentError("element 777 is bad");
   };
@@ -154,12 +198,72 @@ TEST_CASE("an exception thrown inside an omp body reaches the caller") {
 
 TEST_CASE("omp really runs on several threads when asked") {
   CHECK(exec::omp_max_threads() >= 1);
-  std::vector<int> seen(1, 0);
 #if defined(_OPENMP)
-  std::vector<int> owner(64);
-  exec::parallel_for(exec::omp, 64, [&](Index i) { owner[i] = omp_get_thread_num(); });
-  if (exec::omp_max_threads() > 1) CHECK(*std::max_element(owner.begin(), owner.end()) > 0);
+  const ForkMode always(exec::OmpFork::always);
+  std::vector<int> team(64);  // the team's size, not who ran what: hand-out is dynamic
+  exec::parallel_for(exec::omp, 64, [&](Index i) { team[i] = omp_get_num_threads(); });
+  if (exec::omp_max_threads() > 1) CHECK(*std::min_element(team.begin(), team.end()) == std::min(64, exec::omp_max_threads()));
 #endif
+}
+
+TEST_CASE("exec::omp on the calling thread (a loop that does not pay for a region): same results, Eigen single-threaded") {
+  const OmpOnCaller on_caller;
+  std::vector<char> in_region(1000, 1);
+  std::vector<int> eigen_threads(1000, 0);
+  exec::parallel_for(exec::omp, 1000, [&](Index i) {
+#if defined(_OPENMP)
+    in_region[std::size_t(i)] = omp_in_parallel();
+#else
+    in_region[std::size_t(i)] = 0;
+#endif
+    eigen_threads[std::size_t(i)] = Eigen::nbThreads();
+  });
+  CHECK(std::count(in_region.begin(), in_region.end(), 0) == 1000);
+  CHECK(std::count(eigen_threads.begin(), eigen_threads.end(), 1) == 1000);  // its GEMM would fork otherwise
+  for (unsigned seed = 0; seed < 5; ++seed) {
+    const Index n = Index(seed) * 7919 + 3;
+    auto x = random_values(n, 300 + seed);
+    auto map = [&](Index i) { return x[i]; };
+    CHECK(exec::parallel_reduce(exec::seq, n, 0.0, map, std::plus<>{}) == exec::parallel_reduce(exec::omp, n, 0.0, map, std::plus<>{}));
+    auto make = [] { return std::vector<double>(7, 0.0); };
+    auto body = [&](Index i, std::vector<double>& acc) { acc[std::size_t(i % 7)] += x[i]; };
+    auto merge = [](std::vector<double>& total, std::vector<double>&& part) {
+      for (std::size_t i = 0; i < total.size(); ++i) total[i] += part[i];
+    };
+    CHECK(exec::parallel_for_accumulate(exec::seq, n, make, body, merge) == exec::parallel_for_accumulate(exec::omp, n, make, body, merge));
+  }
+  auto thrower = [](Index i) {
+    if (i == 77) throw ArgumentError("element 77 is bad");
+  };
+  CHECK_THROWS_AS(exec::parallel_for(exec::omp, 100, thrower), ArgumentError);
+}
+
+TEST_CASE("exec::omp (adaptive): a loop too small to pay for a region soon runs on the calling thread") {
+  const ForkMode adaptive(exec::OmpFork::adaptive);
+  std::vector<double> y(16);
+  int in_region_last = 0;
+  for (int call = 0; call < 100; ++call) {
+    std::atomic<int> in_region{0};
+    exec::parallel_for(exec::omp, 16, [&](Index i) {
+      y[std::size_t(i)] = double(i) * 0.5;
+#if defined(_OPENMP)
+      if (omp_in_parallel()) in_region = 1;
+#endif
+    });
+    if (call >= 90) in_region_last += in_region;
+  }
+  CHECK(in_region_last == 0);
+}
+
+TEST_CASE("EigenSingleThreaded: Eigen on one thread while alive, the thread count restored after") {
+  const int before = exec::omp_max_threads();
+  {
+    const EigenSingleThreaded serial;
+    CHECK(Eigen::nbThreads() == 1);
+    CHECK(exec::omp_max_threads() == 1);
+  }
+  CHECK(exec::omp_max_threads() == before);
+  CHECK(Eigen::nbThreads() == before);
 }
 
 TEST_CASE("policy concepts") {

@@ -1,7 +1,9 @@
 #pragma once
 /// \file
-/// Umbrella of the core area: aliases, errors, execution policies and parallel primitives.
+/// Umbrella of the core area: aliases, errors, execution policies and parallel primitives, and
+/// Eigen kept single-threaded.
 
+#include "eigen_threads.hpp"
 #include "error.hpp"
 #include "host_device.hpp"
 #include "parallel.hpp"

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <memory>
 
+#include "eigen_threads.hpp"
 #include "types.hpp"
 
 namespace simsr {
@@ -18,7 +19,7 @@ namespace simsr {
 /// threads, which oversubscribes the cores and makes rounding depend on where it runs (it made the
 /// feature kNN 5× slower on a loaded machine). This calls Eigen 3.4's packed kernel directly with
 /// one thread and packing buffers sized once in reserve(); other Eigen versions fall back to the
-/// public product.
+/// public product with Eigen's threads off (EigenSingleThreaded).
 /// Rounding depends on (m, n, k) and the reserved sizes only, never on the thread.
 template <class S>
 class SerialGemm {
@@ -62,6 +63,7 @@ class SerialGemm {
       if (b_t) return Eigen::Map<const CM, 0, Stride>(B, k, n, Stride(ldb));
       return Eigen::Map<const Matrix, 0, Stride>(B, k, n, Stride(ldb));
     };
+    const EigenSingleThreaded eigen_serial;
     Cm.noalias() += opA() * opB();
 #endif
   }

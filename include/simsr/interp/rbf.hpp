@@ -48,6 +48,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include "../core/eigen_threads.hpp"
 #include "concepts.hpp"
 #include "detail/kernel.hpp"
 #include "detail/rbf_distances.hpp"
@@ -231,6 +232,7 @@ class RBF {
         for (Index q = 0; q < p_; ++q) K(i, n_ + q) = K(n_ + q, i) = mono(q);
       }
       info_.lr_nonzeros = np * np;
+      const EigenSingleThreaded eigen_serial;  // the blocked LU's GEMM would start threads of its own
       lu_.compute(K);
       info_.rcond = lu_.rcond();
       check_rcond();

@@ -26,6 +26,7 @@
 
 #include <Eigen/Dense>
 
+#include "../core/eigen_threads.hpp"
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
 #include "../core/types.hpp"
@@ -115,6 +116,8 @@ class Ridge {
     X_.rowwise() -= x_mean_;
     Y_.rowwise() -= y_mean_;
 
+    // Eigen's products and eigen-solver below would start threads of their own (any policy).
+    const EigenSingleThreaded eigen_serial;
     // K = X Xᵀ in double: its eigenvalues span many decades on near-linear data.
     const Eigen::MatrixXd Xd = X_.template cast<double>();
     const Eigen::MatrixXd K = Xd * Xd.transpose();

@@ -5,20 +5,47 @@
 /// one is rethrown on the calling thread (an exception escaping an OpenMP region would terminate).
 /// Eigen stays single-threaded inside these regions (it checks omp_get_num_threads() > 1), so
 /// there is no nested parallelism.
+///
+/// A loop forks a team only when that pays (OmpFork::adaptive, the default). Every loop is timed:
+/// each call site (one per body type) learns the work per item, and the process learns what a
+/// parallel region costs beyond its work (waking the team, the join, a thread that the OS did not
+/// run). A loop whose work would save less than that cost runs on the calling thread.
+/// On an idle machine a region costs microseconds, so only tiny loops stay on the caller; beside a
+/// busy process a region can cost milliseconds — libgomp's idle threads spin, and a join waits
+/// for a thread the scheduler put off — and the loops run on the caller instead of collapsing
+/// (README, "Execution policies"). Now and then one region is run anyway to measure its cost
+/// again, so the threads come back when the machine is idle again. Inside a region the chunks are
+/// handed out dynamically: a thread that is not running does not hold up the others' work.
+/// None of this changes a result: chunks are fixed and combined in order whoever runs them.
 
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <mutex>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "../eigen_threads.hpp"
 #include "chunks.hpp"
 #include "policy.hpp"
+#include "seq.hpp"
 
 #if defined(_OPENMP)
 #include <omp.h>
 #endif
 
 namespace simsr::exec {
+
+/// When an exec::omp loop forks a team of threads.
+enum class OmpFork {
+  adaptive,  ///< when the loop's measured work pays for the measured cost of a region (default)
+  always,    ///< every loop of at least 2 items (no measurement): for benchmarks and tests
+};
 
 namespace detail {
 /// Remembers the first exception thrown by any worker.
@@ -42,6 +69,131 @@ class FirstException {
   std::exception_ptr first_;
 };
 
+inline std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// What the process has measured about its parallel regions (shared by every call site).
+struct RegionCost {
+  /// Moving average of (wall time − work / threads) over recent regions, ns: the price of forking.
+  std::atomic<double> excess_ns{5000.0};
+  /// steady clock (ns) of the last region: a probe is due when it is long ago.
+  std::atomic<std::int64_t> last_region_ns{0};
+  /// OmpFork; -1 until first read (SIMSR_OMP_FORK=always in the environment selects always).
+  std::atomic<int> mode{-1};
+};
+inline RegionCost region_cost;
+
+/// Work per item (ns) of one call site, identified by its body's type; < 0 until measured.
+template <class Site>
+inline std::atomic<double> site_ns_per_item{-1.0};
+
+/// Forking must save at least this much (ns) beyond the measured price of a region.
+inline constexpr double min_fork_saving_ns = 2000.0;
+/// Serial runs predicted shorter than this (ns) are not timed (two clock reads cost ~50 ns).
+inline constexpr double min_timed_ns = 2000.0;
+
+inline OmpFork omp_fork_mode() {
+  int m = region_cost.mode.load(std::memory_order_relaxed);
+  if (m < 0) {
+    const char* env = std::getenv("SIMSR_OMP_FORK");
+    m = int(env && std::strcmp(env, "always") == 0 ? OmpFork::always : OmpFork::adaptive);
+    region_cost.mode.store(m, std::memory_order_relaxed);
+  }
+  return OmpFork(m);
+}
+
+/// Per-item cost: falls fast (a measurement can only be inflated, by preemption or a cold cache)
+/// and rises slowly.
+template <class Site>
+void record_work(Index n, double work_ns) {
+  const double sample = work_ns / double(std::max<Index>(n, 1));
+  auto& site = site_ns_per_item<Site>;
+  const double old = site.load(std::memory_order_relaxed);
+  site.store(old < 0 ? sample : old + (sample - old) * (sample < old ? 0.5 : 0.0625), std::memory_order_relaxed);
+}
+
+inline void record_region(double wall_ns, double work_ns, int threads) {
+  const double sample = std::max(0.0, wall_ns - work_ns / threads);
+  const double old = region_cost.excess_ns.load(std::memory_order_relaxed);
+  region_cost.excess_ns.store(old + (sample - old) * 0.125, std::memory_order_relaxed);
+  region_cost.last_region_ns.store(now_ns(), std::memory_order_relaxed);
+}
+
+/// How an omp loop over n items at `Site` runs now: 0 on the calling thread untimed, 1 on the
+/// calling thread timed, 2 in a team of `threads`.
+template <class Site>
+int fork_decision(Index n, int threads) {
+  if (threads < 2 || n < 2) return 0;
+  if (omp_fork_mode() == OmpFork::always) return 2;
+  const double per_item = site_ns_per_item<Site>.load(std::memory_order_relaxed);
+  const double excess = region_cost.excess_ns.load(std::memory_order_relaxed);
+  // First call: a region measures the work (and the region's price), unless regions are dear.
+  if (per_item < 0) return excess < 50000.0 ? 2 : 1;
+  const double work = per_item * double(n);
+  const double saving = work * (1.0 - 1.0 / double(std::min<Index>(threads, n)));
+  if (saving > excess + min_fork_saving_ns) return 2;
+  if (saving > min_fork_saving_ns) {  // a probe, at most every 64 prices (1 ms to 0.25 s)
+    const std::int64_t now = now_ns();
+    std::int64_t last = region_cost.last_region_ns.load(std::memory_order_relaxed);
+    const double interval = std::clamp(64.0 * excess, 1e6, 2.5e8);
+    if (double(now - last) > interval && region_cost.last_region_ns.compare_exchange_strong(last, now, std::memory_order_relaxed))
+      return 2;
+  }
+  return work >= min_timed_ns ? 1 : 0;
+}
+
+#if defined(_OPENMP)
+/// Wall time, summed busy time of the threads (ns) and team size of one region.
+struct TeamRun {
+  double wall_ns = 0, work_ns = 0;
+  int threads = 1;
+};
+
+/// Runs chunk(c) for c in [0, chunks) on a team of at most `threads` (dynamic hand-out) and
+/// rethrows the first exception.
+template <class Chunk>
+TeamRun run_team(Index chunks, int threads, Chunk&& chunk) {
+  TeamRun run;
+  run.threads = int(std::min<Index>(threads, chunks));
+  FirstException error;
+  std::atomic<std::int64_t> busy{0};
+  const std::int64_t t0 = now_ns();
+#pragma omp parallel num_threads(run.threads)
+  {
+    const std::int64_t start = now_ns();
+#pragma omp for schedule(dynamic, 1) nowait
+    for (Index c = 0; c < chunks; ++c) error.run([&] { chunk(c); });
+    busy.fetch_add(now_ns() - start, std::memory_order_relaxed);
+  }
+  run.wall_ns = double(now_ns() - t0);
+  error.rethrow();
+  run.work_ns = double(busy.load(std::memory_order_relaxed));
+  return run;
+}
+
+/// Runs `serial()` or `parallel(threads)` (a TeamRun) as fork_decision says and records what it
+/// measured. The serial path keeps Eigen single-threaded, as it is inside a region.
+template <class Site, class Serial, class Parallel>
+void dispatch(Index n, Serial&& serial, Parallel&& parallel) {
+  const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
+  const int decision = fork_decision<Site>(n, threads);
+  if (decision < 2) {
+    // On the calling thread outside a region, where Eigen would start threads of its own.
+    const EigenSingleThreaded eigen_serial;
+    if (decision == 0) return serial();
+    const std::int64_t t0 = now_ns();
+    serial();
+    record_work<Site>(n, double(now_ns() - t0));
+    return;
+  }
+  const TeamRun run = parallel(threads);
+  if (omp_fork_mode() == OmpFork::adaptive) {
+    record_work<Site>(n, run.work_ns);
+    record_region(run.wall_ns, run.work_ns, run.threads);
+  }
+}
+#endif
 }  // namespace detail
 
 /// static_assert text for omp algorithms instantiated without OpenMP.
@@ -58,14 +210,26 @@ inline int omp_max_threads() {
 #endif
 }
 
-/// Calls `body(i)` for i = 0..n-1 on OpenMP threads (static schedule).
+/// Sets when exec::omp loops fork a team, process-wide (the environment variable
+/// SIMSR_OMP_FORK=always sets OmpFork::always at start-up).
+inline void set_omp_fork(OmpFork mode) { detail::region_cost.mode.store(int(mode), std::memory_order_relaxed); }
+/// When exec::omp loops fork a team (OmpFork::adaptive unless set otherwise).
+inline OmpFork omp_fork() { return detail::omp_fork_mode(); }
+
+/// Calls `body(i)` for i = 0..n-1 on OpenMP threads (contiguous chunks, handed out dynamically),
+/// or on the calling thread when forking does not pay (see the file comment).
 template <class Body>
 void parallel_for(omp_t, Index n, Body&& body) {
 #if defined(_OPENMP)
-  detail::FirstException error;
-#pragma omp parallel for schedule(static)
-  for (Index i = 0; i < n; ++i) error.run([&] { body(i); });
-  error.rethrow();
+  detail::dispatch<std::remove_cvref_t<Body>>(
+      n, [&] { parallel_for(seq, n, body); },
+      [&](int threads) {
+        const Index nc = std::min<Index>(n, 8 * Index(threads));
+        return detail::run_team(nc, threads, [&](Index c) {
+          const auto [b, e] = chunk_range(n, nc, c);
+          for (Index i = b; i < e; ++i) body(i);
+        });
+      });
 #else
   static_assert(detail::dependent_false<Body>, SIMSR_OMP_MISSING);
 #endif
@@ -76,20 +240,20 @@ void parallel_for(omp_t, Index n, Body&& body) {
 template <class T, class Map, class Combine>
 T parallel_reduce(omp_t, Index n, T identity, Map&& map, Combine&& combine, Index chunks = default_chunks) {
 #if defined(_OPENMP)
-  const Index nc = chunk_count(n, chunks);
-  std::vector<T> parts(static_cast<std::size_t>(nc), identity);
-  detail::FirstException error;
-#pragma omp parallel for schedule(dynamic, 1)
-  for (Index c = 0; c < nc; ++c) {
-    error.run([&] {
-      auto [b, e] = chunk_range(n, nc, c);
-      T part = identity;
-      for (Index i = b; i < e; ++i) part = combine(part, map(i));
-      parts[static_cast<std::size_t>(c)] = std::move(part);
-    });
-  }
-  error.rethrow();
   T total = identity;
+  std::vector<T> parts;
+  detail::dispatch<std::remove_cvref_t<Map>>(
+      n, [&] { total = parallel_reduce(seq, n, identity, map, combine, chunks); },
+      [&](int threads) {
+        const Index nc = chunk_count(n, chunks);
+        parts.assign(static_cast<std::size_t>(nc), identity);
+        return detail::run_team(nc, threads, [&](Index c) {
+          auto [b, e] = chunk_range(n, nc, c);
+          T part = identity;
+          for (Index i = b; i < e; ++i) part = combine(part, map(i));
+          parts[static_cast<std::size_t>(c)] = std::move(part);
+        });
+      });
   for (auto& p : parts) total = combine(total, p);
   return total;
 #else
@@ -103,22 +267,21 @@ T parallel_reduce(omp_t, Index n, T identity, Map&& map, Combine&& combine, Inde
 template <class Make, class Body, class Merge>
 auto parallel_for_accumulate(omp_t, Index n, Make&& make, Body&& body, Merge&& merge, Index chunks = 16) {
 #if defined(_OPENMP)
-  const Index nc = chunk_count(n, chunks);
   using Acc = decltype(make());
   std::vector<Acc> accs;
-  accs.reserve(static_cast<std::size_t>(nc));
-  for (Index c = 0; c < nc; ++c) accs.push_back(make());
-  detail::FirstException error;
-#pragma omp parallel for schedule(dynamic, 1)
-  for (Index c = 0; c < nc; ++c) {
-    error.run([&] {
-      auto [b, e] = chunk_range(n, nc, c);
-      for (Index i = b; i < e; ++i) body(i, accs[static_cast<std::size_t>(c)]);
-    });
-  }
-  error.rethrow();
+  detail::dispatch<std::remove_cvref_t<Body>>(
+      n, [&] { accs.push_back(parallel_for_accumulate(seq, n, make, body, merge, chunks)); },
+      [&](int threads) {
+        const Index nc = chunk_count(n, chunks);
+        accs.reserve(static_cast<std::size_t>(nc));
+        for (Index c = 0; c < nc; ++c) accs.push_back(make());
+        return detail::run_team(nc, threads, [&](Index c) {
+          auto [b, e] = chunk_range(n, nc, c);
+          for (Index i = b; i < e; ++i) body(i, accs[static_cast<std::size_t>(c)]);
+        });
+      });
   Acc total = std::move(accs[0]);
-  for (Index c = 1; c < nc; ++c) merge(total, std::move(accs[static_cast<std::size_t>(c)]));
+  for (std::size_t c = 1; c < accs.size(); ++c) merge(total, std::move(accs[c]));
   return total;
 #else
   static_assert(detail::dependent_false<Make>, SIMSR_OMP_MISSING);
