@@ -6,7 +6,6 @@
 #include <array>
 #include <atomic>
 #include <cmath>
-#include <cstdint>
 #include <functional>
 #include <random>
 #include <stdexcept>
@@ -19,22 +18,6 @@ namespace {
 struct ForkMode {
   explicit ForkMode(exec::OmpFork mode) { exec::set_omp_fork(mode); }
   ~ForkMode() { exec::set_omp_fork(exec::OmpFork::adaptive); }
-};
-
-/// For a scope, parallel regions look ruinously dear to the adaptive exec::omp (no probe is due
-/// either), so every omp loop runs on the calling thread, as beside a busy process.
-struct OmpOnCaller {
-  ForkMode adaptive{exec::OmpFork::adaptive};
-  double excess = exec::detail::region_cost.excess_ns.load();
-  std::int64_t last = exec::detail::region_cost.last_region_ns.load();
-  OmpOnCaller() {
-    exec::detail::region_cost.excess_ns = 1e15;
-    exec::detail::region_cost.last_region_ns = exec::detail::now_ns() + std::int64_t(1e15);
-  }
-  ~OmpOnCaller() {
-    exec::detail::region_cost.excess_ns = excess;
-    exec::detail::region_cost.last_region_ns = last;
-  }
 };
 
 std::vector<double> random_values(Index n, unsigned seed) {
@@ -207,7 +190,7 @@ TEST_CASE("omp really runs on several threads when asked") {
 }
 
 TEST_CASE("exec::omp on the calling thread (a loop that does not pay for a region): same results, Eigen single-threaded") {
-  const OmpOnCaller on_caller;
+  const ForkMode never(exec::OmpFork::never);
   std::vector<char> in_region(1000, 1);
   std::vector<int> eigen_threads(1000, 0);
   exec::parallel_for(exec::omp, 1000, [&](Index i) {

@@ -3,19 +3,22 @@
 /// OpenMP backend. Needs simsr::openmp (-fopenmp); without it, instantiating an omp algorithm is a
 /// static_assert that says so. Exceptions thrown by a body are caught in the worker and the first
 /// one is rethrown on the calling thread (an exception escaping an OpenMP region would terminate).
-/// Eigen stays single-threaded inside these regions (it checks omp_get_num_threads() > 1), so
-/// there is no nested parallelism.
+/// Eigen stays single-threaded inside these regions (it checks omp_get_num_threads() > 1), and on
+/// the calling thread when a loop runs there (EigenSingleThreaded), so there is no nested
+/// parallelism.
 ///
-/// A loop forks a team only when that pays (OmpFork::adaptive, the default). Every loop is timed:
-/// each call site (one per body type) learns the work per item, and the process learns what a
-/// parallel region costs beyond its work (waking the team, the join, a thread that the OS did not
-/// run). A loop whose work would save less than that cost runs on the calling thread.
-/// On an idle machine a region costs microseconds, so only tiny loops stay on the caller; beside a
-/// busy process a region can cost milliseconds — libgomp's idle threads spin, and a join waits
-/// for a thread the scheduler put off — and the loops run on the caller instead of collapsing
-/// (README, "Execution policies"). Now and then one region is run anyway to measure its cost
-/// again, so the threads come back when the machine is idle again. Inside a region the chunks are
-/// handed out dynamically: a thread that is not running does not hold up the others' work.
+/// A loop forks a team only when that pays (OmpFork::adaptive, the default). Loops are timed: each
+/// call site (one per body type) learns its work per item and what its regions cost beyond their
+/// work (waking the team, the join, a thread the OS did not run: wall − work / threads), and the
+/// process learns the same over all regions. A loop whose work would save less than that price —
+/// the site's own, but at least a quarter of the process-wide one — runs on the calling thread.
+/// On an idle machine a region costs microseconds, so only tiny loops stay on the caller; beside
+/// a busy process it costs milliseconds — libgomp's waiting threads spin (OMP_WAIT_POLICY is read
+/// once, at program start), and a join waits for a thread the scheduler put off — and the loops
+/// run on the caller instead of collapsing (README, "Execution policies"). Now and then a region
+/// is run anyway to measure its price again, so the threads come back when the machine is idle
+/// again. Inside a region the chunks are handed out dynamically: a thread that is not running
+/// does not hold up the others' work.
 /// None of this changes a result: chunks are fixed and combined in order whoever runs them.
 
 #include <algorithm>
@@ -45,6 +48,7 @@ namespace simsr::exec {
 enum class OmpFork {
   adaptive,  ///< when the loop's measured work pays for the measured cost of a region (default)
   always,    ///< every loop of at least 2 items (no measurement): for benchmarks and tests
+  never,     ///< no loop: all run on the calling thread, as exec::seq does (for tests)
 };
 
 namespace detail {
@@ -73,20 +77,29 @@ inline std::int64_t now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-/// What the process has measured about its parallel regions (shared by every call site).
+/// Process-wide state of exec::omp's fork decisions.
 struct RegionCost {
-  /// Moving average of (wall time − work / threads) over recent regions, ns: the price of forking.
+  /// Moving average of (wall time − work / threads) over every recent region, ns: what a call
+  /// site that has not forked yet expects a region to cost.
   std::atomic<double> excess_ns{5000.0};
-  /// steady clock (ns) of the last region: a probe is due when it is long ago.
-  std::atomic<std::int64_t> last_region_ns{0};
-  /// OmpFork; -1 until first read (SIMSR_OMP_FORK=always in the environment selects always).
+  /// steady clock (ns) of the last probe: at most one per 64 process-wide prices (1 ms to 0.25 s).
+  std::atomic<std::int64_t> last_probe_ns{0};
+  /// OmpFork; -1 until first read (SIMSR_OMP_FORK=always or =never in the environment selects
+  /// that mode).
   std::atomic<int> mode{-1};
 };
 inline RegionCost region_cost;
 
-/// Work per item (ns) of one call site, identified by its body's type; < 0 until measured.
+/// What one call site (identified by its body's type) has measured.
+struct SiteCost {
+  std::atomic<double> ns_per_item{-1.0};  ///< work per item; < 0 until measured
+  /// Moving average of its regions' (wall time − work / threads); < 0 until it forked. Per site:
+  /// a large loop's imbalance (a few % of milliseconds) is not a small loop's price.
+  std::atomic<double> excess_ns{-1.0};
+  std::atomic<std::int64_t> last_region_ns{0};  ///< steady clock of its last region
+};
 template <class Site>
-inline std::atomic<double> site_ns_per_item{-1.0};
+inline SiteCost site_cost;
 
 /// Forking must save at least this much (ns) beyond the measured price of a region.
 inline constexpr double min_fork_saving_ns = 2000.0;
@@ -97,7 +110,9 @@ inline OmpFork omp_fork_mode() {
   int m = region_cost.mode.load(std::memory_order_relaxed);
   if (m < 0) {
     const char* env = std::getenv("SIMSR_OMP_FORK");
-    m = int(env && std::strcmp(env, "always") == 0 ? OmpFork::always : OmpFork::adaptive);
+    m = int(OmpFork::adaptive);
+    if (env && std::strcmp(env, "always") == 0) m = int(OmpFork::always);
+    if (env && std::strcmp(env, "never") == 0) m = int(OmpFork::never);
     region_cost.mode.store(m, std::memory_order_relaxed);
   }
   return OmpFork(m);
@@ -105,39 +120,47 @@ inline OmpFork omp_fork_mode() {
 
 /// Per-item cost: falls fast (a measurement can only be inflated, by preemption or a cold cache)
 /// and rises slowly.
-template <class Site>
-void record_work(Index n, double work_ns) {
+inline void record_work(SiteCost& site, Index n, double work_ns) {
   const double sample = work_ns / double(std::max<Index>(n, 1));
-  auto& site = site_ns_per_item<Site>;
-  const double old = site.load(std::memory_order_relaxed);
-  site.store(old < 0 ? sample : old + (sample - old) * (sample < old ? 0.5 : 0.0625), std::memory_order_relaxed);
+  const double old = site.ns_per_item.load(std::memory_order_relaxed);
+  site.ns_per_item.store(old < 0 ? sample : old + (sample - old) * (sample < old ? 0.5 : 0.0625), std::memory_order_relaxed);
 }
 
-inline void record_region(double wall_ns, double work_ns, int threads) {
+inline void record_region(SiteCost& site, double wall_ns, double work_ns, int threads) {
   const double sample = std::max(0.0, wall_ns - work_ns / threads);
-  const double old = region_cost.excess_ns.load(std::memory_order_relaxed);
-  region_cost.excess_ns.store(old + (sample - old) * 0.125, std::memory_order_relaxed);
-  region_cost.last_region_ns.store(now_ns(), std::memory_order_relaxed);
+  const double all = region_cost.excess_ns.load(std::memory_order_relaxed);
+  region_cost.excess_ns.store(all + (sample - all) * 0.125, std::memory_order_relaxed);
+  const double old = site.excess_ns.load(std::memory_order_relaxed);
+  site.excess_ns.store(old < 0 ? sample : old + (sample - old) * 0.25, std::memory_order_relaxed);
+  site.last_region_ns.store(now_ns(), std::memory_order_relaxed);
 }
 
-/// How an omp loop over n items at `Site` runs now: 0 on the calling thread untimed, 1 on the
+/// How an omp loop over n items at `site` runs now: 0 on the calling thread untimed, 1 on the
 /// calling thread timed, 2 in a team of `threads`.
-template <class Site>
-int fork_decision(Index n, int threads) {
+inline int fork_decision(SiteCost& site, Index n, int threads) {
   if (threads < 2 || n < 2) return 0;
-  if (omp_fork_mode() == OmpFork::always) return 2;
-  const double per_item = site_ns_per_item<Site>.load(std::memory_order_relaxed);
-  const double excess = region_cost.excess_ns.load(std::memory_order_relaxed);
+  const OmpFork mode = omp_fork_mode();
+  if (mode != OmpFork::adaptive) return mode == OmpFork::always ? 2 : 0;
+  const double per_item = site.ns_per_item.load(std::memory_order_relaxed);
+  // The site's own price of a region, but at least a quarter of the process-wide one: that rises
+  // at once for every site when the machine gets busy.
+  const double site_excess = site.excess_ns.load(std::memory_order_relaxed);
+  const double all_excess = region_cost.excess_ns.load(std::memory_order_relaxed);
+  const double excess = site_excess >= 0 ? std::max(site_excess, 0.25 * all_excess) : all_excess;
   // First call: a region measures the work (and the region's price), unless regions are dear.
   if (per_item < 0) return excess < 50000.0 ? 2 : 1;
   const double work = per_item * double(n);
   const double saving = work * (1.0 - 1.0 / double(std::min<Index>(threads, n)));
   if (saving > excess + min_fork_saving_ns) return 2;
-  if (saving > min_fork_saving_ns) {  // a probe, at most every 64 prices (1 ms to 0.25 s)
+  // A probe measures the price again (the machine may be idle again): when the site's last region
+  // is 64 of its prices ago and no other site probed within 64 process-wide prices (1 ms to 0.25 s
+  // each), so that beside a busy process the probes of all sites cost ~1 %.
+  if (saving > min_fork_saving_ns) {
     const std::int64_t now = now_ns();
-    std::int64_t last = region_cost.last_region_ns.load(std::memory_order_relaxed);
-    const double interval = std::clamp(64.0 * excess, 1e6, 2.5e8);
-    if (double(now - last) > interval && region_cost.last_region_ns.compare_exchange_strong(last, now, std::memory_order_relaxed))
+    std::int64_t last = region_cost.last_probe_ns.load(std::memory_order_relaxed);
+    if (double(now - site.last_region_ns.load(std::memory_order_relaxed)) > std::clamp(64.0 * excess, 1e6, 2.5e8) &&
+        double(now - last) > std::clamp(64.0 * all_excess, 1e6, 2.5e8) &&
+        region_cost.last_probe_ns.compare_exchange_strong(last, now, std::memory_order_relaxed))
       return 2;
   }
   return work >= min_timed_ns ? 1 : 0;
@@ -176,21 +199,22 @@ TeamRun run_team(Index chunks, int threads, Chunk&& chunk) {
 /// measured. The serial path keeps Eigen single-threaded, as it is inside a region.
 template <class Site, class Serial, class Parallel>
 void dispatch(Index n, Serial&& serial, Parallel&& parallel) {
+  SiteCost& site = site_cost<Site>;
   const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
-  const int decision = fork_decision<Site>(n, threads);
+  const int decision = fork_decision(site, n, threads);
   if (decision < 2) {
     // On the calling thread outside a region, where Eigen would start threads of its own.
     const EigenSingleThreaded eigen_serial;
     if (decision == 0) return serial();
     const std::int64_t t0 = now_ns();
     serial();
-    record_work<Site>(n, double(now_ns() - t0));
+    record_work(site, n, double(now_ns() - t0));
     return;
   }
   const TeamRun run = parallel(threads);
   if (omp_fork_mode() == OmpFork::adaptive) {
-    record_work<Site>(n, run.work_ns);
-    record_region(run.wall_ns, run.work_ns, run.threads);
+    record_work(site, n, run.work_ns);
+    record_region(site, run.wall_ns, run.work_ns, run.threads);
   }
 }
 #endif
@@ -211,7 +235,7 @@ inline int omp_max_threads() {
 }
 
 /// Sets when exec::omp loops fork a team, process-wide (the environment variable
-/// SIMSR_OMP_FORK=always sets OmpFork::always at start-up).
+/// SIMSR_OMP_FORK=always or =never sets that mode at start-up).
 inline void set_omp_fork(OmpFork mode) { detail::region_cost.mode.store(int(mode), std::memory_order_relaxed); }
 /// When exec::omp loops fork a team (OmpFork::adaptive unless set otherwise).
 inline OmpFork omp_fork() { return detail::omp_fork_mode(); }

@@ -10,7 +10,8 @@ namespace simsr::exec {
 
 /// Run on the calling thread, in index order.
 struct seq_t {};
-/// Run on the host with OpenMP threads (needs simsr::openmp, i.e. -fopenmp).
+/// Run on the host with OpenMP threads where a loop pays for them, else on the calling thread
+/// (needs simsr::openmp, i.e. -fopenmp; exec/omp.hpp says how it decides).
 struct omp_t {};
 /// Run on a CUDA device (needs nvcc; bodies must be SIMSR_HOST_DEVICE and data device-visible).
 struct cuda_t {};
