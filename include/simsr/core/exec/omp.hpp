@@ -256,6 +256,7 @@ void parallel_for(omp_t, Index n, Body&& body) {
       });
 #else
   static_assert(detail::dependent_false<Body>, SIMSR_OMP_MISSING);
+  (void)n, (void)body;
 #endif
 }
 
@@ -282,6 +283,7 @@ T parallel_reduce(omp_t, Index n, T identity, Map&& map, Combine&& combine, Inde
   return total;
 #else
   static_assert(detail::dependent_false<Map>, SIMSR_OMP_MISSING);
+  (void)n, (void)map, (void)combine, (void)chunks;
   return identity;
 #endif
 }
@@ -309,6 +311,7 @@ auto parallel_for_accumulate(omp_t, Index n, Make&& make, Body&& body, Merge&& m
   return total;
 #else
   static_assert(detail::dependent_false<Make>, SIMSR_OMP_MISSING);
+  (void)n, (void)body, (void)merge, (void)chunks;
   return make();
 #endif
 }
