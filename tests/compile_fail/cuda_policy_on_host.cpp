@@ -1,3 +1,4 @@
+// expect: simsr::exec::cuda needs nvcc
 // Must NOT compile with a host compiler: exec::cuda needs nvcc, and says so.
 #include <simsr/core/parallel.hpp>
 int main() {

@@ -1,3 +1,4 @@
+// expect: simsr::exec::omp needs OpenMP
 // Must NOT compile without -fopenmp: exec::omp needs OpenMP, and says so.
 #include <simsr/core/parallel.hpp>
 int main() {

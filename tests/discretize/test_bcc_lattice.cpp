@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <simsr/discretize/bcc_lattice.hpp>
 #include <simsr/io/obj.hpp>
@@ -144,7 +145,10 @@ TEST_CASE("non-alternating centred split (the bunny's) shares nodes but not face
 
 TEST_CASE("the authors' bunny LR mesh is a uniform centred 5-tet lattice (8 tets per cell, face diagonals crossing)") {
   const auto path = std::filesystem::path(SIMSR_DATA_DIR) / "bunny" / "lrestshape.obj";
-  if (!std::filesystem::exists(path)) return;
+  if (!std::filesystem::exists(path)) {
+    SIMSR_MISSING("bunny LR mesh not found: " << path);
+    return;
+  }
   const auto m = io::read_obj_tets(path);
   REQUIRE(m.T.rows() == 4896);
   REQUIRE(m.V.rows() == 1747);

@@ -2,6 +2,7 @@
 // repeated applies are counted on the bunny problem, under seq and omp, for every method and each
 // RBF solve path. tests/support/malloc_counter.hpp is included here, once for test_interp.
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <simsr/interp/interp.hpp>
 
@@ -33,7 +34,7 @@ void check_no_allocation(const char* name, const Method& method, const Points<>&
 
 TEST_CASE("every interpolator's warm apply allocates nothing (bunny, seq and omp)") {
 #if !defined(__GLIBC__)
-  MESSAGE("malloc counting needs glibc: skipped");
+  SIMSR_MISSING("malloc counting needs glibc");
   return;
 #endif
   {  // the counter itself must see allocations, or every check below would pass vacuously
@@ -44,7 +45,7 @@ TEST_CASE("every interpolator's warm apply allocates nothing (bunny, seq and omp
   }
   simsr::test::Bunny b;
   if (!simsr::test::load_bunny(b, {10, 50, 100, 150, 200, 250})) {
-    MESSAGE("bunny data not found: skipped");
+    SIMSR_MISSING("bunny data not found in " << SIMSR_DATA_DIR);
     return;
   }
   const Points<>& lr = b.lr_frames[0];

@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include "bunny_fixture.hpp"
 
@@ -93,7 +94,7 @@ TEST_CASE("IDW on the bunny beats the rest shape") {
 #ifdef SIMSR_DATA_DIR
   const std::filesystem::path dir = std::filesystem::path(SIMSR_DATA_DIR) / "bunny";
   if (!std::filesystem::exists(dir / "train_frames.npz")) {
-    MESSAGE("bunny data not found: skipped");
+    SIMSR_MISSING("bunny data not found in " << dir);
     return;
   }
   UpsamplingProblem<> p;
@@ -123,6 +124,6 @@ TEST_CASE("IDW on the bunny beats the rest shape") {
   }
   MESSAGE("bunny IDW (p = 2, k = 20): mean error ", mean, ", max ", worst, " (rest shape: mean ", rest, ")");
 #else
-  MESSAGE("SIMSR_DATA_DIR undefined: skipped");
+  SIMSR_MISSING("SIMSR_DATA_DIR undefined");
 #endif
 }

@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include "bunny_fixture.hpp"
 
@@ -217,7 +218,7 @@ using simsr::test::load_bunny;
 TEST_CASE("MLS on the bunny: both variants beat the rest shape") {
   Bunny b;
   if (!load_bunny(b, {10, 100, 200, 250})) {
-    MESSAGE("bunny data not found: skipped");
+    SIMSR_MISSING("bunny data not found in " << SIMSR_DATA_DIR);
     return;
   }
   for (const auto basis : {MlsBasis::per_coordinate, MlsBasis::linear_3d}) {

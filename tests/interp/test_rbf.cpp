@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include "bunny_fixture.hpp"
 
@@ -138,11 +139,11 @@ Eigen::MatrixXd surface_floyd_warshall(const TriMesh<>& t) {
 
 TEST_CASE("RBF (Euclidean) matches scipy.interpolate.RBFInterpolator to 1e-8") {
 #ifndef SIMSR_SOURCE_DIR
-  MESSAGE("SIMSR_SOURCE_DIR undefined: scipy peer skipped");
+  SIMSR_MISSING("SIMSR_SOURCE_DIR undefined: no scipy peer script");
 #else
   const std::filesystem::path peer = std::filesystem::path(SIMSR_SOURCE_DIR) / "scripts/peers/rbf_peer.py";
   if (!std::filesystem::exists("/usr/bin/python3") || std::system("/usr/bin/python3 -c 'import scipy.interpolate' 2>/dev/null") != 0) {
-    MESSAGE("/usr/bin/python3 with scipy not available: scipy peer skipped");
+    SIMSR_MISSING("/usr/bin/python3 with scipy (python3-scipy) not available for the RBF peer");
     return;
   }
   const std::filesystem::path dir = std::filesystem::path(SIMSR_TEST_TMP_DIR) / "interp_rbf_peer";
@@ -166,7 +167,7 @@ TEST_CASE("RBF (Euclidean) matches scipy.interpolate.RBFInterpolator to 1e-8") {
                             eps.str() + " --degree " + std::to_string(degree) + " --out " + out;
     const int rc = std::system(cmd.c_str());
     if (WIFEXITED(rc) && WEXITSTATUS(rc) == 77) {
-      MESSAGE("scipy missing: peer skipped");
+      SIMSR_MISSING("scipy missing: " << peer << " exited 77");
       return;
     }
     REQUIRE(rc == 0);
@@ -465,7 +466,7 @@ using simsr::test::load_bunny;
 TEST_CASE("RBF on the bunny: geodesic (one surface metric) and Euclidean beat the rest shape") {
   Bunny b;
   if (!load_bunny(b, {10, 100, 200, 250})) {
-    MESSAGE("bunny data not found: skipped");
+    SIMSR_MISSING("bunny data not found in " << SIMSR_DATA_DIR);
     return;
   }
   const auto& map = b.problem.neighborhoods->lr_to_hr;

@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <cstdint>
 #include <cstdlib>
@@ -300,7 +301,7 @@ TEST_CASE("npy: hostile input gives ParseError with the byte offset") {
 
 TEST_CASE("npy: round trips through numpy") {
   if (!have_numpy()) {
-    MESSAGE("skipped: /usr/bin/python3 with numpy not available");
+    SIMSR_MISSING("numpy round trip: /usr/bin/python3 with numpy (python3-numpy) not available");
     return;
   }
   const auto dir = tmp_dir();

@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <cstdint>
 #include <cstdlib>
@@ -125,7 +126,7 @@ TEST_CASE("npz: numpy's savez and savez_compressed, from a path and from memory"
 TEST_CASE("npz: the bunny training frames, read lazily") {
   const auto path = shared / "bunny" / "train_frames.npz";
   if (!std::filesystem::exists(path)) {
-    MESSAGE("skipped: " << path << " not found");
+    SIMSR_MISSING(path << " not found");
     return;
   }
   io::NpzReader z(path);
@@ -154,7 +155,7 @@ TEST_CASE("npz: the bunny training frames, read lazily") {
 TEST_CASE("npz: the ICT face expressions (float32 deltas and <U16 names)") {
   const auto path = shared / "ict_face" / "expressions.npz";
   if (!std::filesystem::exists(path)) {
-    MESSAGE("skipped: " << path << " not found");
+    SIMSR_MISSING(path << " not found");
     return;
   }
   const auto bytes = slurp(path);
@@ -204,7 +205,7 @@ TEST_CASE("npz: write stored and compressed, to a file and to memory") {
   CHECK_THROWS_AS(io::npz_bytes(bad), simsr::ArgumentError);
 
   if (!have_numpy()) {
-    MESSAGE("numpy check skipped: /usr/bin/python3 with numpy not available");
+    SIMSR_MISSING("numpy check: /usr/bin/python3 with numpy (python3-numpy) not available");
     return;
   }
   const std::string script =

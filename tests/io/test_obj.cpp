@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include "io_test_support.hpp"
 
@@ -175,7 +176,7 @@ TEST_CASE("obj: files not in the tet-soup convention name the first bad group's 
 TEST_CASE("obj: the official bunny rest shape is a positively oriented tet soup") {
   const fs::path dir = fs::path(SIMSR_DATA_DIR) / "bunny";
   if (!fs::exists(dir / "lrestshape.obj")) {
-    MESSAGE("shared data not found, skipping");
+    SIMSR_MISSING("bunny data not found in " << dir);
     return;
   }
   const auto poly = simsr::io::read_obj(dir / "lrestshape.obj");
@@ -214,5 +215,7 @@ TEST_CASE("obj: the official bunny rest shape is a positively oriented tet soup"
     CHECK(f.num_vertices() == 11248);
     CHECK(f.num_faces() == 11144);
     CHECK(simsr::triangulate(f).num_faces() == static_cast<simsr::Index>(f.indices.size()) - 2 * f.num_faces());
+  } else {
+    SIMSR_MISSING("ICT face OBJ not found: " << face);
   }
 }

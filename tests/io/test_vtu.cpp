@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <cstdlib>
 #include <cstring>
@@ -171,7 +172,7 @@ TEST_CASE("vtu: meshio reads back points, cells and every data array; pvd series
   CHECK(std::filesystem::exists(dir / "series" / "series_000002.vtu"));
 
   if (!have_meshio()) {
-    MESSAGE("meshio check skipped: /usr/bin/python3 with meshio not available");
+    SIMSR_MISSING("meshio check: /usr/bin/python3 with meshio (python3-meshio) not available");
     return;
   }
   // meshio reads each file and saves what it saw to an .npz, which we compare here.

@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <simsr/mesh/normals.hpp>
 #include <simsr/mesh/topology.hpp>
@@ -148,7 +149,7 @@ TEST_CASE("triangulate: several polygons, face_of_triangle, and errors naming th
 TEST_CASE("real data: the ICT face (quads) triangulates, keeps vector areas, is a disc with holes") {
   const std::string path = std::string(SIMSR_DATA_DIR) + "/ict_face/neutral_face_head.obj";
   if (!std::filesystem::exists(path)) {
-    MESSAGE("face OBJ not found, skipped: " << path);
+    SIMSR_MISSING("ICT face OBJ not found: " << path);
     return;
   }
   const PolyMesh<> poly = load_obj_polygons(path);

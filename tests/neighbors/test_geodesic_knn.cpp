@@ -3,6 +3,7 @@
 #include <simsr/neighbors/geodesic_knn.hpp>
 
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <filesystem>
 #include <random>
@@ -163,7 +164,7 @@ Index shared_neighbours(const A& a, const B& b, Index kk) {
 TEST_CASE("GeodesicKnn on the bunny's LR tet mesh against the authors' precomputed geodesic neighbours") {
   const std::filesystem::path dir = std::filesystem::path(SIMSR_DATA_DIR) / "bunny";
   if (!std::filesystem::exists(dir / "lrestshape.obj") || !std::filesystem::exists(dir / "geo_dist_tet2tet_idx.npy")) {
-    MESSAGE("skipped: bunny data not found in " << dir);
+    SIMSR_MISSING("bunny data not found in " << dir);
     return;
   }
   const auto lr = io::read_obj_tets<double>(dir / "lrestshape.obj");

@@ -5,6 +5,7 @@
 #include <simsr/neighbors/kd_tree.hpp>
 
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <cstdlib>
 #include <filesystem>
@@ -161,7 +162,7 @@ bool debian_scipy_available() {
 TEST_CASE("KdTree gives exactly scipy's cKDTree results (peer script, when Debian's scipy is there)") {
   const auto script = peer_script();
   if (!std::filesystem::exists(script) || !debian_scipy_available()) {
-    MESSAGE("skipped: /usr/bin/python3 with scipy or " << script << " not found");
+    SIMSR_MISSING("/usr/bin/python3 with scipy (python3-scipy) or " << script << " not found");
     return;
   }
   const std::filesystem::path tmp = std::filesystem::path(SIMSR_TEST_TMP_DIR) / "knn_peer";
