@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
                                           {"seconds", r.seconds}};
         if (!vtu.empty()) {
           const Points<> u = r.positions - r.mesh.V;
-          const VecX<> J = signed_volumes(r.positions, r.mesh.T).cwiseQuotient(signed_volumes(r.mesh.V, r.mesh.T));
+          const VecX<> J = signed_volumes(exec::seq, r.positions, r.mesh.T).cwiseQuotient(signed_volumes(exec::seq, r.mesh.V, r.mesh.T));
           io::VtuGrid grid;
           grid.set_points(r.positions).set_tets(r.mesh.T).add_point_data("displacement", u).add_cell_data("volume_ratio", J);
           io::write_vtu(vtu, grid);

@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
         interp::Ridge<> ridge;
         run("ridge", ridge, d);
         interp::BetaVaeBaseline<> vae;
-        run("beta_vae", vae, d, interp::BetaVaeTrainOptions{.epochs = vae_epochs});
+        run("beta_vae", vae, d, interp::BetaVaeTrainOptions{.epochs = vae_epochs, .on_epoch = {}});
         // The official network composed with Embedded (residual), trained with the tool's defaults
         // for 2 CPU cores (README, "Training on the bunny").
         nn::NetworkConfig config = nn::NetworkConfig::official();

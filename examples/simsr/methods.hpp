@@ -76,7 +76,7 @@ void with_method(const std::string& name, const MethodArgs& a, Visit&& visit) {
   } else if (name == "beta_vae") {
     if (a.vae_epochs < 0) throw ArgumentError("--vae-epochs must be >= 0 (got " + std::to_string(a.vae_epochs) + ")");
     interp::BetaVaeBaseline<> m;
-    visit(m, interp::BetaVaeTrainOptions{.epochs = a.vae_epochs, .seed = a.seed, .progress = true});
+    visit(m, interp::BetaVaeTrainOptions{.epochs = a.vae_epochs, .seed = a.seed, .progress = true, .on_epoch = {}});
   } else {
     throw ArgumentError("unknown method '" + name + "' (known: embedded, idw, rbf, mls, ridge, beta_vae)");
   }

@@ -250,7 +250,7 @@ TEST_CASE("embed agrees with brute-force location on box meshes: random, on shar
     pts.emplace_back(-1.3, -0.75, 0.25);
     Points<> Q(Index(pts.size()), 3);
     for (Index i = 0; i < Q.rows(); ++i) Q.row(i) = pts[std::size_t(i)].transpose();
-    const Embedding<> e = embed(m, Q);
+    const Embedding<> e = embed(exec::seq, m, Q);
     const auto [in, out] = compare_with_brute_force(m, Q, e);
     CHECK(in > 1000);
     CHECK(out > 500);
@@ -292,12 +292,12 @@ TEST_CASE("deform reproduces affine fields at inside and extrapolated points; cl
   const Points<> V2 = (m.V * A.transpose()).rowwise() + b;
   const Points<> expect = (Q * A.transpose()).rowwise() + b;
 
-  const Embedding<> e = embed(m, Q);
+  const Embedding<> e = embed(exec::seq, m, Q);
   REQUIRE(e.num_outside() > 100);
-  const Points<> X = deform(e, m.T, V2);
+  const Points<> X = deform(exec::seq, e, m.T, V2);
   CHECK((X - expect).cwiseAbs().maxCoeff() < 1e-12);
   CHECK((deform(exec::omp, e, m.T, V2) - X).cwiseAbs().maxCoeff() == 0);
-  CHECK((deform(e, m.T, m.V) - Q).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((deform(exec::seq, e, m.T, m.V) - Q).cwiseAbs().maxCoeff() < 1e-12);
   for (Index q = 0; q < Q.rows(); ++q) CHECK(std::abs(e.weights.row(q).sum() - 1) < 1e-13);
 
   const auto W = embedding_matrix(e, m.T, m.num_vertices());
@@ -308,10 +308,10 @@ TEST_CASE("deform reproduces affine fields at inside and extrapolated points; cl
 
   EmbeddingOptions clamp;
   clamp.outside = OutsideMode::clamp;
-  const Embedding<> c = embed(m, Q, clamp);
+  const Embedding<> c = embed(exec::seq, m, Q, clamp);
   CHECK(c.tet == e.tet);
   CHECK(c.distance == e.distance);
-  const Points<> C = deform(c, m.T, m.V);
+  const Points<> C = deform(exec::seq, c, m.T, m.V);
   for (Index q = 0; q < Q.rows(); ++q) {
     CHECK((c.weights.row(q).array() >= (e.inside[q] ? -1e-10 : 0.0)).all());
     CHECK(std::abs((C.row(q) - Q.row(q)).norm() - c.distance[q]) < 1e-12);
@@ -326,13 +326,13 @@ TEST_CASE("embedding errors name the tet, the point or the shape") {
   SUBCASE("degenerate tet") {
     TetMesh<> bad = m;
     bad.T.row(5) << bad.T(5, 0), bad.T(5, 1), bad.T(5, 2), bad.T(5, 2);  // repeated vertex
-    CHECK_THROWS_AS(embed(bad, Q), MeshError);
+    CHECK_THROWS_AS(embed(exec::seq, bad, Q), MeshError);
     TetMesh<> flat = m;
     flat.V.conservativeResize(flat.V.rows() + 1, 3);
     flat.V.row(flat.V.rows() - 1) = (flat.V.row(flat.T(7, 0)) + flat.V.row(flat.T(7, 1))) / 2;  // on an edge: coplanar
     flat.T(7, 3) = VIndex(flat.V.rows() - 1);
     try {
-      embed(flat, Q);
+      embed(exec::seq, flat, Q);
       FAIL("no MeshError");
     } catch (const MeshError& err) {
       CHECK(err.element() == 7);
@@ -343,7 +343,7 @@ TEST_CASE("embedding errors name the tet, the point or the shape") {
   SUBCASE("non-finite query") {
     Q(1, 2) = std::numeric_limits<double>::quiet_NaN();
     try {
-      embed(m, Q);
+      embed(exec::seq, m, Q);
       FAIL("no ArgumentError");
     } catch (const ArgumentError& err) {
       CHECK(std::string(err.what()).find("point 1") != std::string::npos);
@@ -352,18 +352,18 @@ TEST_CASE("embedding errors name the tet, the point or the shape") {
   SUBCASE("empty mesh and wrong shapes") {
     TetMesh<> empty;
     empty.V = m.V;
-    CHECK_THROWS_AS(embed(empty, Q), MeshError);
+    CHECK_THROWS_AS(embed(exec::seq, empty, Q), MeshError);
     Eigen::MatrixXd Q2(4, 2);
     Q2.setZero();
-    CHECK_THROWS_AS(embed(m, Q2), ShapeError);
-    const Embedding<> e = embed(m, Q);
-    CHECK_THROWS_AS(deform(e, m.T, Eigen::MatrixXd::Zero(m.num_vertices(), 2)), ShapeError);
-    CHECK_THROWS_AS(deform(e, m.T, m.V.topRows(5)), MeshError);
+    CHECK_THROWS_AS(embed(exec::seq, m, Q2), ShapeError);
+    const Embedding<> e = embed(exec::seq, m, Q);
+    CHECK_THROWS_AS(deform(exec::seq, e, m.T, Eigen::MatrixXd::Zero(m.num_vertices(), 2)), ShapeError);
+    CHECK_THROWS_AS(deform(exec::seq, e, m.T, m.V.topRows(5)), MeshError);
     Tets fewer = m.T.topRows(1);
-    CHECK_THROWS_AS(deform(e, fewer, m.V), ArgumentError);
+    CHECK_THROWS_AS(deform(exec::seq, e, fewer, m.V), ArgumentError);
   }
   SUBCASE("no queries") {
-    const Embedding<> e = embed(m, Points<>(0, 3));
+    const Embedding<> e = embed(exec::seq, m, Points<>(0, 3));
     CHECK(e.size() == 0);
     CHECK(e.max_distance() == 0);
   }
@@ -377,9 +377,9 @@ TEST_CASE("float embedding agrees with double on inside points") {
   std::uniform_real_distribution<double> u(0.01, 0.99);
   Points<> Q(300, 3);
   for (Index i = 0; i < Q.rows(); ++i) Q.row(i) << u(rng), u(rng), u(rng);
-  const Embedding<> e = embed(m, Q);
-  const Embedding<float> ef = embed(mf, Points<float>(Q.cast<float>()));
-  const Points<float> X = deform(ef, mf.T, mf.V);
+  const Embedding<> e = embed(exec::seq, m, Q);
+  const Embedding<float> ef = embed(exec::seq, mf, Points<float>(Q.cast<float>()));
+  const Points<float> X = deform(exec::seq, ef, mf.T, mf.V);
   CHECK((X.cast<double>() - Q).cwiseAbs().maxCoeff() < 1e-5);
   Index same = (ef.tet.array() == e.tet.array()).count();
   CHECK(same >= Q.rows() - 3);  // points within float rounding of a face may pick the neighbour

@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include "../support/require.hpp"
 
 #include <simsr/eval/error_statistics.hpp>
 #include <simsr/interp/ridge.hpp>
@@ -136,10 +137,10 @@ TEST_CASE("Ridge errors") {
 TEST_CASE("Ridge on the bunny: held-out frames (every 4th) against Embedded") {
   const std::filesystem::path dir = std::filesystem::path(SIMSR_DATA_DIR) / "bunny";
   if (!std::filesystem::exists(dir / "train_frames.npz")) {
-    MESSAGE("bunny data not found: skipped");
+    SIMSR_MISSING("bunny data not found in " << dir);
     return;
   }
-  interp::UpsamplingProblem<> problem{io::read_obj_tets(dir / "lrestshape.obj"), io::read_obj_triangles(dir / "hrestshape.obj"), {}};
+  interp::UpsamplingProblem<> problem{io::read_obj_tets(dir / "lrestshape.obj"), io::read_obj_triangles(dir / "hrestshape.obj"), {}, {}};
   io::NpzReader z(dir / "train_frames.npz");
   const auto low = z.read("lowres"), high = z.read("highres");
   const Index frames = low.num_frames(), n = problem.num_lr(), m = problem.num_hr();

@@ -3,7 +3,10 @@
 
 #include <simsr/nn/trainer.hpp>
 
+#include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <limits>
 
 using namespace simsr;
 using nn::Matrix;
@@ -107,7 +110,7 @@ TEST_CASE("nn::Trainer: a seed fixes the run, seq == omp bitwise, and a checkpoi
   }
   nn::Rng other(99);  // different initial weights: the checkpoint must overwrite them all
   nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, other);
-  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 4, .seed = 0, .progress = false, .on_epoch = {}});
+  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 4, .seed = 11, .progress = false, .on_epoch = {}});
   tr.load_checkpoint(dir / "ckpt.npz");
   CHECK(tr.epoch() == 2);
   CHECK(tr.steps() == 6);
@@ -162,5 +165,179 @@ TEST_CASE("nn::Trainer and the model file: bad input is rejected with what and w
     REQUIRE(arr.dtype.itemsize == 8);
     std::memcpy(arr.bytes.data(), &nan, sizeof(double));
     CHECK_THROWS_WITH_AS(nn::load_state(net.store(), b), doctest::Contains("not finite"), ArgumentError);
+  }
+}
+
+namespace {
+
+nn::ModelData toy_model_data(const Toy& toy) {
+  nn::ModelData md;
+  md.config = toy.cfg;
+  md.geometry = toy.geo;
+  md.lr_tets = Tets::Zero(1, 4);
+  md.lr_tets.row(0) << 0, 1, 2, 3;
+  md.hr_faces = toy.faces;
+  return md;
+}
+
+std::vector<double> trainer_state(const nn::SuperResolutionNet<double>& net) {
+  const auto v = net.store().values();
+  const auto b = net.store().buffers();
+  std::vector<double> out(v.data(), v.data() + v.size());
+  out.insert(out.end(), b.data(), b.data() + b.size());
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("nn::Trainer: a non-finite loss stops training before the optimizer moves anything, naming the step") {
+  Toy toy = make_toy(4);
+  toy.frames.hdx(5 * toy.frames.m + 3, 1) = std::numeric_limits<double>::quiet_NaN();  // frame 5
+  nn::Rng init(7);
+  nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
+  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 2, .seed = 1, .progress = false, .on_epoch = {}});
+  const auto before = trainer_state(net);
+  try {
+    tr.run(exec::seq);
+    FAIL("a NaN target trained without error");
+  } catch (const NumericalError& e) {
+    CHECK(e.tensor() == "the loss");
+    CHECK(e.step() >= 1);
+    CHECK(e.step() == tr.steps() + 1);  // the step that was refused
+    CHECK(std::string(e.what()).find("step " + std::to_string(e.step())) != std::string::npos);
+  }
+  if (tr.steps() == 0) CHECK(trainer_state(net) == before);  // NaN in the first batch: nothing moved
+}
+
+TEST_CASE("nn::Trainer: weights the optimizer makes non-finite stop training at that step, and no model file holds them") {
+  // float network, lr beyond float's range: Adam's first step sends every weight to ±inf
+  Toy toy = make_toy(5);
+  nn::Rng init(7);
+  nn::NetworkGeometry geo = toy.geo;
+  nn::SuperResolutionNet<float> net(toy.cfg, geo, init);
+  nn::TrainingFrames<float> frames;
+  frames.n = toy.frames.n, frames.m = toy.frames.m, frames.frames = toy.frames.frames, frames.ids = toy.frames.ids;
+  frames.ldx = toy.frames.ldx.cast<float>();
+  frames.hdx = toy.frames.hdx.cast<float>();
+  nn::Trainer<float> tr(net, toy.faces, frames, {.epochs = 1, .lr = 1e39, .seed = 1, .progress = false, .on_epoch = {}});
+  try {
+    tr.run(exec::seq);
+    FAIL("training with lr = 1e39 in float gave finite weights");
+  } catch (const NumericalError& e) {
+    CHECK(e.step() == 1);
+    CHECK(std::string(e.tensor()).find("the weight of '") == 0);
+  }
+  const auto dir = std::filesystem::path(SIMSR_TEST_TMP_DIR) / "trainer_nonfinite";
+  std::filesystem::create_directories(dir);
+  std::filesystem::remove(dir / "model.npz");
+  const Toy& t = toy;
+  CHECK_THROWS_AS(nn::save_model(dir / "model.npz", net, toy_model_data(t)), NumericalError);
+  CHECK(!std::filesystem::exists(dir / "model.npz"));
+  CHECK_THROWS_AS(tr.save_checkpoint(dir / "model.npz", toy_model_data(t)), NumericalError);
+  CHECK(!std::filesystem::exists(dir / "model.npz"));
+}
+
+TEST_CASE("nn: the finite guards name the tensor, the entry and the step") {
+  nn::ParameterStore<double> store;
+  const Index w = store.add_parameter("block.weight", {2, 3});
+  store.add_buffer("block.running_var", {3}, 1.0);
+  CHECK_NOTHROW(nn::require_finite_state("here", store, 4));
+  store.gradient(w, 2, 3)(1, 2) = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH_AS(nn::require_finite_gradients("here", store, 4), "here: the gradient of 'block.weight' (entry 5) is not finite (inf) at step 4",
+                       NumericalError);
+  store.buffers()[1] = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH_AS(nn::require_finite_buffers("here", store, 9), doctest::Contains("the buffer of 'block.running_var' (entry 1)"), NumericalError);
+  CHECK_THROWS_AS(nn::require_finite_loss("here", std::nan(""), 2), NumericalError);
+}
+
+TEST_CASE("nn::Trainer: a non-finite held-out error is an error, not a number in the history") {
+  Toy toy = make_toy(6);
+  nn::Rng init(7);
+  nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
+  nn::Trainer<double> tr(net, toy.faces, toy.frames, {.epochs = 1, .seed = 1, .progress = false, .on_epoch = {}});
+  nn::TrainingFrames<double> held = toy.frames;
+  held.hdx(2, 0) = std::numeric_limits<double>::infinity();
+  tr.set_holdout(held);
+  CHECK_THROWS_WITH_AS(tr.run(exec::seq), doctest::Contains("the held-out mean error"), NumericalError);
+}
+
+TEST_CASE("nn::Trainer: a checkpoint written before the first step resumes to the same run; another run's checkpoint is refused, naming what differs") {
+  const Toy toy = make_toy(7);
+  const auto dir = std::filesystem::path(SIMSR_TEST_TMP_DIR) / "trainer_resume";
+  std::filesystem::create_directories(dir);
+  const nn::TrainerOptions opts{.epochs = 3, .seed = 21, .progress = false, .on_epoch = {}};
+  std::vector<double> straight;
+  {
+    nn::Rng init(7);
+    nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
+    nn::Trainer<double> tr(net, toy.faces, toy.frames, opts);
+    tr.save_checkpoint(dir / "step0.npz", toy_model_data(toy));  // before any step
+    tr.run(exec::seq);
+    straight = trainer_state(net);
+  }
+  {
+    nn::Rng other(1234);
+    nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, other);
+    nn::Trainer<double> tr(net, toy.faces, toy.frames, opts);
+    tr.load_checkpoint(dir / "step0.npz");
+    CHECK(tr.epoch() == 0);
+    CHECK(tr.steps() == 0);
+    tr.run(exec::seq);
+    CHECK(trainer_state(net) == straight);
+  }
+  auto refused = [&](const Toy& t, const nn::TrainerOptions& o, const std::string& what) {
+    nn::Rng init(7);
+    nn::SuperResolutionNet<double> net(t.cfg, t.geo, init);
+    nn::Trainer<double> tr(net, t.faces, t.frames, o);
+    const auto before = trainer_state(net);
+    CHECK_THROWS_WITH_AS(tr.load_checkpoint(dir / "step0.npz"), doctest::Contains(what.c_str()), ArgumentError);
+    CHECK(trainer_state(net) == before);  // nothing loaded
+    CHECK(tr.epoch() == 0);
+  };
+  nn::TrainerOptions o = opts;
+  o.batch_size = 3;
+  refused(toy, o, "options differ: batch_size (checkpoint 4, this run 3)");
+  o = opts;
+  o.seed = 22;
+  refused(toy, o, "seed (checkpoint 21, this run 22)");
+  o = opts;
+  o.epochs = 5;  // the official loss has no run-length schedule: training longer is a continuation
+  {
+    nn::Rng init(7);
+    nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
+    nn::Trainer<double> tr(net, toy.faces, toy.frames, o);
+    CHECK_NOTHROW(tr.load_checkpoint(dir / "step0.npz"));
+  }
+  {  // the paper's ramped latent norm spans the whole run: there the epochs must match
+    Toy ramped = toy;
+    ramped.cfg.zreg = nn::LatentRegularizer::ramped_norm;
+    nn::Rng init(7);
+    nn::SuperResolutionNet<double> net(ramped.cfg, ramped.geo, init);
+    nn::Trainer<double> tr(net, ramped.faces, ramped.frames, opts);
+    tr.save_checkpoint(dir / "ramped.npz", toy_model_data(ramped));
+    nn::Trainer<double> longer(net, ramped.faces, ramped.frames, o);
+    CHECK_THROWS_WITH_AS(longer.load_checkpoint(dir / "ramped.npz"), doctest::Contains("epochs (checkpoint 3, this run 5)"), ArgumentError);
+  }
+  Toy other_data = toy;
+  other_data.frames.hdx(0, 0) += 1e-9;
+  refused(other_data, opts, "data differ: training_fingerprint");
+  Toy fewer = make_toy(7, 9);
+  refused(fewer, opts, "training_frames (checkpoint 10, this run 9)");
+  Toy other_cfg = toy;
+  other_cfg.cfg.dropout = 0.25;
+  refused(other_cfg, opts, "config differ: dropout");
+  {  // held-out frames are part of the data too
+    nn::Rng init(7);
+    nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
+    nn::Trainer<double> tr(net, toy.faces, toy.frames, opts);
+    tr.set_holdout(toy.frames);
+    CHECK_THROWS_WITH_AS(tr.load_checkpoint(dir / "step0.npz"), doctest::Contains("holdout_frames (checkpoint 0, this run 10)"), ArgumentError);
+  }
+  {  // a model file is not a checkpoint
+    nn::Rng init(7);
+    nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
+    nn::save_model(dir / "model.npz", net, toy_model_data(toy));
+    nn::Trainer<double> tr(net, toy.faces, toy.frames, opts);
+    CHECK_THROWS_WITH_AS(tr.load_checkpoint(dir / "model.npz"), doctest::Contains("not a training checkpoint"), ArgumentError);
   }
 }

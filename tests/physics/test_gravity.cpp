@@ -28,7 +28,7 @@ TEST_CASE("Gravity: total force is density × g × mesh volume") {
   SUBCASE("sphere shell") {
     const TetMesh<> m = sphere_shell_tet_mesh<double>(0.5, 1.0, 2, 3);
     const Gravity<> grav(m, rho, g);
-    const double volume = total_volume(m.V, m.T);
+    const double volume = total_volume(exec::seq, m.V, m.T);
     const Vec3<> total = grav.forces().colwise().sum().transpose();
     CHECK((total - rho * volume * g).norm() < 1e-12 * rho * volume * g.norm());
     MESSAGE("gravity: shell total-force error " << (total - rho * volume * g).norm());

@@ -39,6 +39,24 @@ auto parallel_for_accumulate(cuda_t, Index, Make&& make, Body&&, Merge&&, Index 
 
 namespace simsr::exec {
 
+/// The policy comes first in every call: a primitive called with anything else there (the policy
+/// last, as before issue #10, or none) stops the build with assert_execution_policy's sentence.
+template <class NotAPolicy, class... Args>
+  requires(!ExecutionPolicy<NotAPolicy>)
+void parallel_for(NotAPolicy&&, Args&&...) {
+  static_assert(assert_execution_policy<NotAPolicy>());
+}
+template <class NotAPolicy, class... Args>
+  requires(!ExecutionPolicy<NotAPolicy>)
+void parallel_reduce(NotAPolicy&&, Args&&...) {
+  static_assert(assert_execution_policy<NotAPolicy>());
+}
+template <class NotAPolicy, class... Args>
+  requires(!ExecutionPolicy<NotAPolicy>)
+void parallel_for_accumulate(NotAPolicy&&, Args&&...) {
+  static_assert(assert_execution_policy<NotAPolicy>());
+}
+
 /// Workers a chunked loop uses under `policy` for `chunks` chunks: 1 under seq (no thread is
 /// started), min(chunks, OpenMP threads) under omp.
 template <ExecutionPolicy Policy>

@@ -7,7 +7,7 @@
 /// reproduced exactly) or clamped to the closest point of that tet.
 ///
 ///     auto emb = simsr::embed(exec::omp, lr_rest, hr_rest.V);     // Embedding<double>
-///     Points<> x = simsr::deform(emb, lr_rest.T, lr_frame_V);      // #Q×3 deformed points
+///     Points<> x = simsr::deform(exec::omp, emb, lr_rest.T, lr_frame_V);      // #Q×3 deformed points
 ///     auto W = simsr::embedding_matrix(emb, lr_rest.T, lr_rest.num_vertices());  // Q×N, x = W·V
 
 #include <string>
@@ -109,12 +109,6 @@ Embedding<S> embed(P policy, const TetMesh<S>& mesh, const Eigen::MatrixBase<DQ>
   return embed(policy, locator, Q, options.outside);
 }
 
-/// Sequential embed.
-template <class S, class DQ>
-Embedding<S> embed(const TetMesh<S>& mesh, const Eigen::MatrixBase<DQ>& Q, const EmbeddingOptions& options = {}) {
-  return embed(exec::seq, mesh, Q, options);
-}
-
 namespace detail {
 /// Checks that every embedded point's tet exists in T and indexes one of `num_vertices` vertices.
 template <class S>
@@ -147,12 +141,6 @@ Points<S> deform(P policy, const Embedding<S>& e, const Tets& T, const Eigen::Ma
     X.row(q) = x.transpose();
   });
   return X;
-}
-
-/// Sequential deform.
-template <class S, class DV>
-Points<S> deform(const Embedding<S>& e, const Tets& T, const Eigen::MatrixBase<DV>& V) {
-  return deform(exec::seq, e, T, V);
 }
 
 /// The embedding as a row-major Q×N sparse matrix W (4 entries per row, explicit zeros kept for a

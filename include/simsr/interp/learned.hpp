@@ -49,9 +49,10 @@ struct NetworkTrainOptions {
   nn::TrainerOptions trainer;
   /// Frames (displacements, as the training frames) evaluated after every epoch; never trained on.
   const data::PairedFrames<Scalar>* holdout = nullptr;
-  /// Written after every epoch when not empty (atomically); resumable.
+  /// Written before the first step and after every epoch when not empty (atomically); resumable.
   std::filesystem::path checkpoint;
-  /// Continue from this checkpoint when not empty (it must come from the same config and data).
+  /// Continue from this checkpoint when not empty: it must come from the same config, options and
+  /// data (nn::Trainer::load_checkpoint names what differs).
   std::filesystem::path resume;
 };
 
@@ -124,9 +125,12 @@ class Learned {
   template <exec::HostPolicy Policy>
   void train(Policy policy, const data::PairedFrames<Scalar>& frames, const NetworkTrainOptions& options) {
     if (!net_) throw ArgumentError("Learned::train before fit");
-    nn::Trainer<network_scalar> trainer(*net_, model_.hr_faces, training_frames(frames, "training frames"), options.trainer);
+    nn::Trainer<network_scalar, typename Net::search_type> trainer(*net_, model_.hr_faces, training_frames(frames, "training frames"), options.trainer);
     if (options.holdout) trainer.set_holdout(training_frames(*options.holdout, "held-out frames"));
-    if (!options.resume.empty()) trainer.load_checkpoint(options.resume);
+    if (!options.resume.empty())
+      trainer.load_checkpoint(options.resume);  // refuses another run's checkpoint, naming what differs
+    else if (!options.checkpoint.empty())
+      trainer.save_checkpoint(options.checkpoint, model_);  // before the first step: a run killed in epoch 1 resumes too
     while (trainer.epoch() < trainer.epochs()) {
       trainer.run_epoch(policy);
       if (!options.checkpoint.empty()) trainer.save_checkpoint(options.checkpoint, model_);

@@ -25,12 +25,6 @@ VecX<typename DV::Scalar> signed_volumes(P policy, const Eigen::MatrixBase<DV>& 
   return vol;
 }
 
-/// Sequential signed_volumes.
-template <class DV, class DT>
-VecX<typename DV::Scalar> signed_volumes(const Eigen::MatrixBase<DV>& V, const Eigen::MatrixBase<DT>& T) {
-  return signed_volumes(exec::seq, V, T);
-}
-
 /// Sum of the signed tet volumes (V #V×3, T #T×4): the enclosed volume of a positively oriented
 /// mesh. seq and omp round identically.
 template <exec::HostPolicy P, class DV, class DT>
@@ -46,12 +40,6 @@ typename DV::Scalar total_volume(P policy, const Eigen::MatrixBase<DV>& V, const
              },
              std::plus<>{}) /
          S(6);
-}
-
-/// Sequential total_volume.
-template <class DV, class DT>
-typename DV::Scalar total_volume(const Eigen::MatrixBase<DV>& V, const Eigen::MatrixBase<DT>& T) {
-  return total_volume(exec::seq, V, T);
 }
 
 }  // namespace simsr

@@ -53,9 +53,13 @@ class Adam {
   /// Restores a saved state; ShapeError when it does not match the store's parameter count.
   void load_state(State s) {
     const Index n = store_->num_parameters();
+    if (s.step < 0) throw ArgumentError("nn::Adam::load_state: negative step count");
+    if (s.step == 0 && s.exp_avg.size() == 0 && s.exp_avg_sq.size() == 0) {  // the state before the first step
+      st_ = std::move(s);
+      return;
+    }
     if (s.exp_avg.size() != n || s.exp_avg_sq.size() != n)
       throw ShapeError("nn::Adam::load_state: exp_avg / exp_avg_sq", {n}, {s.exp_avg.size()});
-    if (s.step < 0) throw ArgumentError("nn::Adam::load_state: negative step count");
     st_ = std::move(s);
   }
 

@@ -78,6 +78,14 @@ class CoordinateUpsampling {
     mlp_ = std::make_unique<Mlp<S>>(store, prefix + ".conv_weights", stages(cfg), rng);
   }
 
+  /// The tensors this module registers under `prefix` for M HR vertices and K = upK (shapes only).
+  static void append_state_shapes(std::vector<TensorEntry>& out, const std::string& prefix, const NetworkConfig& cfg, Index M) {
+    if (cfg.upsampling == UpsamplingKind::table)
+      out.push_back(TensorEntry{prefix + ".logits", {M, cfg.up_k}, TensorEntry::Kind::parameter, 0, M * cfg.up_k});
+    else
+      nn::append_state_shapes(out, prefix + ".conv_weights", stages(cfg));
+  }
+
   /// f_θ: hidden layers (Conv2d [no bias + BatchNorm2d] then sin(ω₀·)), then Conv2d → 1 with bias.
   static std::vector<MlpStage> stages(const NetworkConfig& cfg) {
     std::vector<MlpStage> st;

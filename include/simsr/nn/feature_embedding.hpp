@@ -133,18 +133,29 @@ class FeatureEmbedding {
                                                                     b == 0 ? &graph_ : nullptr, rng));
       drops_.push_back(std::make_unique<Dropout<S>>(cfg.dropout, Rng(rng())));
     }
-    if (cfg.profile == "official") {
-      const Index d = cfg.pos_feat_dim;
-      fc_initial_ = std::make_unique<Mlp<S>>(
-          store, prefix + ".fc_initial",
-          std::vector<MlpStage>{MlpStage::linear(3, d, "0").dims(0).then(Act::leaky_relu, cfg.leaky_relu_slope), MlpStage::linear(d, d, "2").dims(0)},
-          rng);
-    }
+    if (cfg.profile == "official") fc_initial_ = std::make_unique<Mlp<S>>(store, prefix + ".fc_initial", fc_initial_stages(cfg), rng);
     std::vector<Index> widths(dims_.begin(), dims_.end());
     cat_ = std::make_unique<Concat<S>>(widths);
     h_.resize(std::size_t(S_blocks));
     pre_drop_.resize(std::size_t(S_blocks));
     d_h_.resize(std::size_t(S_blocks));
+  }
+
+  /// The official module's unused fc_initial: Linear 3→D, LeakyReLU, Linear D→D.
+  static std::vector<MlpStage> fc_initial_stages(const NetworkConfig& cfg) {
+    const Index d = cfg.pos_feat_dim;
+    return {MlpStage::linear(3, d, "0").dims(0).then(Act::leaky_relu, cfg.leaky_relu_slope), MlpStage::linear(d, d, "2").dims(0)};
+  }
+
+  /// The tensors this module registers under `prefix`, in its order (shapes only).
+  static void append_state_shapes(std::vector<TensorEntry>& out, const std::string& prefix, const NetworkConfig& cfg) {
+    for (std::size_t b = 0; b + 1 < cfg.emb_feat_dims.size(); ++b) {
+      const std::string p = prefix + ".blocks." + std::to_string(b);
+      const Index in = cfg.emb_feat_dims[b], width = cfg.emb_feat_dims[b + 1];
+      nn::append_state_shapes(out, p + ".edge_conv", EdgeConv<S, Search>::stages(in, width, EmbeddingBlock<S, Search>::edge_options(cfg)));
+      nn::append_state_shapes(out, p + ".fc_out", EmbeddingBlock<S, Search>::fc_out_stages(cfg, in, width));
+    }
+    if (cfg.profile == "official") nn::append_state_shapes(out, prefix + ".fc_initial", fc_initial_stages(cfg));
   }
 
   Index blocks() const { return Index(blocks_.size()); }

@@ -26,9 +26,10 @@ inline void require_finite_loss(const std::string& where, double value, std::int
 
 namespace detail {
 template <class S, class Values>
-void require_finite_entries(const std::string& where, const ParameterStore<S>& store, std::int64_t step, const char* what, Values&& values) {
+void require_finite_entries(const std::string& where, const ParameterStore<S>& store, std::int64_t step, const char* what, Values&& values,
+                            TensorEntry::Kind kind = TensorEntry::Kind::parameter) {
   for (const auto& e : store.entries()) {
-    if (e.kind != TensorEntry::Kind::parameter) continue;
+    if (e.kind != kind) continue;
     const S* v = values(e);
     for (Index i = 0; i < e.size; ++i)
       if (!std::isfinite(double(v[i])))
@@ -47,6 +48,20 @@ void require_finite_gradients(const std::string& where, const ParameterStore<S>&
 template <class S>
 void require_finite_parameters(const std::string& where, const ParameterStore<S>& store, std::int64_t step) {
   detail::require_finite_entries(where, store, step, "the weight", [&](const TensorEntry& e) { return store.values().data() + e.offset; });
+}
+
+/// NumericalError naming the first buffer (BatchNorm running statistics) with a non-finite value.
+template <class S>
+void require_finite_buffers(const std::string& where, const ParameterStore<S>& store, std::int64_t step) {
+  detail::require_finite_entries(
+      where, store, step, "the buffer", [&](const TensorEntry& e) { return store.buffers().data() + e.offset; }, TensorEntry::Kind::buffer);
+}
+
+/// Every weight and buffer finite (what a model file or checkpoint may hold): before any write.
+template <class S>
+void require_finite_state(const std::string& where, const ParameterStore<S>& store, std::int64_t step = -1) {
+  require_finite_parameters(where, store, step);
+  require_finite_buffers(where, store, step);
 }
 
 }  // namespace simsr::nn

@@ -78,6 +78,33 @@ struct MlpStage {
 
 /// The stages in order; forward keeps every intermediate for backward. Not copyable (layers
 /// point into the store); one object serves one place in the graph.
+/// The tensors an Mlp of `stages` registers under `prefix`, in its order, without building it
+/// (shapes only, offsets 0): what a model file must hold for it (nn::network_state_shapes).
+inline void append_state_shapes(std::vector<TensorEntry>& out, const std::string& prefix, const std::vector<MlpStage>& stages) {
+  const std::string p = prefix.empty() ? "" : prefix + ".";
+  auto add = [&](std::string name, std::vector<Index> shape, TensorEntry::Kind kind) {
+    Index size = 1;
+    for (Index d : shape) size *= d;
+    out.push_back(TensorEntry{std::move(name), std::move(shape), kind, 0, size});
+  };
+  for (const MlpStage& s : stages) {
+    std::vector<Index> w{s.out, s.in};
+    w.insert(w.end(), static_cast<std::size_t>(s.kernel_dims), Index(1));
+    add(p + s.linear_name + ".weight", w, TensorEntry::Kind::parameter);
+    if (s.bias) add(p + s.linear_name + ".bias", {s.out}, TensorEntry::Kind::parameter);
+    if (!s.batch_norm) continue;
+    if (s.bn.affine) {
+      add(p + s.bn_name + ".weight", {s.out}, TensorEntry::Kind::parameter);
+      add(p + s.bn_name + ".bias", {s.out}, TensorEntry::Kind::parameter);
+    }
+    if (s.bn.track_running_stats) {
+      add(p + s.bn_name + ".running_mean", {s.out}, TensorEntry::Kind::buffer);
+      add(p + s.bn_name + ".running_var", {s.out}, TensorEntry::Kind::buffer);
+      add(p + s.bn_name + ".num_batches_tracked", {}, TensorEntry::Kind::buffer);
+    }
+  }
+}
+
 template <class S = float>
 class Mlp {
  public:

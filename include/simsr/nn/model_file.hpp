@@ -15,7 +15,10 @@
 #include <string>
 #include <vector>
 
+#include <algorithm>
+
 #include "../io/npz.hpp"
+#include "finite_checks.hpp"
 #include "super_resolution_net.hpp"
 
 namespace simsr::nn {
@@ -98,7 +101,31 @@ Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> model_matrix(c
 
 }  // namespace detail
 
-/// Config, geometry, tets and faces of a model file's arrays; `file` names it in errors.
+/// ArgumentError unless `arrays` hold exactly the state tensors that `cfg` implies for M HR
+/// vertices (SuperResolutionNet::state_shapes), each with its shape: checked on the arrays' headers
+/// before any network is built, so a small file cannot make the loader allocate a huge network.
+inline void check_state_shapes(const io::NpzArrays& arrays, const std::string& file, const NetworkConfig& cfg, Index M) {
+  auto text = [](const auto& shape) {
+    std::string t = "(";
+    for (std::size_t i = 0; i < shape.size(); ++i) t += (i ? ", " : "") + std::to_string(shape[i]);
+    return t + ")";
+  };
+  const std::vector<TensorEntry> expected = SuperResolutionNet<float>::state_shapes(cfg, M);
+  for (const auto& e : expected) {
+    if (!arrays.contains(e.name)) throw ArgumentError(file + ": the config implies tensor '" + e.name + "' " + text(e.shape) + ", which the file lacks");
+    const auto& shape = arrays.at(e.name).shape;
+    if (std::vector<Index>(shape.begin(), shape.end()) != e.shape)
+      throw ArgumentError(file + ": tensor '" + e.name + "' has shape " + text(shape) + ", the config implies " + text(e.shape));
+  }
+  for (const auto& [name, a] : arrays)
+    if (is_state_tensor_name(name) &&
+        std::none_of(expected.begin(), expected.end(), [&, &n = name](const TensorEntry& e) { return e.name == n; }))
+      throw ArgumentError(file + ": tensor '" + name + "' is not part of the network its config describes");
+}
+
+/// Config, geometry, tets and faces of a model file's arrays; `file` names it in errors. The
+/// config is validated (every field within its bounds) and the state tensors' shapes checked
+/// against it (check_state_shapes) before anything the config sizes is allocated.
 inline ModelData model_data(const io::NpzArrays& a, const std::string& file = "<model>") {
   ModelData d;
   if (!a.contains("config")) throw ArgumentError(file + ": the model file has no 'config'");
@@ -117,6 +144,7 @@ inline ModelData model_data(const io::NpzArrays& a, const std::string& file = "<
   auto& g = d.geometry;
   g.lr_rest = detail::model_matrix<double>(a, file, "lr_rest", 3);
   g.hr_rest = detail::model_matrix<double>(a, file, "hr_rest", 3);
+  check_state_shapes(a, file, d.config, g.hr_rest.rows());
   g.lr_graph = detail::model_matrix<VIndex>(a, file, "lr_graph", -1);
   g.up_indices = detail::model_matrix<VIndex>(a, file, "up_indices", -1);
   g.up_distances = detail::model_matrix<double>(a, file, "up_distances", -1);
@@ -163,8 +191,10 @@ inline io::NpzArrays read_model_arrays(const std::filesystem::path& path) { retu
 inline ModelData read_model_data(const std::filesystem::path& path) { return model_data(io::read_npz(path), path.string()); }
 
 /// The model file's arrays for `net` and its data (which must be the data `net` was built from).
+/// NumericalError when a weight or buffer of `net` is not finite: a model file never holds one.
 template <class S, class Search>
 io::NpzArrays model_arrays(const SuperResolutionNet<S, Search>& net, const ModelData& data) {
+  require_finite_state("nn::save_model", net.store());
   io::NpzArrays out;
   add_state(out, net.store());
   out["config"] = io::make_npy(std::vector<std::string>{net.config().to_json().dump()});

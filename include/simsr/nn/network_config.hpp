@@ -130,9 +130,34 @@ struct NetworkConfig {
     return d;
   }
 
-  /// ArgumentError naming the first inconsistent field.
+  /// validate()'s upper bounds: any layer width, entries of a width list, knn and upK.
+  static constexpr Index max_width = 8192, max_layers = 64, max_neighbors = 1024;
+
+  /// ArgumentError naming the first inconsistent or out-of-bounds field.
   void validate() const {
     auto fail = [](const std::string& m) { throw ArgumentError("nn::NetworkConfig: " + m); };
+    // Upper bounds first (a model file's config is untrusted input: a few bytes of JSON must not
+    // ask for a network of hundreds of GB), far above any published network (widths ≤ 512).
+    auto at_most = [&](const char* field, Index value, Index bound) {
+      if (value > bound) fail(std::string(field) + " = " + std::to_string(value) + " exceeds the sane bound " + std::to_string(bound));
+    };
+    auto widths_at_most = [&](const char* field, const std::vector<Index>& v) {
+      at_most((std::string(field) + " (number of entries)").c_str(), Index(v.size()), max_layers);
+      for (Index d : v) at_most(field, d, max_width);
+    };
+    at_most("pos_feat_dim", pos_feat_dim, max_width);
+    widths_at_most("emb_feat_dims", emb_feat_dims);
+    widths_at_most("up_hidden", up_hidden);
+    widths_at_most("decoder_dims", decoder_dims);
+    at_most("knn", knn, max_neighbors);
+    at_most("upK", up_k, max_neighbors);
+    at_most("batch_size", batch_size, Index(1) << 20);
+    at_most("n_epochs", epochs, Index(1) << 24);
+    at_most("zreg_ramp_steps", zreg_ramp_steps, Index(1) << 40);
+    for (double v : {w0_initial, w0, up_w0_initial, up_w0, leaky_relu_slope, batchnorm_eps, batchnorm_momentum, lr, w_recon, w_fn, w_zreg,
+                     zreg_start, zreg_end, norm_mean, norm_std, dropout})
+      if (!std::isfinite(v)) fail("every real-valued field must be finite");
+    if (!(batchnorm_eps > 0) || !(batchnorm_momentum >= 0 && batchnorm_momentum <= 1)) fail("batchnorm eps must be > 0 and momentum in [0, 1]");
     if (pos_feat_dim < 2 || pos_feat_dim % 2) fail("pos_feat_dim must be even and >= 2");
     if (emb_feat_dims.empty() || emb_feat_dims[0] != 3 + pos_feat_dim)
       fail("emb_feat_dims[0] must be 3 + pos_feat_dim = " + std::to_string(3 + pos_feat_dim));
@@ -223,6 +248,7 @@ struct NetworkConfig {
   /// ArgumentError naming it.
   static NetworkConfig from_json(const nlohmann::json& j) {
     if (!j.is_object()) throw ArgumentError("nn::NetworkConfig: the config is not a JSON object");
+    if (j.contains("profile") && !j.at("profile").is_string()) throw ArgumentError("nn::NetworkConfig: key 'profile' must be a string");
     NetworkConfig c = preset(j.value("profile", std::string("official")));
     auto get = [&](const char* key, auto& field) {
       if (!j.contains(key)) return;
@@ -241,7 +267,8 @@ struct NetworkConfig {
       Index width = c.up_hidden.empty() ? 128 : c.up_hidden.front(), layers = Index(c.up_hidden.size());
       get("w_up_feat_dim", width);
       get("n_upscale_layers", layers);
-      if (layers < 0) throw ArgumentError("nn::NetworkConfig: n_upscale_layers must be >= 0");
+      if (layers < 0 || layers > max_layers)
+        throw ArgumentError("nn::NetworkConfig: n_upscale_layers = " + std::to_string(layers) + " is outside [0, " + std::to_string(max_layers) + "]");
       c.up_hidden.assign(std::size_t(layers), width);
     }
     if (!j.contains("decoder_dims") && j.contains("decoder_dim")) {

@@ -53,23 +53,39 @@ class SirenDecoder {
   /// Registers the sine layers, the dead layer (into `dead`, when the config has it) and
   /// last_layer, in the official state-dict order.
   static Net build(ParameterStore<S>& store, const std::string& prefix, const NetworkConfig& cfg, Rng& rng, std::unique_ptr<Mlp<S>>& dead) {
+    const Stages st = stages(cfg);
+    Mlp<S> sines(store, prefix, st.sines, rng);
+    if (cfg.decoder_dead_layer) dead = std::make_unique<Mlp<S>>(store, prefix, st.dead, rng);
+    Mlp<S> last(store, prefix, st.last, rng);
+    return Net(std::move(sines), std::move(last));
+  }
+
+  struct Stages {
+    std::vector<MlpStage> sines, dead, last;
+  };
+  static Stages stages(const NetworkConfig& cfg) {
     const auto& d = cfg.decoder_dims;
     if (d.size() < 3) throw ArgumentError("nn::SirenDecoder: decoder_dims needs at least one hidden width (in, hidden…, 3)");
     const std::size_t hidden = d.size() - 2;
-    std::vector<MlpStage> st;
+    Stages st;
     for (std::size_t i = 0; i < hidden; ++i) {
       const double w0 = i == 0 ? cfg.w0_initial : cfg.w0;
-      st.push_back(MlpStage::linear(d[i], d[i + 1], "layers." + std::to_string(i) + ".fc").dims(0).siren(i == 0, w0).then(Act::sine, w0));
+      st.sines.push_back(MlpStage::linear(d[i], d[i + 1], "layers." + std::to_string(i) + ".fc").dims(0).siren(i == 0, w0).then(Act::sine, w0));
     }
-    Mlp<S> sines(store, prefix, st, rng);
     if (cfg.decoder_dead_layer)
-      dead = std::make_unique<Mlp<S>>(
-          store, prefix,
-          std::vector<MlpStage>{MlpStage::linear(d[hidden], d[hidden + 1], "layers." + std::to_string(hidden) + ".fc").dims(0).siren(false, cfg.w0)},
-          rng);
-    Mlp<S> last(store, prefix, std::vector<MlpStage>{MlpStage::linear(d[hidden], d[hidden + 1], "last_layer.fc").dims(0).siren(false, cfg.w0)}, rng);
-    return Net(std::move(sines), std::move(last));
+      st.dead = {MlpStage::linear(d[hidden], d[hidden + 1], "layers." + std::to_string(hidden) + ".fc").dims(0).siren(false, cfg.w0)};
+    st.last = {MlpStage::linear(d[hidden], d[hidden + 1], "last_layer.fc").dims(0).siren(false, cfg.w0)};
+    return st;
   }
+
+ public:
+  /// The tensors this module registers under `prefix`, in its order (shapes only).
+  static void append_state_shapes(std::vector<TensorEntry>& out, const std::string& prefix, const NetworkConfig& cfg) {
+    const Stages st = stages(cfg);
+    for (const auto* s : {&st.sines, &st.dead, &st.last}) nn::append_state_shapes(out, prefix, *s);
+  }
+
+ private:
 
   std::unique_ptr<Mlp<S>> dead_;  ///< registered only (official weights load), never run; before net_ (built first)
   Net net_;

@@ -81,6 +81,18 @@ class SuperResolutionNet {
     }
   }
 
+  /// The state dict this network registers for `cfg` and M HR vertices, in order (names, shapes,
+  /// kinds; no weight allocated): a model file's tensors are checked against it before a network
+  /// is built (nn::model_data), so a small file cannot ask for a huge network.
+  static std::vector<TensorEntry> state_shapes(const NetworkConfig& cfg, Index M) {
+    cfg.validate();
+    std::vector<TensorEntry> out;
+    if (cfg.feature_embedding) FeatureEmbedding<S, Search>::append_state_shapes(out, "net_feat_emb", cfg);
+    CoordinateUpsampling<S>::append_state_shapes(out, "net_upscale", cfg, M);
+    SirenDecoder<S>::append_state_shapes(out, "net_decoder.decoder", cfg);
+    return out;
+  }
+
   SuperResolutionNet(const SuperResolutionNet&) = delete;
   SuperResolutionNet& operator=(const SuperResolutionNet&) = delete;
 
@@ -160,8 +172,15 @@ class SuperResolutionNet {
     decoder_->forward(policy, mode, zh_, pred);
     pred_ = &pred;
     if (cfg_.residual) {
+      // Row by row under the policy: Eigen's sparse × dense product may start its own OpenMP
+      // threads, and exec::seq must start none (tests/threads).
       const Index B = ldx.rows() / n_;
-      for (Index b = 0; b < B; ++b) pred.middleRows(b * m_, m_).noalias() += embedding_ * ldx.middleRows(b * n_, n_);
+      exec::parallel_for(policy, B * m_, [&](Index r) {
+        const Index b = r / m_;
+        auto out = pred.row(r);
+        for (typename decltype(embedding_)::InnerIterator it(embedding_, r - b * m_); it; ++it)
+          out += it.value() * ldx.row(b * n_ + it.index());
+      });
     }
   }
   ConstView<S> pred_ref() const {

@@ -14,6 +14,14 @@
 /// Determinism: the shuffle is a Fisher–Yates over a 64-bit Mersenne twister seeded by `seed`,
 /// dropout masks are reseeded from it at every step, and every kernel gives the same bits under
 /// exec::seq and exec::omp, so a seed fixes the run.
+///
+/// No silent failure (issue #10): the loss is checked before anything moves (backward, the
+/// optimizer step), the gradients before the step and the weights and BatchNorm statistics after
+/// it; a non-finite value is a NumericalError naming the step and the tensor, and since every
+/// model file and checkpoint writer checks the state again, a non-finite weight is never saved. A
+/// non-finite held-out error is a NumericalError too. A checkpoint records the run's config,
+/// options and a fingerprint of its data (training frames, held-out frames, rest shapes, faces);
+/// load_checkpoint refuses one that differs and says in what.
 
 #include <chrono>
 #include <cstdio>
@@ -22,9 +30,12 @@
 #include <string>
 #include <vector>
 
+#include "../core/fingerprint.hpp"
 #include "../io/npy.hpp"
 #include "adam.hpp"
+#include "finite_checks.hpp"
 #include "model_file.hpp"
+#include "shuffle.hpp"
 #include "super_resolution_loss.hpp"
 
 namespace simsr::nn {
@@ -100,7 +111,7 @@ class Trainer {
   Trainer(SuperResolutionNet<S, Search>& net, const Tris& hr_faces, TrainingFrames<S> frames, TrainerOptions options = {})
       : net_(&net), data_(std::move(frames)), opt_(std::move(options)), rng_(opt_.seed),
         adam_(net.store(), {.lr = opt_.lr > 0 ? opt_.lr : net.config().lr}),
-        loss_(net.config(), net.hr_rest_normalized(), hr_faces, total_steps_estimate()) {
+        loss_(net.config(), net.hr_rest_normalized(), hr_faces, total_steps_estimate()), hr_faces_(hr_faces) {
     if (data_.frames < 1) throw ArgumentError("nn::Trainer: no training frames");
     if (data_.n != net.lr_points() || data_.m != net.hr_points())
       throw ShapeError("nn::Trainer: frames (N, M)", {net.lr_points(), net.hr_points()}, {data_.n, data_.m});
@@ -133,9 +144,8 @@ class Trainer {
   EpochReport run_epoch(Policy policy) {
     const auto t0 = std::chrono::steady_clock::now();
     adam_.set_lr(current_lr());
-    std::vector<Index> order(std::size_t(data_.frames));
-    for (Index i = 0; i < data_.frames; ++i) order[std::size_t(i)] = i;
-    for (Index i = data_.frames - 1; i > 0; --i) std::swap(order[std::size_t(i)], order[std::size_t(uniform_index(i + 1))]);
+    shuffled_order(rng_, data_.frames, order_);
+    const auto& order = order_;
     EpochReport rep;
     rep.epoch = epoch_ + 1;
     rep.lr = current_lr();
@@ -147,10 +157,12 @@ class Trainer {
       net_->store().zero_grad();
       net_->forward(policy, Mode::train, ldx_, pred_);
       const auto t = loss_.evaluate(policy, pred_, hdx_, net_->code(), long(adam_.steps()), &d_pred_, &d_code_);
+      const std::int64_t step = adam_.steps() + 1;  // the step this batch makes (1-based)
+      require_finite_loss("nn::Trainer", t.total, step);
       net_->backward(policy, d_pred_, &d_code_);
+      require_finite_gradients("nn::Trainer", net_->store(), step);
       adam_.step(policy);
-      if (!std::isfinite(t.total))
-        throw ConvergenceError("nn::Trainer", int(adam_.steps()), t.total);
+      require_finite_state("nn::Trainer (after the optimizer step)", net_->store(), step);
       rep.loss += t.total / double(nb);
       rep.recon += t.recon / double(nb);
       rep.z_reg += t.z_reg / double(nb);
@@ -185,14 +197,18 @@ class Trainer {
       net_->infer(policy, holdout_.ldx.middleRows(f * N, N), pred_eval_);
       sum += (pred_eval_ - holdout_.hdx.middleRows(f * M, M)).template cast<double>().rowwise().norm().sum();
     }
-    return sum / double(holdout_.frames * M) * net_->config().norm_std;
+    const double error = sum / double(holdout_.frames * M) * net_->config().norm_std;
+    if (!std::isfinite(error)) throw NumericalError("nn::Trainer", "the held-out mean error", adam_.steps(), error);
+    return error;
   }
 
   /// The model file plus the training state: `train/epoch`, `train/adam_step`,
   /// `train/exp_avg/<name>`, `train/exp_avg_sq/<name>`, `train/rng` (the Mersenne twister state
-  /// as text), `train/options` (JSON). A model file loads from it as is.
+  /// as text), `train/options` and `train/data` (JSON: what load_checkpoint compares). A model file
+  /// loads from it as is. Written before the first step it resumes too (epoch 0, no moments).
+  /// NumericalError (nothing written) when a weight, buffer or moment is not finite.
   void save_checkpoint(const std::filesystem::path& path, const ModelData& data) const {
-    io::NpzArrays a = model_arrays(*net_, data);
+    io::NpzArrays a = model_arrays(*net_, data);  // checks the weights and buffers
     const std::int64_t ep = epoch_, st = adam_.steps();
     a["train/epoch"] = io::make_npy<std::int64_t>({}, &ep);
     a["train/adam_step"] = io::make_npy<std::int64_t>({}, &st);
@@ -208,31 +224,93 @@ class Trainer {
     std::ostringstream rng;
     rng << rng_;
     a["train/rng"] = io::make_npy(std::vector<std::string>{rng.str()});
-    nlohmann::json o{{"epochs", epochs()}, {"batch_size", batch_size()}, {"lr", adam_.options().lr}, {"seed", opt_.seed}};
-    a["train/options"] = io::make_npy(std::vector<std::string>{o.dump()});
+    for (Index i = 0; i < Index(s.exp_avg.size()); ++i)
+      if (!std::isfinite(double(s.exp_avg[i])) || !std::isfinite(double(s.exp_avg_sq[i])))
+        throw NumericalError("nn::Trainer::save_checkpoint", "Adam's moment " + std::to_string(i), adam_.steps(), double(s.exp_avg[i]));
+    a["train/options"] = io::make_npy(std::vector<std::string>{options_json().dump()});
+    a["train/data"] = io::make_npy(std::vector<std::string>{data_json().dump()});
     io::write_npz(path, a);
+  }
+
+  /// True when the loss's schedule depends on the run's length (the paper's ramped latent norm
+  /// over the whole run): then a resumed run must have the checkpoint's epochs; otherwise it may
+  /// train longer (or stop earlier) than the run that wrote the checkpoint.
+  bool schedule_depends_on_epochs() const {
+    return net_->config().zreg == LatentRegularizer::ramped_norm && net_->config().zreg_ramp_steps == 0;
+  }
+
+  /// What a resumed run must share with the run that wrote the checkpoint: every option that
+  /// changes the continuation (epochs only where schedule_depends_on_epochs()).
+  nlohmann::json options_json() const {
+    return {{"epochs", epochs()}, {"batch_size", batch_size()}, {"lr", opt_.lr > 0 ? opt_.lr : net_->config().lr}, {"seed", opt_.seed},
+            {"lr_decay_epochs", opt_.lr_decay_epochs}, {"lr_decay_gamma", opt_.lr_decay_gamma}};
+  }
+  /// The data a resumed run must share: frame counts and fingerprints of the normalized training and
+  /// held-out frames (ids included), of the rest shapes and of the HR faces.
+  nlohmann::json data_json() const {
+    auto frames = [](const TrainingFrames<S>& t) {
+      return Fingerprint().add(t.ldx).add(t.hdx).add(t.ids).hex();
+    };
+    return {{"training_frames", data_.frames},
+            {"training_fingerprint", frames(data_)},
+            {"holdout_frames", holdout_.frames},
+            {"holdout_fingerprint", frames(holdout_)},
+            {"lr_vertices", data_.n},
+            {"hr_vertices", data_.m},
+            {"rest_fingerprint", Fingerprint().add(net_->lr_rest_normalized()).add(net_->hr_rest_normalized()).hex()},
+            {"faces_fingerprint", Fingerprint().add(hr_faces_).hex()}};
   }
 
   /// Restores weights, buffers, optimizer, RNG and counters from save_checkpoint's file: run(policy)
   /// then continues exactly as the saved run would have.
+  /// ArgumentError, before anything changes, when the checkpoint's config, options (options_json)
+  /// or data (data_json) differ from this run's, naming each difference.
   void load_checkpoint(const std::filesystem::path& path) {
     const io::NpzArrays a = io::read_npz(path);
-    load_state(net_->store(), a);
-    net_->parameters_changed();
-    if (!a.contains("train/epoch")) throw ArgumentError(path.string() + ": not a training checkpoint (no train/epoch)");
-    epoch_ = Index(a.at("train/epoch").item<std::int64_t>());
+    const std::string file = path.string();
+    for (const char* key : {"train/epoch", "train/adam_step", "train/rng", "train/options", "train/data", "config"})
+      if (!a.contains(key)) throw ArgumentError(file + ": not a training checkpoint of this version (no '" + key + "')");
+    std::string differences;
+    // the config's training fields are compared as the effective options below (a config's
+    // n_epochs may differ where the run's length may)
+    nlohmann::json saved_config = json_text(a, file, "config"), run_config = net_->config().to_json();
+    for (const char* key : {"n_epochs", "batch_size", "lr"})
+      if (saved_config.is_object()) saved_config.erase(key), run_config.erase(key);
+    compare_json(differences, "config", saved_config, run_config);
+    nlohmann::json saved_options = json_text(a, file, "train/options"), run_options = options_json();
+    if (!schedule_depends_on_epochs() && saved_options.is_object()) {
+      saved_options.erase("epochs");
+      run_options.erase("epochs");
+    }
+    compare_json(differences, "options", saved_options, run_options);
+    compare_json(differences, "data", json_text(a, file, "train/data"), data_json());
+    if (!differences.empty()) throw ArgumentError(file + ": this checkpoint comes from another run; " + differences);
+    const std::int64_t epoch = a.at("train/epoch").item<std::int64_t>();
     typename Adam<S>::State s;
     s.step = a.at("train/adam_step").item<std::int64_t>();
+    if (epoch > epochs())
+      throw ArgumentError(file + ": the checkpoint has trained " + std::to_string(epoch) + " epochs, more than this run's " + std::to_string(epochs()));
+    if (epoch < 0 || s.step < 0 || s.step != epoch * std::int64_t(steps_per_epoch()))
+      throw ArgumentError(file + ": inconsistent counters (epoch " + std::to_string(epoch) + ", step " + std::to_string(s.step) + ", " +
+                          std::to_string(steps_per_epoch()) + " steps per epoch)");
+    load_state(net_->store(), a);
+    net_->parameters_changed();
+    epoch_ = Index(epoch);
     if (s.step > 0) {
       const Index n = net_->store().num_parameters();
       s.exp_avg.setZero(n);
       s.exp_avg_sq.setZero(n);
       for (const auto& e : net_->store().entries()) {
         if (e.kind != TensorEntry::Kind::parameter) continue;
+        for (const auto& key : {"train/exp_avg/" + e.name, "train/exp_avg_sq/" + e.name})
+          if (!a.contains(key)) throw ArgumentError(file + ": the checkpoint has no optimizer state '" + key + "'");
         const auto m = a.at("train/exp_avg/" + e.name).template to_vector<S>();
         const auto v = a.at("train/exp_avg_sq/" + e.name).template to_vector<S>();
         if (Index(m.size()) != e.size || Index(v.size()) != e.size)
-          throw ShapeError(path.string() + ": optimizer state of '" + e.name + "'", {e.size}, {Index(m.size())});
+          throw ShapeError(file + ": optimizer state of '" + e.name + "'", {e.size}, {Index(m.size())});
+        for (std::size_t i = 0; i < m.size(); ++i)
+          if (!std::isfinite(double(m[i])) || !std::isfinite(double(v[i])))
+            throw ArgumentError(file + ": optimizer state of '" + e.name + "' entry " + std::to_string(i) + " is not finite");
         std::copy(m.begin(), m.end(), s.exp_avg.data() + e.offset);
         std::copy(v.begin(), v.end(), s.exp_avg_sq.data() + e.offset);
       }
@@ -240,7 +318,7 @@ class Trainer {
     adam_.load_state(std::move(s));
     std::istringstream rng(a.at("train/rng").to_strings().at(0));
     rng >> rng_;
-    if (rng.fail()) throw ParseError(path.string() + ":train/rng", 0, "not a Mersenne twister state");
+    if (rng.fail()) throw ParseError(file + ":train/rng", 0, "not a Mersenne twister state");
   }
 
  private:
@@ -254,13 +332,30 @@ class Trainer {
     if (opt_.lr_decay_epochs > 0) lr *= std::pow(opt_.lr_decay_gamma, double(epoch_ / opt_.lr_decay_epochs));
     return lr;
   }
-  /// Unbiased integer in [0, n) (rejection on the top of the 64-bit range).
-  Index uniform_index(Index n) {
-    const std::uint64_t un = std::uint64_t(n), limit = UINT64_MAX - UINT64_MAX % un;
-    std::uint64_t x;
-    do x = rng_();
-    while (x >= limit);
-    return Index(x % un);
+  static nlohmann::json json_text(const io::NpzArrays& a, const std::string& file, const std::string& key) {
+    const auto text = a.at(key).to_strings();
+    if (text.size() != 1) throw ArgumentError(file + ": '" + key + "' must be one JSON string");
+    try {
+      return nlohmann::json::parse(text[0]);
+    } catch (const nlohmann::json::exception& e) {
+      throw ParseError(file + ":" + key, 0, e.what());
+    }
+  }
+  /// Appends "what: key (checkpoint X, this run Y)" for every top-level key that differs.
+  static void compare_json(std::string& out, const char* what, const nlohmann::json& saved, const nlohmann::json& run) {
+    std::string diff;
+    auto note = [&](const std::string& key, const std::string& a, const std::string& b) {
+      diff += (diff.empty() ? "" : ", ") + key + " (checkpoint " + a + ", this run " + b + ")";
+    };
+    if (!saved.is_object()) {
+      note("the whole entry", saved.dump(), run.dump());
+    } else {
+      for (const auto& [key, value] : run.items())
+        if (!saved.contains(key) || saved.at(key) != value) note(key, saved.contains(key) ? saved.at(key).dump() : "none", value.dump());
+      for (const auto& [key, value] : saved.items())
+        if (!run.contains(key)) note(key, value.dump(), "none");
+    }
+    if (!diff.empty()) out += (out.empty() ? "" : "; ") + std::string(what) + " differ: " + diff;
   }
   void reseed_dropout() {
     const std::uint64_t s = rng_();
@@ -295,8 +390,10 @@ class Trainer {
   Rng rng_;
   Adam<S> adam_;
   SuperResolutionLoss<S> loss_;
+  Tris hr_faces_;
   Index epoch_ = 0;
   std::vector<EpochReport> history_;
+  std::vector<Index> order_;
   Matrix<S> ldx_, hdx_, pred_, d_pred_, d_code_, pred_eval_;
 };
 

@@ -26,6 +26,14 @@ concept ExecutionPolicy = std::same_as<std::remove_cvref_t<P>, seq_t> ||
                           std::same_as<std::remove_cvref_t<P>, omp_t> ||
                           std::same_as<std::remove_cvref_t<P>, cuda_t>;
 
+/// True for an ExecutionPolicy; for any other type a static_assert says so in one sentence.
+template <class P>
+constexpr bool assert_execution_policy() {
+  static_assert(ExecutionPolicy<P>,
+                "this type is not a simsr::exec::ExecutionPolicy: pass exec::seq, exec::omp or exec::cuda, as the first argument of every call");
+  return ExecutionPolicy<P>;
+}
+
 /// Policies that run on the host (their bodies may touch host memory and throw).
 template <class P>
 concept HostPolicy = std::same_as<std::remove_cvref_t<P>, seq_t> || std::same_as<std::remove_cvref_t<P>, omp_t>;

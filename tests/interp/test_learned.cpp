@@ -1,0 +1,154 @@
+// interp::Learned: the super-resolution network as a TrainableInterpolator (normalization,
+// geometry, training, inference and model files owned by the library, not the tool).
+#include <simsr/interp/embedded.hpp>
+#include <simsr/interp/learned.hpp>
+#include <simsr/mesh/generators.hpp>
+
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <random>
+
+using namespace simsr;
+
+namespace {
+
+struct NetScene {
+  interp::UpsamplingProblem<> problem;
+  data::PairedFrames<> frames;  // displacements
+};
+
+/// An LR box, an HR sphere inside it, F frames of smooth random motion (displacements).
+NetScene net_scene(Index f, unsigned seed) {
+  NetScene s;
+  s.problem.lr = box_tet_mesh<double>(3, 3, 3, Vec3<>(-0.1, -0.1, -0.1), Vec3<>(0.1, 0.1, 0.1));
+  s.problem.hr = icosphere<double>(2, 0.08);
+  s.problem.ensure_neighborhoods(exec::seq, 10);
+  const Index n = s.problem.num_lr(), m = s.problem.num_hr();
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, 0.01);
+  s.frames.lowres.resize(f, 3 * n);
+  s.frames.highres.resize(f, 3 * m);
+  s.frames.controls.resize(f, 0);
+  for (Index i = 0; i < f; ++i) {
+    const Eigen::RowVector3d a(g(rng), g(rng), g(rng)), b(g(rng), g(rng), g(rng));
+    for (Index v = 0; v < n; ++v) s.frames.lr(i).row(v) = a + b * (s.problem.lr.V(v, 0) * 10) * (s.problem.lr.V(v, 1) * 10);
+    for (Index v = 0; v < m; ++v) s.frames.hr(i).row(v) = a + b * (s.problem.hr.V(v, 0) * 10) * (s.problem.hr.V(v, 1) * 10);
+    s.frames.ids.push_back(i);
+  }
+  return s;
+}
+
+nn::NetworkConfig residual_config() {
+  nn::NetworkConfig c = nn::NetworkConfig::official();
+  c.residual = true;
+  return c;
+}
+
+interp::NetworkTrainOptions quick(Index epochs) {
+  interp::NetworkTrainOptions o;
+  o.trainer.epochs = epochs;
+  o.trainer.batch_size = 4;
+  o.trainer.lr = 1e-3;
+  o.trainer.progress = false;
+  o.trainer.seed = 3;
+  return o;
+}
+
+std::filesystem::path tmp(const std::string& name) {
+  const auto dir = std::filesystem::path(SIMSR_TEST_TMP_DIR) / "learned";
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+}  // namespace
+
+TEST_CASE("Learned: the untrained residual network is exactly the Embedded interpolation") {
+  auto s = net_scene(3, 1);
+  interp::Learned<> net(residual_config());
+  net.fit(exec::omp, s.problem);
+  interp::Embedded<> e;
+  e.fit(exec::omp, s.problem);
+  Points<> a(s.problem.num_hr(), 3), b(s.problem.num_hr(), 3);
+  for (Index f = 0; f < 3; ++f) {
+    const Points<> in = s.frames.lr(f);
+    net.apply(exec::omp, in, a);
+    e.apply(exec::omp, in, b);
+    // the output layer starts at zero; what differs is float32 normalization of the input
+    CHECK((a - b).cwiseAbs().maxCoeff() <= 1e-6 * (1.0 + b.cwiseAbs().maxCoeff()));
+  }
+}
+
+TEST_CASE("Learned: train, held-out error, seq == omp, save and load give the same predictions") {
+  auto s = net_scene(10, 2);
+  const auto train = s.frames.select(std::vector<Index>{0, 1, 2, 3, 4, 5, 6, 7});
+  const auto held = s.frames.select(std::vector<Index>{8, 9});
+  interp::Learned<> a(residual_config(), 5), b(residual_config(), 5);
+  a.fit(exec::seq, s.problem);
+  b.fit(exec::omp, s.problem);
+  auto o = quick(2);
+  o.holdout = &held;
+  a.train(exec::seq, train, o);
+  b.train(exec::omp, train, o);
+  REQUIRE(a.history().size() == 2);
+  CHECK(a.history().back().holdout_mean_error >= 0);
+  CHECK(a.steps() == 4);
+  Points<> pa(s.problem.num_hr(), 3), pb(s.problem.num_hr(), 3), pc(s.problem.num_hr(), 3);
+  const Points<> in = held.lr(0);
+  a.apply(exec::seq, in, pa);
+  b.apply(exec::omp, in, pb);
+  CHECK(pa == pb);
+  const auto file = tmp("model.npz");
+  a.save(file);
+  auto c = interp::Learned<>::from_model_file(file);
+  c.fit(exec::omp, s.problem);  // checks the rest shapes only
+  c.apply(exec::omp, in, pc);
+  CHECK(pa == pc);
+  auto other = net_scene(1, 9);
+  other.problem.hr.V *= 1.01;
+  auto d = interp::Learned<>::from_model_file(file);
+  CHECK_THROWS_WITH_AS(d.fit(exec::seq, other.problem), doctest::Contains("trained on other rest shapes"), ArgumentError);
+}
+
+TEST_CASE("Learned: a run resumed from its checkpoint ends where the uninterrupted run ends") {
+  auto s = net_scene(8, 3);
+  const auto ckpt = tmp("checkpoint.npz");
+  interp::Learned<> full(residual_config(), 1), first(residual_config(), 1), rest(residual_config(), 1);
+  full.fit(exec::seq, s.problem);
+  full.train(exec::seq, s.frames, quick(2));
+  first.fit(exec::seq, s.problem);
+  auto o1 = quick(1);
+  o1.checkpoint = ckpt;
+  first.train(exec::seq, s.frames, o1);
+  rest.fit(exec::seq, s.problem);
+  auto o2 = quick(2);
+  o2.resume = ckpt;
+  rest.train(exec::seq, s.frames, o2);
+  Points<> a(s.problem.num_hr(), 3), b(s.problem.num_hr(), 3);
+  const Points<> in = s.frames.lr(3);
+  full.apply(exec::seq, in, a);
+  rest.apply(exec::seq, in, b);
+  CHECK(a == b);
+}
+
+TEST_CASE("Learned: bad inputs are errors naming the vertex; the w/o CU ablation fits") {
+  auto s = net_scene(2, 4);
+  interp::Learned<> net(residual_config());
+  Points<> in(s.problem.num_lr(), 3), out(s.problem.num_hr(), 3);
+  in.setZero();
+  CHECK_THROWS_WITH_AS(net.apply(exec::seq, in, out), doctest::Contains("before fit"), ArgumentError);
+  net.fit(exec::seq, s.problem);
+  in(7, 1) = std::nan("");
+  CHECK_THROWS_WITH_AS(net.apply(exec::seq, in, out), doctest::Contains("vertex 7"), ArgumentError);
+  in(7, 1) = 1e300;
+  CHECK_THROWS_WITH_AS(net.apply(exec::seq, in, out), doctest::Contains("float range"), ArgumentError);
+  Points<> wrong(s.problem.num_hr() + 1, 3);
+  in.setZero();
+  CHECK_THROWS_AS(net.apply(exec::seq, in, wrong), ShapeError);
+  nn::NetworkConfig wocu = residual_config();
+  wocu.upsampling = nn::UpsamplingKind::table;
+  interp::Learned<> table(wocu);
+  table.fit(exec::omp, s.problem);
+  table.apply(exec::omp, in, out);
+  CHECK(out.allFinite());
+}
