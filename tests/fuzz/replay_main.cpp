@@ -31,8 +31,19 @@ static int replay(const std::filesystem::path& file) {
 int main(int argc, char** argv) {
   // As libFuzzer's -rss_limit_mb/-malloc_limit_mb: an input that makes a reader ask for more than
   // 4 GiB is a finding (std::bad_alloc), not a machine pushed into its OOM killer.
+  // Under ASan (whose shadow memory needs terabytes of address space) its allocator does the same:
+  // ASAN_OPTIONS=max_allocation_size_mb=4096:allocator_may_return_null=1 (tests/fuzz/CMakeLists.txt).
+#if defined(__has_feature)
+#if !__has_feature(address_sanitizer)
+#define SIMSR_REPLAY_LIMIT_ADDRESS_SPACE 1
+#endif
+#elif !defined(__SANITIZE_ADDRESS__)
+#define SIMSR_REPLAY_LIMIT_ADDRESS_SPACE 1
+#endif
+#if defined(SIMSR_REPLAY_LIMIT_ADDRESS_SPACE)
   const rlimit limit{rlim_t{4} << 30, rlim_t{4} << 30};
   setrlimit(RLIMIT_AS, &limit);
+#endif
   std::set_terminate([] {
     std::fprintf(stderr, "replay: uncaught exception while replaying %s\n", simsr_fuzz_replay_file ? simsr_fuzz_replay_file : "?");
     if (auto e = std::current_exception()) {

@@ -54,6 +54,15 @@ Toy make_toy(std::uint64_t seed, Index F = 10) {
   return t;
 }
 
+/// Every weight and buffer of `net`, flat.
+std::vector<double> trainer_state(const nn::SuperResolutionNet<double>& net) {
+  const auto v = net.store().values();
+  const auto b = net.store().buffers();
+  std::vector<double> out(v.data(), v.data() + v.size());
+  out.insert(out.end(), b.data(), b.data() + b.size());
+  return out;
+}
+
 std::vector<double> train_values(const Toy& toy, Index epochs, std::uint64_t seed, bool omp) {
   nn::Rng init(7);
   nn::SuperResolutionNet<double> net(toy.cfg, toy.geo, init);
@@ -62,11 +71,7 @@ std::vector<double> train_values(const Toy& toy, Index epochs, std::uint64_t see
     tr.run(exec::omp);
   else
     tr.run(exec::seq);
-  const auto v = net.store().values();
-  const auto b = net.store().buffers();
-  std::vector<double> out(v.data(), v.data() + v.size());
-  out.insert(out.end(), b.data(), b.data() + b.size());
-  return out;
+  return trainer_state(net);
 }
 
 }  // namespace
@@ -115,11 +120,7 @@ TEST_CASE("nn::Trainer: a seed fixes the run, seq == omp bitwise, and a checkpoi
   CHECK(tr.epoch() == 2);
   CHECK(tr.steps() == 6);
   tr.run(exec::omp);
-  const auto v = net.store().values();
-  const auto b = net.store().buffers();
-  std::vector<double> resumed(v.data(), v.data() + v.size());
-  resumed.insert(resumed.end(), b.data(), b.data() + b.size());
-  CHECK(resumed == a);
+  CHECK(trainer_state(net) == a);
   // the checkpoint is also a model file
   const auto data = nn::read_model_data(dir / "ckpt.npz");
   CHECK(data.geometry.up_indices == toy.geo.up_indices);
@@ -178,14 +179,6 @@ nn::ModelData toy_model_data(const Toy& toy) {
   md.lr_tets.row(0) << 0, 1, 2, 3;
   md.hr_faces = toy.faces;
   return md;
-}
-
-std::vector<double> trainer_state(const nn::SuperResolutionNet<double>& net) {
-  const auto v = net.store().values();
-  const auto b = net.store().buffers();
-  std::vector<double> out(v.data(), v.data() + v.size());
-  out.insert(out.end(), b.data(), b.data() + b.size());
-  return out;
 }
 
 }  // namespace
