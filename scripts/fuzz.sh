@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Builds every libFuzzer harness (tests/fuzz/fuzz_*.cpp: each reader, the model-file loader, paired
-# frames) with clang (ASan+UBSan) and fuzzes each for N seconds (default 60), starting from its
-# committed corpus. New crashing inputs land in build-fuzz/crashes/. Without clang++ this is a skip,
-# or a failure where SIMSR_REQUIRE_PEERS is set (scripts/test.sh, CI).
+# Fuzzes every libFuzzer harness (tests/fuzz/fuzz_*.cpp: each reader, the model-file loader, paired
+# frames) for N seconds each (default 60), starting from its committed corpus. The fuzzers are the
+# ASan build's replay_<name> binaries (clang, ASan+UBSan, libFuzzer's driver behind `--fuzz`): the
+# build scripts/test.sh makes, configured and built here if needed. New crashing inputs land in
+# build-asan/crashes/. Without clang++ this is a skip, or a failure where SIMSR_REQUIRE_PEERS is set.
 #   bash scripts/fuzz.sh [SECONDS]        (SIMSR_FUZZ_SEED=N picks the mutation seed; default 1, so
 #                                         a short run in CI explores the same inputs every time)
 set -euo pipefail
@@ -15,25 +16,25 @@ if ! command -v clang++ >/dev/null; then
   fi
   echo "simsr: clang++ not found, fuzzing skipped (apt-get install clang libclang-rt-dev)"; exit 0
 fi
-build=${SIMSR_FUZZ_BUILD_DIR:-build-fuzz}
-cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Release \
-  -DSIMSR_FUZZ=ON -DSIMSR_BUILD_TESTS=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_BUILD_EXAMPLES=OFF >/dev/null
+build=${SIMSR_ASAN_BUILD_DIR:-build-asan}
+[[ -f $build/CMakeCache.txt ]] || cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
+  -DSIMSR_SANITIZE=asan -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_BUILD_EXAMPLES=OFF >/dev/null
 shopt -s nullglob
 targets=""
-for f in tests/fuzz/fuzz_*.cpp; do targets+=" $(basename "$f" .cpp)"; done
+for f in tests/fuzz/fuzz_*.cpp; do n=$(basename "$f" .cpp); targets+=" replay_${n#fuzz_}"; done
 [[ -n $targets ]] || { echo "simsr: no fuzz harnesses"; exit 0; }
 cmake --build "$build" -j "$(nproc)" --target $targets
 mkdir -p "$build/crashes"
 status=0
 for t in $targets; do
-  name=${t#fuzz_}
+  name=${t#replay_}
   work=$(mktemp -d)
   cp -r "tests/fuzz/corpus/$name/." "$work/" 2>/dev/null || true
   # inputs up to 8 KiB, or twice the largest seed (a model file's seeds are ~40 KB): a seed cut to
   # max_len would only exercise the truncated-file paths
   largest=$(find "$work" -type f -printf '%s\n' | sort -n | tail -1)
   max_len=$((2 * ${largest:-0} > 8192 ? 2 * ${largest:-0} : 8192))
-  if "$build/tests/fuzz/$t" "$work" -max_total_time="$seconds" -seed="${SIMSR_FUZZ_SEED:-1}" -max_len="$max_len" -timeout=5 -rss_limit_mb=2048 \
+  if "$build/tests/fuzz/$t" --fuzz "$work" -max_total_time="$seconds" -seed="${SIMSR_FUZZ_SEED:-1}" -max_len="$max_len" -timeout=5 -rss_limit_mb=2048 \
        -artifact_prefix="$build/crashes/$name-" -print_final_stats=1 >"$build/$t.log" 2>&1; then
     runs=$(grep -m1 'stat::number_of_executed_units' "$build/$t.log" | awk '{print $2}')
     echo "simsr: fuzz $name: ${seconds} s, ${runs:-?} inputs, no crash"

@@ -7,11 +7,12 @@
 #   1. build/       g++ Release: every area's doctest suite, test_threads, the tool and examples, the
 #                   benchmarks (built, not run), the fuzz-corpus replays, the peers (gmsh, meshio,
 #                   numpy, scipy, torch), install + consumer project, compile-fail checks, cuda-compile
-#   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite and test_threads under
+#   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite and the corpus replays under
 #                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, no recovery)
 #   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: every suite that runs exec::omp under TSan, with
 #                   LLVM's libomp and its Archer tool (so OpenMP's synchronisation is understood)
-#   4. scripts/fuzz.sh: every libFuzzer harness for SIMSR_FUZZ_SECONDS (default 5) seconds
+#   4. scripts/fuzz.sh: every libFuzzer harness (build-asan's replay binaries) for
+#                   SIMSR_FUZZ_SECONDS (default 5) seconds each
 #
 # ctest must report no skipped or not-run test. The one exception, named here:
 #   cuda_compile where nvcc is absent: the CUDA toolkit is no Debian package deps.sh can install
@@ -73,8 +74,8 @@ step "build ($build)"
 run_ctest "$build"
 step "ctest ($build)"
 
-# 2-3. the sanitizer builds: clang, only the test suites (no tool, examples or benchmarks), -O1 -g1
-# with assertions on (Debug: no NDEBUG, so Eigen checks its indices too)
+# 2-3. the sanitizer builds: only the test suites (no tool, examples or benchmarks), -O1 -g1 with
+# assertions on (Debug: no NDEBUG, so Eigen checks its indices too), clang
 for kind in asan tsan; do
   dir=$asan
   [[ $kind == tsan ]] && dir=$tsan

@@ -41,7 +41,7 @@ struct BaselinesArgs {
 /// What the β-VAE's training did (the other methods report none).
 inline nlohmann::ordered_json training_json(const interp::BetaVaeBaseline<>& vae, const interp::BetaVaeTrainOptions& o) {
   const auto& h = vae.history();
-  return {{"epochs", o.epochs},         {"batch_size", o.batch_size}, {"lr", o.lr}, {"beta", o.beta}, {"seed", o.seed}, {"scale", vae.scale()},
+  return {{"epochs", o.epochs},         {"batch_size", o.batch_size}, {"lr", o.lr}, {"beta", o.network.beta}, {"seed", o.seed}, {"scale", vae.scale()},
           {"parameters", vae.num_parameters()},
           {"final_loss", h.empty() ? 0.0 : h.back().loss}, {"final_recon", h.empty() ? 0.0 : h.back().recon},
           {"final_kl", h.empty() ? 0.0 : h.back().kl}};

@@ -1,5 +1,7 @@
 // Replays every file of the given folders (or the given files) through LLVMFuzzerTestOneInput:
-// the corpus of each fuzzer becomes a regression test in builds without libFuzzer.
+// the corpus of each fuzzer becomes a regression test. In the ASan build (clang, SIMSR_FUZZ_DRIVER)
+// the same binary is also the libFuzzer fuzzer: `replay_<name> --fuzz [libFuzzer arguments]` hands
+// over to libFuzzer's driver (scripts/fuzz.sh), so one build serves replays and fuzzing.
 #include <sys/resource.h>
 
 #include <cstdint>
@@ -13,6 +15,10 @@
 #include <vector>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
+#if defined(SIMSR_FUZZ_DRIVER)
+// libFuzzer's entry for programs with a main of their own (libclang_rt.fuzzer_no_main, LLVM >= 11).
+extern "C" int LLVMFuzzerRunDriver(int* argc, char*** argv, int (*callback)(const std::uint8_t*, std::size_t));
+#endif
 
 // The file being replayed, for harnesses that hold seeds named valid_* to loading (npz_input.hpp).
 extern "C" {
@@ -29,6 +35,17 @@ static int replay(const std::filesystem::path& file) {
 }
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "--fuzz") {
+#if defined(SIMSR_FUZZ_DRIVER)
+    argv[1] = argv[0];  // libFuzzer sees "<program> [its arguments]"
+    int fuzz_argc = argc - 1;
+    char** fuzz_argv = argv + 1;
+    return LLVMFuzzerRunDriver(&fuzz_argc, &fuzz_argv, LLVMFuzzerTestOneInput);
+#else
+    std::fprintf(stderr, "%s: built without libFuzzer; the ASan build has it (clang, SIMSR_SANITIZE=asan: scripts/fuzz.sh)\n", argv[0]);
+    return 2;
+#endif
+  }
   // As libFuzzer's -rss_limit_mb/-malloc_limit_mb: an input that makes a reader ask for more than
   // 4 GiB is a finding (std::bad_alloc), not a machine pushed into its OOM killer.
   // Under ASan (whose shadow memory needs terabytes of address space) its allocator does the same:

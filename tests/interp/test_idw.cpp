@@ -2,6 +2,7 @@
 #include "../support/require.hpp"
 
 #include "bunny_fixture.hpp"
+#include "random_points.hpp"
 
 #include <simsr/interp/idw.hpp>
 #include <simsr/io/npy.hpp>
@@ -20,12 +21,7 @@ using namespace simsr::interp;
 
 namespace {
 
-Points<> random_points(Index n, double lo, double hi, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(lo, hi);
-  Points<> P(n, 3);
-  for (Index i = 0; i < P.size(); ++i) P.data()[i] = u(rng);
-  return P;
-}
+using simsr::test::random_points;
 
 /// Problem whose neighbourhoods are the k Euclidean-nearest LR vertices (stand-ins for §3.2's).
 UpsamplingProblem<> make_problem(Points<> L, Points<> H, Index k) {

@@ -2,6 +2,7 @@
 #include "../support/require.hpp"
 
 #include "bunny_fixture.hpp"
+#include "random_points.hpp"
 
 #include <simsr/interp/idw.hpp>
 #include <simsr/interp/mls.hpp>
@@ -35,13 +36,7 @@ Points<> jittered_lattice(int nx, int ny, int nz, double h, double jitter, std::
   return V;
 }
 
-/// Uniform random points in [lo, hi]³.
-Points<> random_points(Index n, double lo, double hi, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(lo, hi);
-  Points<> P(n, 3);
-  for (Index i = 0; i < P.size(); ++i) P.data()[i] = u(rng);
-  return P;
-}
+using simsr::test::random_points;
 
 using simsr::test::brute_neighborhoods;
 
@@ -208,7 +203,9 @@ TEST_CASE("MLS: seq and omp give identical bits; shapes and options are checked"
   CHECK_THROWS_AS(m.apply(exec::seq, dX, wrong), ShapeError);
   CHECK_THROWS_AS(MLS<>(MLSOptions{.degree = 4}).fit(exec::seq, p), ArgumentError);
   CHECK_THROWS_AS(MLS<>(MLSOptions{.k = 30}).fit(exec::seq, p), ArgumentError);
-  UpsamplingProblem<> bare{p.lr, p.hr, std::nullopt};
+  UpsamplingProblem<> bare;  // no neighbourhoods
+  bare.lr = p.lr;
+  bare.hr = p.hr;
   CHECK_THROWS_WITH_AS(MLS<>().fit(exec::seq, bare), doctest::Contains("ensure_neighborhoods"), ArgumentError);
 }
 

@@ -2,6 +2,7 @@
 #include "../support/require.hpp"
 
 #include "bunny_fixture.hpp"
+#include "random_points.hpp"
 
 #include <simsr/interp/rbf.hpp>
 #include <simsr/io/npy.hpp>
@@ -53,12 +54,7 @@ TetMesh<> lattice_tets(int nx, int ny, int nz, double h, double jitter, std::mt1
   return t;
 }
 
-Points<> random_points(Index n, double lo, double hi, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(lo, hi);
-  Points<> P(n, 3);
-  for (Index i = 0; i < P.size(); ++i) P.data()[i] = u(rng);
-  return P;
-}
+using simsr::test::random_points;
 
 /// All-pairs shortest paths over the tets' corner pairs (Floyd–Warshall): the truth for A.2's
 /// geodesic LR–LR distances.

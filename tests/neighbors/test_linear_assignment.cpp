@@ -85,7 +85,7 @@ Points<> clustered_points(Index n, int clusters, std::mt19937& rng, bool duplica
 Eigen::MatrixXd distance_matrix(const Points<>& A, const Points<>& B) {
   Eigen::MatrixXd C(A.rows(), B.rows());
   for (Index i = 0; i < A.rows(); ++i)
-    for (Index j = 0; j < B.rows(); ++j) C(i, j) = detail::assignment_distance(A, i, B, j);
+    for (Index j = 0; j < B.rows(); ++j) C(i, j) = neighbors::detail::assignment_distance(A, i, B, j);
   return C;
 }
 

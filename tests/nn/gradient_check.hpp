@@ -8,15 +8,14 @@
 
 #include <doctest/doctest.h>
 
+#include "../support/allocation_check.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <random>
 #include <string>
 #include <vector>
-
-/// Number of malloc/calloc/realloc calls so far in this process (all threads).
-long simsr_test_malloc_count();
 
 namespace simsr::test {
 
@@ -168,8 +167,7 @@ void check_warm_no_allocation(Policy policy, L& layer, const Matrix<S>& x, nn::M
   const long before = simsr_test_malloc_count();
   layer.forward(policy, mode, x, out);
   layer.backward(policy, x, out, r, &dx);
-  const long after = simsr_test_malloc_count();
-  CHECK(after - before == 0);
+  SIMSR_CHECK_NO_ALLOCATION(policy, simsr_test_malloc_count() - before);
   CHECK(out.data() == out_ptr);
   CHECK(dx.data() == dx_ptr);
 }

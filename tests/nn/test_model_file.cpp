@@ -135,6 +135,17 @@ TEST_CASE("nn::model_data: a config beyond its bounds or one its tensors do not 
     a.at("net_upscale.logits").shape = {1000000, 4};
     CHECK_THROWS_WITH_AS(nn::model_data(a, "t.npz"), doctest::Contains("the config implies (15, 4)"), ArgumentError);
   }
+  SUBCASE("an embedding indptr that runs past the indices and comes back (found by fuzz_model_file)") {
+    nn::NetworkConfig r = cfg;
+    r.residual = true;
+    io::NpzArrays a = small_model_arrays(r, 5);
+    CHECK_NOTHROW(nn::model_data(a, "r.npz"));
+    std::vector<std::int64_t> ptr(16);  // 15 rows of one entry each: 0, 1, …, 15
+    for (std::size_t i = 0; i < ptr.size(); ++i) ptr[i] = std::int64_t(i);
+    ptr[1] = 1000;  // row 0 would read indices 0..999 of 15, row 1 then "decreases"
+    a["embedding_indptr"] = io::make_npy<std::int64_t>({16}, ptr.data());
+    CHECK_THROWS_WITH_AS(nn::model_data(a, "r.npz"), doctest::Contains("r.npz: embedding_indptr decreases at row 1"), ArgumentError);
+  }
 }
 
 TEST_CASE("nn::save_model writes a model that loads into the same network; a non-finite weight is never written") {

@@ -176,7 +176,7 @@ TEST_CASE("nn::SuperResolutionNet: seq == omp bitwise; infer (precomputed sparse
   net.infer(exec::omp, ldx, pi2);
   const long before = simsr_test_malloc_count();
   net.infer(exec::omp, ldx, pi2);
-  CHECK(simsr_test_malloc_count() - before == 0);
+  SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before);
   // the residual path (a sparse embedding product per item) allocates nothing either
   nn::NetworkConfig rcfg = cfg;
   rcfg.residual = true;
@@ -187,7 +187,7 @@ TEST_CASE("nn::SuperResolutionNet: seq == omp bitwise; infer (precomputed sparse
   rnet.infer(exec::omp, ldx, pr);
   const long before_r = simsr_test_malloc_count();
   rnet.infer(exec::omp, ldx, pr);
-  CHECK(simsr_test_malloc_count() - before_r == 0);
+  SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before_r);
   // bad input
   CHECK_THROWS_AS(net.infer(exec::seq, Matrix<float>::Zero(59, 3), pi), ShapeError);
   CHECK_THROWS_AS(net.infer(exec::seq, Matrix<float>::Zero(60, 2), pi), ShapeError);

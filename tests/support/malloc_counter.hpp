@@ -2,8 +2,9 @@
 // Counts malloc calls (Eigen allocates with std::malloc, the standard containers through operator
 // new → malloc) by interposing glibc's malloc family, for the "no allocation once warm" checks.
 // Include from exactly ONE source file per test executable: it defines malloc/calloc/realloc/free.
-// Elsewhere, declare `long simsr_test_malloc_count();`. Without glibc the count stays 0.
-// Under ASan or TSan the sanitizer owns malloc (glibc's would bypass it, and its free would meet
+// Elsewhere, include allocation_check.hpp (SIMSR_CHECK_NO_ALLOCATION, which also says why exec::omp
+// counts are not checked under LLVM's libomp). Without glibc or a sanitizer the count stays 0.
+// Under ASan (or TSan) the sanitizer owns malloc (glibc's would bypass it, and its free would meet
 // blocks it never gave out), so the count comes from the sanitizer's own allocation hook instead,
 // which sees every malloc, calloc, realloc and operator new alike.
 #include <atomic>
@@ -12,8 +13,6 @@
 namespace simsr_test_detail {
 inline std::atomic<long> malloc_calls{0};
 }
-
-long simsr_test_malloc_count() { return simsr_test_detail::malloc_calls.load(); }
 
 #if defined(__has_feature)
 #if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
@@ -24,8 +23,12 @@ long simsr_test_malloc_count() { return simsr_test_detail::malloc_calls.load(); 
 #define SIMSR_TEST_SANITIZER_MALLOC 1
 #endif
 
+long simsr_test_malloc_count() { return simsr_test_detail::malloc_calls.load(); }
+
 #if defined(SIMSR_TEST_SANITIZER_MALLOC)
-#include <sanitizer/allocator_interface.h>
+// Declared here: GCC ships no sanitizer/allocator_interface.h, but its runtimes have the hook.
+extern "C" int __sanitizer_install_malloc_and_free_hooks(void (*malloc_hook)(const volatile void*, std::size_t),
+                                                         void (*free_hook)(const volatile void*));
 namespace simsr_test_detail {
 inline void count_malloc(const volatile void*, std::size_t) { malloc_calls.fetch_add(1, std::memory_order_relaxed); }
 inline void ignore_free(const volatile void*) {}

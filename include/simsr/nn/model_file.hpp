@@ -170,9 +170,11 @@ inline ModelData model_data(const io::NpzArrays& a, const std::string& file = "<
     const auto val = a.at("embedding_data").to_vector<double>();
     if (Index(ptr.size()) != M + 1 || ptr.front() != 0 || std::size_t(ptr.back()) != idx.size() || idx.size() != val.size())
       throw ArgumentError(file + ": the embedding CSR arrays are inconsistent");
+    // all of indptr before any row is read: a row past a later decrease would index beyond idx
+    for (Index r = 0; r < M; ++r)
+      if (ptr[std::size_t(r + 1)] < ptr[std::size_t(r)]) throw ArgumentError(file + ": embedding_indptr decreases at row " + std::to_string(r));
     std::vector<Eigen::Triplet<double>> t;
     for (Index r = 0; r < M; ++r) {
-      if (ptr[std::size_t(r + 1)] < ptr[std::size_t(r)]) throw ArgumentError(file + ": embedding_indptr decreases at row " + std::to_string(r));
       for (auto k = ptr[std::size_t(r)]; k < ptr[std::size_t(r + 1)]; ++k) {
         if (idx[std::size_t(k)] < 0 || idx[std::size_t(k)] >= N) throw ArgumentError(file + ": embedding index out of range in row " + std::to_string(r));
         t.emplace_back(r, idx[std::size_t(k)], val[std::size_t(k)]);
