@@ -1,10 +1,12 @@
 #pragma once
 /// \file
 /// Umbrella header: every area of simsr, in the order data flows through them
-/// (core → mesh/io → discretize → physics → neighbors → interp | nn → eval). Include single areas
-/// (simsr/mesh/mesh.hpp, simsr/interp/interp.hpp, ...) to keep compile times short.
+/// (core → mesh/io → discretize → physics → neighbors → data → scenario | nn → interp → eval).
+/// Include single areas (simsr/mesh/mesh.hpp, simsr/interp/interp.hpp, ...) to keep compile
+/// times short.
 
 #include "core/core.hpp"
+#include "data/data.hpp"
 #include "discretize/discretize.hpp"
 #include "eval/eval.hpp"
 #include "interp/interp.hpp"
@@ -13,3 +15,4 @@
 #include "neighbors/neighbors.hpp"
 #include "nn/nn.hpp"
 #include "physics/physics.hpp"
+#include "scenario/scenario.hpp"

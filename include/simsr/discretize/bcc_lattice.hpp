@@ -147,6 +147,40 @@ Lattice<S> bcc_lattice(const TetMesh<S>& mesh, double h, const VoxelizeOptions& 
   return build_lattice<Split, S>(voxelize(mesh, h, options));
 }
 
+/// Which nodes of `lattice` lie inside the closed `surface` (winding number ≠ 0): one flag per
+/// node (nodes on the surface may go either way). Corners and centres each form a regular grid,
+/// so this is two row-crossing passes, O(#F + #nodes), not a ray per node. MeshError for an open
+/// surface.
+template <class S, class S2>
+std::vector<char> lattice_nodes_inside(const Lattice<S>& lattice, const TriMesh<S2>& surface) {
+  detail::check_closed_surface(surface.F);
+  const auto& C = lattice.node_coords;
+  std::vector<char> out(std::size_t(C.rows()), 0);
+  const double h = lattice.cells.grid.h;
+  for (int parity = 0; parity < 2; ++parity) {  // 0: corners (even), 1: centres (odd)
+    std::array<std::int64_t, 3> lo{}, hi{};
+    bool any = false;
+    for (Index v = 0; v < C.rows(); ++v) {
+      if (std::int64_t(C(v, 0) & 1) != parity) continue;
+      for (int d = 0; d < 3; ++d) {
+        lo[std::size_t(d)] = any ? std::min(lo[std::size_t(d)], C(v, d)) : C(v, d);
+        hi[std::size_t(d)] = any ? std::max(hi[std::size_t(d)], C(v, d)) : C(v, d);
+      }
+      any = true;
+    }
+    if (!any) continue;
+    const std::array<Index, 3> n{Index((hi[0] - lo[0]) / 2 + 1), Index((hi[1] - lo[1]) / 2 + 1), Index((hi[2] - lo[2]) / 2 + 1)};
+    const Vec3<double> o = lattice.cells.grid.origin + 0.5 * h * Vec3<double>(double(lo[0]), double(lo[1]), double(lo[2]));
+    const auto in = detail::inside_on_grid(surface.V, surface.F, o, h, n);
+    for (Index v = 0; v < C.rows(); ++v) {
+      if (std::int64_t(C(v, 0) & 1) != parity) continue;
+      const Index i = Index((C(v, 0) - lo[0]) / 2), j = Index((C(v, 1) - lo[1]) / 2), k = Index((C(v, 2) - lo[2]) / 2);
+      out[std::size_t(v)] = in[std::size_t(i + n[0] * (j + n[1] * k))];
+    }
+  }
+  return out;
+}
+
 /// Nodes of the infinite BCC lattice of spacing h (corners anchor + h·ℤ³, centres
 /// anchor + h·(ℤ + ½)³) strictly inside the closed `surface` (winding number ≠ 0), corners first,
 /// each group in (k, j, i) order. #P×3.

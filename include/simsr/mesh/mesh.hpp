@@ -3,10 +3,13 @@
 /// Umbrella of the mesh area: mesh structs, topology, geometry, quality, validation, triangulation.
 
 #include "../core/core.hpp"
+#include "closest_point.hpp"
 #include "cotangent_laplacian.hpp"
 #include "normals.hpp"
 #include "poly_mesh.hpp"
+#include "isosurface.hpp"
 #include "quality.hpp"
+#include "rigid_motion.hpp"
 #include "tet_mesh.hpp"
 #include "topology.hpp"
 #include "tri_mesh.hpp"

@@ -13,5 +13,6 @@
 #include "nanoflann_compat.hpp"
 #include "point_assignment.hpp"
 #include "sparse_assignment.hpp"
+#include "surface_distance.hpp"
 #include "surface_graph.hpp"
 #include "upsampling_neighborhoods.hpp"

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// Geometry kernels of the barycentric embedding: closest point on a triangle (Ericson,
-/// Real-Time Collision Detection §5.1.5), exact point–tetrahedron distance, point–box distance.
+/// Geometry kernels of the barycentric embedding: closest point on a triangle, exact
+/// point–tetrahedron distance, point–box distance.
 
 #include <algorithm>
 #include <array>
@@ -9,43 +9,17 @@
 #include <Eigen/Core>
 
 #include "../../core/types.hpp"
+#include "../../mesh/closest_point.hpp"
 
 namespace simsr::detail {
 
 template <class S>
 using Vec4 = Eigen::Matrix<S, 4, 1>;
 
-/// Barycentric coordinates (of a, b, c) of the point of triangle abc closest to p; all ≥ 0, sum 1.
-/// Works for degenerate triangles too (falls back to vertices/edges).
+/// Barycentric coordinates of the point of triangle abc closest to p (mesh/closest_point.hpp).
 template <class S>
 Vec3<S> closest_on_triangle(const Vec3<S>& p, const Vec3<S>& a, const Vec3<S>& b, const Vec3<S>& c) {
-  const Vec3<S> ab = b - a, ac = c - a, ap = p - a;
-  const S d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= S(0) && d2 <= S(0)) return {S(1), S(0), S(0)};
-  const Vec3<S> bp = p - b;
-  const S d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= S(0) && d4 <= d3) return {S(0), S(1), S(0)};
-  const S vc = d1 * d4 - d3 * d2;
-  if (vc <= S(0) && d1 >= S(0) && d3 <= S(0)) {
-    const S v = d1 / (d1 - d3);
-    return {S(1) - v, v, S(0)};
-  }
-  const Vec3<S> cp = p - c;
-  const S d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= S(0) && d5 <= d6) return {S(0), S(0), S(1)};
-  const S vb = d5 * d2 - d1 * d6;
-  if (vb <= S(0) && d2 >= S(0) && d6 <= S(0)) {
-    const S w = d2 / (d2 - d6);
-    return {S(1) - w, S(0), w};
-  }
-  const S va = d3 * d6 - d5 * d4;
-  if (va <= S(0) && (d4 - d3) >= S(0) && (d5 - d6) >= S(0)) {
-    const S w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {S(0), S(1) - w, w};
-  }
-  const S denom = S(1) / (va + vb + vc);
-  const S v = vb * denom, w = vc * denom;
-  return {S(1) - v - w, v, w};
+  return closest_point_on_triangle(p, a, b, c);
 }
 
 /// Squared exact distance from p to the solid tetrahedron x[0..3], given p's barycentric weights

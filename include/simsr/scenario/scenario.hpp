@@ -1,0 +1,9 @@
+#pragma once
+/// \file
+/// The scenario area: simulated data sets built from real input — today the face of the core
+/// paper (§4) from the ICT FaceKit: the kit and its parts, the jaw hinge read from data.
+
+#include "face/head_surface.hpp"
+#include "face/ict_kit.hpp"
+#include "face/jaw.hpp"
+#include "face/skull.hpp"
