@@ -127,6 +127,8 @@ inline TetMesh<> tetgen_mesh(const TriMesh<>& boundary, const std::vector<Vec3<>
   }
   if (opt.max_volume > 0) sw << 'a' << opt.max_volume;
   const auto log = work_dir / "tetgen.log";
+  for (const char* old : {"domain.1.node", "domain.1.ele", "domain.1.face", "domain.1.edge"})
+    std::filesystem::remove(work_dir / old);  // never read a previous run's output
   const int rc = detail::run_program({detail::tetgen_program(), sw.str(), smesh.string()}, log);
   if (rc != 0)
     throw Error("tetgen " + sw.str() + " " + smesh.string() + " failed (exit " + std::to_string(rc) + "); the end of " + log.string() +
