@@ -7,4 +7,5 @@
 #include "bcc_lattice.hpp"
 #include "cell_split.hpp"
 #include "embedding.hpp"
+#include "material_split.hpp"
 #include "voxelize.hpp"

@@ -10,6 +10,7 @@
 #include "isosurface.hpp"
 #include "quality.hpp"
 #include "rigid_motion.hpp"
+#include "tet_overlap.hpp"
 #include "tet_mesh.hpp"
 #include "topology.hpp"
 #include "tri_mesh.hpp"
