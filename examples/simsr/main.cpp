@@ -11,6 +11,7 @@
 // Errors: a message on stderr naming the file, and an exit code in 1..125 (errors.hpp).
 #include "cmd_baselines.hpp"
 #include "cmd_convert.hpp"
+#include "cmd_datagen.hpp"
 #include "cmd_eval.hpp"
 #include "cmd_info.hpp"
 #include "cmd_infer.hpp"
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
   simsr::cli::add_eval(app, action);
   simsr::cli::add_train(app, action);
   simsr::cli::add_infer(app, action);
+  simsr::cli::add_datagen(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -262,7 +263,9 @@ MaterialSplit<S> split_by_material(P policy, const Lattice<S>& lattice, const Te
 /// the split tet, among those holding an M-tet around v, whose lattice tet contains v best (the
 /// largest smallest barycentric weight; ties to the lowest split tet). `inside[q]` is false, and
 /// `distance[q]` the most negative weight times the lattice tet's size, where v lies in no
-/// such tet (outside the lattice's region mask). Throws MeshError for a vertex out of range.
+/// such tet (at the edge of the lattice's region mask); where no split tet holds any M-tet
+/// around v (v lies beyond the mask), tet[q] is −1 and distance[q] infinite. Throws MeshError
+/// for a vertex out of range or in no M-tet.
 template <exec::HostPolicy P, class S>
 Embedding<S> embed_material_vertices(P policy, const MaterialSplit<S>& split, const TetMesh<S>& material, const IndexVector& vertices,
                                      double inside_tolerance = 1e-9) {
@@ -310,7 +313,15 @@ Embedding<S> embed_material_vertices(P policy, const MaterialSplit<S>& split, co
         }
       }
     }
-    if (best_s < 0) throw MeshError("vertex", v, "embed_material_vertices: the vertex belongs to no tet of the material mesh");
+    if (voff[std::size_t(v)] == voff[std::size_t(v) + 1])
+      throw MeshError("vertex", v, "embed_material_vertices: the vertex belongs to no tet of the material mesh");
+    if (best_s < 0) {  // every M-tet around v lies outside the lattice (its region mask)
+      out.tet[q] = -1;
+      out.weights.row(q).setZero();
+      out.inside[q] = false;
+      out.distance[q] = std::numeric_limits<S>::infinity();
+      return;
+    }
     out.tet[q] = VIndex(best_s);
     out.weights.row(q) = best_w.transpose().template cast<S>();
     out.inside[q] = best >= -inside_tolerance;

@@ -10,9 +10,9 @@
 /// `boundary` is every facet of the domain (outer surface and inner ones, e.g. the skull) as one
 /// triangle soup; `holes` are points inside the cavities to carve out (tetgen removes the tets
 /// of every region reachable from a hole point without crossing a facet). The input vertices come
-/// back first and in order (tetgen keeps them; -Y is not used, so tetgen may split boundary
-/// triangles with Steiner points, but never moves an input vertex): vertex i of `boundary` is mesh
-/// vertex i. The program is found as $SIMSR_TETGEN, else `tetgen` on PATH.
+/// back first and in order (tetgen never moves an input vertex): vertex i of `boundary` is mesh
+/// vertex i. With `preserve_boundary` (-Y) the boundary triangles are kept as they are (a surface
+/// whose vertices carry data, like the skin, stays one-to-one); otherwise tetgen may split them. The program is found as $SIMSR_TETGEN, else `tetgen` on PATH.
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -45,6 +45,7 @@ struct TetgenOptions {
   double max_volume = 0;     ///< largest tet volume (−a), 0 = no bound
   double radius_edge = 1.5;  ///< quality bound on radius/shortest edge (−q), 0 = no refinement
   double min_dihedral = 0;   ///< with radius_edge: the smallest dihedral angle in degrees (−q r/d), 0 = tetgen's default
+  bool preserve_boundary = false;  ///< -Y: no Steiner points on the boundary facets
   bool verbose = false;      ///< keep tetgen's own output on stderr as well as in the log
 };
 
@@ -126,6 +127,7 @@ inline TetMesh<> tetgen_mesh(const TriMesh<>& boundary, const std::vector<Vec3<>
     if (opt.min_dihedral > 0) sw << '/' << opt.min_dihedral;
   }
   if (opt.max_volume > 0) sw << 'a' << opt.max_volume;
+  if (opt.preserve_boundary) sw << 'Y';
   const auto log = work_dir / "tetgen.log";
   for (const char* old : {"domain.1.node", "domain.1.ele", "domain.1.face", "domain.1.edge"})
     std::filesystem::remove(work_dir / old);  // never read a previous run's output

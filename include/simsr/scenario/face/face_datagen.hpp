@@ -1,0 +1,322 @@
+#pragma once
+/// \file
+/// Paired face data (core paper §4): every performance simulated at both resolutions from the same
+/// controls, written in the layout every simsr command reads (data/paired_frames.hpp):
+///
+///     DIR/lr_rest.msh            the LR rest mesh (split lattice, m)
+///     DIR/hr_rest.obj            the HR rest surface: the face skin, with triangles (m)
+///     DIR/hr_volume.msh          the HR conforming tet mesh (for looking at it)
+///     DIR/<performance>.npz      lowres F×N×3, highres F×M×3, controls F×C, frame F, sequence
+///     DIR/<performance>_controls.npz   the controls alone (names, weights): a controls file
+///     DIR/face_data.json         sizes, options, per-performance timings and Newton iterations
+///
+/// Each frame is a warm-started quasistatic solve at each resolution. Every performance starts
+/// from the settled neutral (all controls 0), solved once and kept in DIR/.state. A run checkpoints
+/// each performance every `checkpoint_every` frames (DIR/.state/<name>.npz: the frames so far and
+/// the last two states of both meshes, atomically), so a killed run resumes where it stopped and
+/// loses no finished frame; the resumed output is bitwise the uninterrupted one (the warm start
+/// is restored exactly). A file from another run (another mesh, options or controls) is refused
+/// by fingerprint, never continued. A Newton failure, or an inverted tet after a solve, is an
+/// Error naming the performance, the frame, the resolution and the residual: nothing is written
+/// for that frame.
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "../../core/error.hpp"
+#include "../../core/fingerprint.hpp"
+#include "../../core/parallel.hpp"
+#include "../../data/paired_frames.hpp"
+#include "../../io/atomic_file.hpp"
+#include "../../io/mesh_io.hpp"
+#include "../../io/npz.hpp"
+#include "face_model.hpp"
+#include "face_simulator.hpp"
+#include "performances.hpp"
+
+namespace simsr::scenario {
+
+/// What a datagen run is asked for.
+struct FaceDatagenOptions {
+  FaceSimulationOptions simulation;
+  Index checkpoint_every = 10;  ///< frames between checkpoints of a performance
+  /// Called after every frame: performance, frame, frames of it, the two reports, seconds of the
+  /// frame (LR, HR). Progress lines and ETA live in the caller.
+  std::function<void(const std::string&, Index, Index, const physics::NewtonReport&, const physics::NewtonReport&, double, double)> on_frame;
+};
+
+/// Per-performance figures of a run.
+struct PerformanceStats {
+  std::string name;
+  Index frames = 0;
+  double lr_seconds = 0, hr_seconds = 0;   ///< total over the frames simulated in this run
+  Index lr_iterations = 0, hr_iterations = 0;
+  Index simulated = 0;                     ///< frames simulated in this run (the rest were resumed or reused)
+  bool reused = false;                     ///< the finished file was there already
+};
+
+namespace detail {
+
+/// The fingerprint of everything a frame depends on: meshes, options, controls.
+inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulationOptions& o, const Performance* p) {
+  Fingerprint f;
+  f.add(face.hr.V).add(face.hr.T).add(face.lr.V).add(face.lr.T).add(face.surface.F);
+  f.add(o.mu10).add(o.mu01).add(o.kappa).add(o.muscle_max_stress).add(o.track_stiffness).add(o.contact_stiffness).add(o.contact_thickness);
+  f.add(o.contact_exclusion).add(o.newton.relative_tolerance).add(o.newton.max_iterations).add(o.linear.tolerance).add(std::int64_t(o.extrapolate));
+  if (p) {
+    f.add(p->weights);
+    for (const auto& n : p->names) f.add_bytes(n.data(), n.size());
+  }
+  return f.hex();
+}
+
+inline std::string fingerprint_of(const io::NpzArrays& z) {
+  if (!z.contains("fingerprint")) return "";
+  const auto s = z.at("fingerprint").to_strings();
+  return s.empty() ? "" : s[0];
+}
+
+inline Points<> points_of(const io::NpzArrays& z, const std::string& name, Index rows, const std::string& file) {
+  const auto& a = z.at(name);
+  if (a.ndim() != 2 || a.shape[0] != rows || a.shape[1] != 3)
+    throw ShapeError(file + ": " + name, {rows, 3}, {a.ndim() > 0 ? Index(a.shape[0]) : 0, a.ndim() > 1 ? Index(a.shape[1]) : 0});
+  return a.to_points<double>();
+}
+
+/// One resolution's Newton solve with the failure made specific.
+template <class P, class Sim>
+physics::NewtonReport solve_frame(P policy, Sim& sim, const std::string& perf, Index frame) {
+  physics::NewtonReport r;
+  try {
+    r = sim.step(policy);
+  } catch (const ConvergenceError& e) {
+    throw Error("face datagen: performance '" + perf + "', frame " + std::to_string(frame) + ", " + resolution_name(sim.resolution()) +
+                " solve failed: " + e.what());
+  }
+  if (const Index inv = sim.count_inverted(policy))
+    throw Error("face datagen: performance '" + perf + "', frame " + std::to_string(frame) + ", " + resolution_name(sim.resolution()) + ": " +
+                std::to_string(inv) + " tets inverted after the solve (residual " + std::to_string(r.gradient_norm) + ")");
+  return r;
+}
+
+}  // namespace detail
+
+/// Writes the rest shapes (atomically) to `dir`.
+inline void write_face_rest_shapes(const FaceModel& face, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  io::MeshData<double> lr, hrv, hrs;
+  lr.V = face.lr.V;
+  lr.T = face.lr.T;
+  hrv.V = face.hr.V;
+  hrv.T = face.hr.T;
+  hrs.V = face.surface.V;
+  hrs.F = face.surface.F;
+  io::write_mesh(dir / "lr_rest.msh", lr);
+  io::write_mesh(dir / "hr_volume.msh", hrv);
+  io::write_mesh(dir / "hr_rest.obj", hrs);
+}
+
+/// Simulates `performances` on `face` into `dir` (see the file comment). Returns the figures of
+/// this run, also written to DIR/face_data.json.
+template <class Linear = physics::ConjugateGradient<physics::Multigrid<>>, exec::HostPolicy P>
+std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face, const std::vector<Performance>& performances,
+                                                 const std::filesystem::path& dir, const FaceDatagenOptions& opt = {}) {
+  if (opt.checkpoint_every < 1) throw ArgumentError("generate_face_data: checkpoint_every must be ≥ 1");
+  for (const auto& p : performances)
+    if (p.name.empty() || p.name.find_first_of("/\\. ") != std::string::npos)
+      throw ArgumentError("generate_face_data: performance name '" + p.name + "' cannot be a file name");
+  const auto state = dir / ".state";
+  std::filesystem::create_directories(state);
+  write_face_rest_shapes(face, dir);
+  const std::string model_print = detail::face_run_fingerprint(face, opt.simulation, nullptr);
+
+  FaceSimulator<Linear> lr(policy, face, FaceResolution::low, opt.simulation);
+  FaceSimulator<Linear> hr(policy, face, FaceResolution::high, opt.simulation);
+
+  // the settled neutral, shared by every performance's first frame
+  Points<> lr_neutral, hr_neutral;
+  const auto neutral_file = state / "neutral.npz";
+  bool have_neutral = false;
+  if (std::filesystem::exists(neutral_file)) {
+    const auto z = io::read_npz(neutral_file);
+    if (detail::fingerprint_of(z) == model_print) {
+      lr_neutral = detail::points_of(z, "lr", face.lr.num_vertices(), neutral_file.string());
+      hr_neutral = detail::points_of(z, "hr", face.hr.num_vertices(), neutral_file.string());
+      have_neutral = true;
+    }
+  }
+  if (!have_neutral) {
+    FaceControls zero;
+    zero.blendshapes = VecX<>::Zero(face.num_expressions());
+    lr.set_controls(zero);
+    hr.set_controls(zero);
+    detail::solve_frame(policy, lr, "neutral", 0);
+    detail::solve_frame(policy, hr, "neutral", 0);
+    lr_neutral = lr.positions();
+    hr_neutral = hr.positions();
+    io::NpzArrays z;
+    z["lr"] = io::make_npy(lr_neutral);
+    z["hr"] = io::make_npy(hr_neutral);
+    z["fingerprint"] = io::make_npy(std::vector<std::string>{model_print});
+    io::write_npz(neutral_file, z);
+  }
+
+  std::vector<PerformanceStats> stats;
+  for (std::size_t pi = 0; pi < performances.size(); ++pi) {
+    const Performance& perf = performances[pi];
+    const Index F = perf.num_frames(), N = face.lr.num_vertices(), M = face.surface.num_vertices();
+    if (F < 1) throw ArgumentError("generate_face_data: performance '" + perf.name + "' has no frames");
+    PerformanceStats st;
+    st.name = perf.name;
+    st.frames = F;
+    const std::string print = detail::face_run_fingerprint(face, opt.simulation, &perf);
+    const auto final_file = dir / (perf.name + ".npz");
+    const auto partial = state / (perf.name + ".npz");
+    // a finished file of this very run: reuse
+    if (std::filesystem::exists(final_file)) {
+      const auto z = io::read_npz(final_file);
+      if (detail::fingerprint_of(z) == print) {
+        st.reused = true;
+        stats.push_back(st);
+        continue;
+      }
+    }
+    data::PairedFrames<> out;
+    out.lowres.resize(F, 3 * N);
+    out.highres.resize(F, 3 * M);
+    out.controls = perf.weights;
+    out.ids.resize(std::size_t(F));
+    for (Index f = 0; f < F; ++f) out.ids[std::size_t(f)] = f;
+    out.sequence.assign(std::size_t(F), 0);
+    out.sequence_names = {perf.name};
+    Index start = 0;
+    lr.set_positions(lr_neutral);
+    hr.set_positions(hr_neutral);
+    if (std::filesystem::exists(partial)) {
+      const auto z = io::read_npz(partial);
+      if (detail::fingerprint_of(z) != print)
+        throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
+      start = z.at("frames_done").item<std::int64_t>();
+      if (start < 1 || start > F) throw ArgumentError(partial.string() + ": frames_done " + std::to_string(start) + " outside [1, " + std::to_string(F) + "]");
+      const auto lo = z.at("lowres").to_matrix<double>(), hi = z.at("highres").to_matrix<double>();
+      if (lo.rows() != start || lo.cols() != 3 * N || hi.rows() != start || hi.cols() != 3 * M)
+        throw ArgumentError(partial.string() + ": its frame arrays do not match frames_done and the meshes");
+      out.lowres.topRows(start) = lo;
+      out.highres.topRows(start) = hi;
+      const Points<> lx = detail::points_of(z, "lr_state", N, partial.string()), hx = detail::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
+      if (start >= 2) {
+        lr.set_positions(detail::points_of(z, "lr_before", N, partial.string()), lx);
+        hr.set_positions(detail::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()), hx);
+      } else {
+        lr.set_positions(lx);
+        hr.set_positions(hx);
+      }
+    }
+    Points<> lr_before = lr.positions(), hr_before = hr.positions();
+    for (Index f = start; f < F; ++f) {
+      const FaceControls c = face_controls(perf, f, face);
+      lr.set_controls(c);
+      hr.set_controls(c);
+      lr_before = lr.positions();
+      hr_before = hr.positions();
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto rl = detail::solve_frame(policy, lr, perf.name, f);
+      const auto t1 = std::chrono::steady_clock::now();
+      const auto rh = detail::solve_frame(policy, hr, perf.name, f);
+      const auto t2 = std::chrono::steady_clock::now();
+      const double sl = std::chrono::duration<double>(t1 - t0).count(), sh = std::chrono::duration<double>(t2 - t1).count();
+      out.lr(f) = lr.positions();
+      out.hr(f) = hr.surface(policy);
+      st.lr_seconds += sl;
+      st.hr_seconds += sh;
+      st.lr_iterations += rl.iterations;
+      st.hr_iterations += rh.iterations;
+      ++st.simulated;
+      if (opt.on_frame) opt.on_frame(perf.name, f, F, rl, rh, sl, sh);
+      const Index done = f + 1;
+      if (done < F && done % opt.checkpoint_every == 0) {
+        io::NpzArrays z;
+        z["frames_done"] = io::make_npy<std::int64_t>({}, &done);
+        const data::FrameMatrix<double> lo = out.lowres.topRows(done), hi = out.highres.topRows(done);
+        z["lowres"] = io::make_npy(lo);
+        z["highres"] = io::make_npy(hi);
+        z["lr_state"] = io::make_npy(lr.positions());
+        z["hr_state"] = io::make_npy(hr.positions());
+        z["lr_before"] = io::make_npy(lr_before);
+        z["hr_before"] = io::make_npy(hr_before);
+        z["fingerprint"] = io::make_npy(std::vector<std::string>{print});
+        io::write_npz(partial, z);
+      }
+    }
+    auto arrays = data::paired_frame_arrays(out);
+    arrays["fingerprint"] = io::make_npy(std::vector<std::string>{print});
+    arrays["control_names"] = io::make_npy(perf.names);
+    io::write_npz(final_file, arrays);
+    io::NpzArrays ctl;
+    ctl["names"] = io::make_npy(perf.names);
+    ctl["weights"] = io::make_npy(perf.weights);
+    io::write_npz(dir / (perf.name + "_controls.npz"), ctl);
+    std::filesystem::remove(partial);
+    stats.push_back(st);
+  }
+  return stats;
+}
+
+/// The run's summary as JSON: mesh sizes, the split, muscles, and per performance the seconds per
+/// frame and Newton iterations per frame at each resolution (frames simulated in this run).
+inline nlohmann::ordered_json face_data_report(const FaceModel& face, const std::vector<PerformanceStats>& stats) {
+  nlohmann::ordered_json j;
+  j["hr"] = {{"vertices", face.hr.num_vertices()}, {"tets", face.hr.num_tets()}, {"bone_vertices", face.hr_bone.size()}};
+  j["lr"] = {{"vertices", face.lr.num_vertices()},
+             {"tets", face.lr.num_tets()},
+             {"bone_vertices", face.lr_bone.size()},
+             {"split_lattice_tets", face.lr_split.split_lattice_tets},
+             {"duplicated_nodes", face.lr_split.duplicated_nodes}};
+  j["tet_ratio"] = double(face.hr.num_tets()) / double(face.lr.num_tets());
+  j["surface"] = {{"vertices", face.surface.num_vertices()}, {"triangles", face.surface.num_faces()}};
+  j["skull"] = {{"vertices", face.skull_vertices}, {"volume_cm3", face.skull_volume * 1e6}, {"thinnest_flesh_cm", face.min_flesh * 100}};
+  j["jaw"] = {{"hinge_point_m", {face.hinge.point.x(), face.hinge.point.y(), face.hinge.point.z()}},
+              {"hinge_axis", {face.hinge.axis.x(), face.hinge.axis.y(), face.hinge.axis.z()}},
+              {"jawOpen_degrees", face.hinge.angle * 180 / std::acos(-1.0)},
+              {"rest_degrees", face.rest_jaw_angle * 180 / std::acos(-1.0)}};
+  nlohmann::ordered_json muscles = nlohmann::ordered_json::array();
+  for (const auto& m : face.muscles) muscles.push_back(m.spec.name);
+  j["muscles"] = muscles;
+  nlohmann::ordered_json perf = nlohmann::ordered_json::array();
+  for (const auto& s : stats) {
+    nlohmann::ordered_json p{{"name", s.name}, {"frames", s.frames}, {"reused", s.reused}, {"simulated", s.simulated}};
+    if (s.simulated > 0) {
+      const double n = double(s.simulated);
+      p["lr_seconds_per_frame"] = s.lr_seconds / n;
+      p["hr_seconds_per_frame"] = s.hr_seconds / n;
+      p["lr_newton_iterations_per_frame"] = double(s.lr_iterations) / n;
+      p["hr_newton_iterations_per_frame"] = double(s.hr_iterations) / n;
+    }
+    perf.push_back(p);
+  }
+  j["performances"] = perf;
+  return j;
+}
+
+/// Reads a controls file (`names`: C strings, `weights`: F×C) as a performance called `name`.
+inline Performance read_controls(const std::filesystem::path& file, const std::string& name) {
+  const auto z = io::read_npz(file);
+  if (!z.contains("names") || !z.contains("weights")) throw ArgumentError(file.string() + ": a controls file needs arrays 'names' (C strings) and 'weights' (F×C)");
+  Performance p;
+  p.name = name;
+  p.names = z.at("names").to_strings();
+  const auto& w = z.at("weights");
+  if (w.ndim() != 2 || w.shape[1] != std::int64_t(p.names.size()))
+    throw ShapeError(file.string() + ": weights", {-1, Index(p.names.size())}, {w.ndim() > 0 ? Index(w.shape[0]) : 0, w.ndim() > 1 ? Index(w.shape[1]) : 0});
+  if (w.shape[0] < 1 || w.shape[0] > data::max_frames) throw ArgumentError(file.string() + ": " + std::to_string(w.shape[0]) + " frames (expected 1 to " + std::to_string(data::max_frames) + ")");
+  p.weights = w.to_matrix<double>();
+  return p;
+}
+
+}  // namespace simsr::scenario

@@ -1,0 +1,354 @@
+#pragma once
+/// \file
+/// One face simulator, two resolutions (core paper §4): the same anatomy, controls and parameters
+/// on the HR conforming mesh or the LR split lattice. A frame is a quasistatic solve, warm-started
+/// from the previous frame, of
+///
+///     E(x) = Σ_t V_t ψ(F_t)                                 Mooney–Rivlin flesh (+ muscle fibres)
+///          + Σ_i κ A_i / 2 ‖x(p_i) − b_i(w)‖²                track springs to the blendshapes
+///          + lip contact (HR only)
+///
+/// with the bones as Dirichlet conditions: cranium fixed, jaw rotated about the hinge, the skull
+/// between them linearly blended by the jaw weight. b_i(w) = neutral_i + Σ_e w_e δ_ei is the kit's
+/// blendshape combination at surface vertex i (the paper's "blendshape muscle rig"), x(p_i) the
+/// simulated position of that material point (an HR vertex, or its embedding in an LR tet), A_i
+/// its rest Voronoi area: stiffness per unit area, so both meshes feel the same pull. Parameters
+/// are per unit volume and area throughout (SPEC §3), so bulk behaviour agrees across resolutions
+/// and what differs is the discretization, as in the paper's Fig. 4.
+///
+///     scenario::FaceSimulator<> hr(exec::omp, face, scenario::FaceResolution::high);
+///     hr.set_controls(controls_of_frame);         // blendshape weights, muscle activations, jaw
+///     auto report = hr.step(exec::omp);           // ConvergenceError names the residual
+///     Points<> skin = hr.surface(exec::omp);      // M×3, the output surface
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../../core/error.hpp"
+#include "../../core/parallel.hpp"
+#include "../../core/types.hpp"
+#include "../../discretize/embedding.hpp"
+#include "../../physics/dirichlet_boundary.hpp"
+#include "../../physics/elastic_energy.hpp"
+#include "../../physics/forces/embedded_springs.hpp"
+#include "../../physics/forces/obstacle_contact.hpp"
+#include "../../physics/forces/self_contact.hpp"
+#include "../../physics/linear_solvers/linear_solvers.hpp"
+#include "../../physics/linear_solvers/multigrid.hpp"
+#include "../../physics/materials/mooney_rivlin.hpp"
+#include "../../physics/materials/teran_muscle.hpp"
+#include "../../physics/quasistatic.hpp"
+#include "../../neighbors/surface_distance.hpp"
+#include "face_model.hpp"
+
+namespace simsr::scenario {
+
+/// Which mesh a FaceSimulator runs on.
+enum class FaceResolution { low, high };
+
+inline const char* resolution_name(FaceResolution r) { return r == FaceResolution::high ? "HR" : "LR"; }
+
+/// One frame's controls: the kit's blendshape weights, the muscles' activations, the jaw angle.
+struct FaceControls {
+  VecX<> blendshapes;  ///< one weight per expression of the model (FaceModel::expression_names)
+  VecX<> muscles;      ///< one activation in [0, 1] per FaceModel::muscles; empty: from the blendshapes (muscle_activations)
+  double jaw = 0;      ///< rad, the jaw's rotation from the neutral about the hinge (≥ 0 opens)
+};
+
+/// Material and force parameters, per unit volume or area (SI).
+struct FaceSimulationOptions {
+  static physics::NewtonOptions default_newton() {
+    physics::NewtonOptions o;
+    o.relative_tolerance = 1e-5;
+    o.max_iterations = 60;
+    return o;
+  }
+  double mu10 = 4e3;            ///< Pa, Mooney–Rivlin (soft tissue: a few kPa)
+  double mu01 = 1e3;            ///< Pa
+  double kappa = 1e5;           ///< Pa, volume penalty (ν ≈ 0.48)
+  /// Pa, the muscles' maximum isometric stress σ_max (Teran 2003's 3e5 Pa is for limb muscle
+  /// against stiffer flesh; scaled here to the soft flesh above).
+  double muscle_max_stress = 2e4;
+  double track_stiffness = 3e6; ///< N/m³: track spring stiffness per unit skin area
+  double contact_stiffness = 2e9;  ///< N/m³: lip contact stiffness per unit area (HR)
+  double contact_thickness = 5e-4; ///< m: d̂, the lips' contact distance (HR)
+  /// Lip vertices closer than this to the other lip's triangles at rest are left out of contact
+  /// (the corners of the mouth, where the lips are one piece of skin).
+  double contact_exclusion = 3e-3;
+  physics::NewtonOptions newton = default_newton();
+  /// Start each frame's Newton from the linear extrapolation of the last two frames (2x₁ − x₀)
+  /// instead of the last frame: along a smooth performance it halves the Newton iterations. A
+  /// start whose energy is not finite falls back to the last frame.
+  bool extrapolate = true;
+  physics::ConjugateGradientOptions linear{.tolerance = 1e-4};
+};
+
+/// A quasistatic face simulator on one mesh of a FaceModel (see the file comment). Linear: the
+/// Newton systems' solver (default PCG with the lattice multigrid).
+template <class Linear = physics::ConjugateGradient<physics::Multigrid<>>>
+class FaceSimulator {
+ public:
+  template <exec::HostPolicy P>
+  FaceSimulator(P policy, const FaceModel& face, FaceResolution resolution, FaceSimulationOptions options = {})
+      : face_(&face),
+        res_(resolution),
+        opt_(std::move(options)),
+        mesh_(resolution == FaceResolution::high ? face.hr : face.lr),
+        elastic_(part_of_mesh(face, false), physics::MooneyRivlin<>(opt_.mu10, opt_.mu01, opt_.kappa)),
+        muscle_(part_of_mesh(face, true), physics::TeranMuscle<>(physics::MooneyRivlin<>(opt_.mu10, opt_.mu01, opt_.kappa), opt_.muscle_max_stress),
+                fibres_),
+        newton_(mesh_.num_vertices(), mesh_.T, opt_.newton, physics::make_linear_solver<Linear>(policy, mesh_, opt_.linear)),
+        tracks_(make_tracks(policy)) {
+    const bool high = resolution == FaceResolution::high;
+    bone_ = high ? face.hr_bone : face.lr_bone;
+    bone_jaw_ = high ? face.hr_bone_jaw : face.lr_bone_jaw;
+    bone_rest_.resize(bone_.size(), 3);
+    for (Index i = 0; i < bone_.size(); ++i) bone_rest_.row(i) = mesh_.V.row(bone_[i]);
+    if (high) make_contact(policy);
+    x_ = mesh_.V;
+    FaceControls rest;
+    rest.blendshapes = VecX<>::Zero(face.num_expressions());
+    rest.jaw = face.rest_jaw_angle;
+    set_controls(rest);
+  }
+
+  FaceResolution resolution() const { return res_; }
+  const TetMesh<>& mesh() const { return mesh_; }
+  const Points<>& positions() const { return x_; }
+  /// Starts the next solve from these positions (a resumed run's last frame).
+  void set_positions(const Points<>& x) {
+    if (x.rows() != mesh_.num_vertices() || x.cols() != 3) throw ShapeError("FaceSimulator::set_positions", {mesh_.num_vertices(), 3}, {x.rows(), x.cols()});
+    if (!x.allFinite()) throw ArgumentError("FaceSimulator::set_positions: non-finite positions");
+    x_ = x;
+    have_previous_ = false;
+    x_is_solution_ = true;
+  }
+  /// As set_positions, with the frame before it too (the warm start extrapolates from both).
+  void set_positions(const Points<>& before, const Points<>& x) {
+    set_positions(before);
+    set_positions(x);
+    previous_ = before;
+    have_previous_ = true;
+  }
+  void reset() {
+    x_ = mesh_.V;
+    have_previous_ = x_is_solution_ = false;
+  }
+
+  /// Sets the spring targets, the muscles' activations and the bones' positions for the next step.
+  void set_controls(const FaceControls& c) {
+    const Index E = face_->num_expressions();
+    if (c.blendshapes.size() != E) throw ShapeError("FaceSimulator::set_controls: blendshape weights", {E, 1}, {c.blendshapes.size(), 1});
+    if (!c.blendshapes.allFinite() || !std::isfinite(c.jaw)) throw ArgumentError("FaceSimulator::set_controls: non-finite control");
+    const Index nm = Index(face_->muscles.size());
+    const VecX<> act = c.muscles.size() ? c.muscles : muscle_activations(face_->muscles, face_->expression_names, c.blendshapes);
+    if (act.size() != nm) throw ShapeError("FaceSimulator::set_controls: muscle activations", {nm, 1}, {act.size(), 1});
+    for (Index k = 0; k < nm; ++k)
+      if (!(act[k] >= 0 && act[k] <= 1)) throw ArgumentError("FaceSimulator::set_controls: activation of muscle '" + face_->muscles[std::size_t(k)].spec.name + "' is " + std::to_string(act[k]) + ", not in [0, 1]");
+    for (std::size_t t = 0; t < fibres_.size(); ++t) fibres_[t].activation = act[muscle_of_tet_[t]] * muscle_share_[t];
+    muscle_.set_elements(fibres_);
+    const Index M = face_->surface.num_vertices();
+    VecX<> flat = face_->deltas.transpose() * c.blendshapes;
+    Points<> y = face_->neutral + Eigen::Map<const Points<>>(flat.data(), M, 3);
+    tracks_.set_targets(y);
+    // bones: linear blend of fixed and hinged
+    const double delta = c.jaw - face_->rest_jaw_angle;
+    const Mat3<> R = Eigen::AngleAxisd(delta, face_->hinge.axis.normalized()).toRotationMatrix();
+    const Vec3<> p = face_->hinge.point;
+    boundary_.vertices = bone_;
+    boundary_.targets.resize(bone_.size(), 3);
+    for (Index i = 0; i < bone_.size(); ++i) {
+      const Vec3<> x = bone_rest_.row(i).transpose();
+      const Vec3<> jawed = R * (x - p) + p;
+      boundary_.targets.row(i) = ((1 - bone_jaw_[i]) * x + bone_jaw_[i] * jawed).transpose();
+    }
+    controls_ = c;
+  }
+
+  /// One quasistatic frame from the current positions; ConvergenceError when Newton fails.
+  template <exec::HostPolicy P>
+  physics::NewtonReport step(P policy) {
+    return advance(policy, [&](Points<>& x) {
+      if (contact_) return newton_.solve(policy, x, boundary_, elastic_, muscle_, tracks_, contact_->first, contact_->second);
+      return newton_.solve(policy, x, boundary_, elastic_, muscle_, tracks_);
+    });
+  }
+
+  /// As step, with one more energy term for this frame (the §5.3 "unseen forces": a spring, an
+  /// obstacle).
+  template <exec::HostPolicy P, class Extra>
+  physics::NewtonReport step_with(P policy, const Extra& extra) {
+    return advance(policy, [&](Points<>& x) {
+      if (contact_) return newton_.solve(policy, x, boundary_, elastic_, muscle_, tracks_, contact_->first, contact_->second, extra);
+      return newton_.solve(policy, x, boundary_, elastic_, muscle_, tracks_, extra);
+    });
+  }
+
+  /// The output surface (M×3) at the current positions.
+  template <exec::HostPolicy P>
+  Points<> surface(P policy) const {
+    if (res_ == FaceResolution::high) {
+      Points<> s(face_->surface_hr_vertex.size(), 3);
+      for (Index i = 0; i < s.rows(); ++i) s.row(i) = x_.row(face_->surface_hr_vertex[i]);
+      return s;
+    }
+    return deform(policy, face_->surface_in_lr, mesh_.T, x_);
+  }
+
+  /// Inverted tets at the current positions.
+  template <exec::HostPolicy P>
+  Index count_inverted(P policy) const {
+    return elastic_.count_inverted(policy, x_) + muscle_.count_inverted(policy, x_);
+  }
+
+  const physics::EmbeddedSprings<>& tracks() const { return tracks_; }
+  /// Each muscle's active volume at rest (m³): Σ over its tets of volume × share inside it.
+  std::vector<double> muscle_volumes() const {
+    std::vector<double> v(face_->muscles.size(), 0.0);
+    const auto& vol = muscle_.rest().volume;
+    for (std::size_t t = 0; t < muscle_of_tet_.size(); ++t) v[std::size_t(muscle_of_tet_[t])] += double(vol[Index(t)]) * muscle_share_[t];
+    return v;
+  }
+  bool has_contact() const { return contact_.has_value(); }
+  /// The two lip contact terms (upper vertices against lower triangles, and the reverse); HR only.
+  const std::pair<physics::SelfContact<>, physics::SelfContact<>>& contact() const {
+    if (!contact_) throw ArgumentError("FaceSimulator::contact: the LR simulator has no lip contact");
+    return *contact_;
+  }
+
+ private:
+  /// The flesh tets (muscle = false) or the muscle tets of the mesh, over all its vertices; the
+  /// muscle tets' fibres go to fibres_, muscle_of_tet_ and muscle_share_ (called for the flesh first).
+  TetMesh<> part_of_mesh(const FaceModel& face, bool muscle) {
+    const TetMesh<>& m = res_ == FaceResolution::high ? face.hr : face.lr;
+    if (!muscle) {
+      // 11 points per tet (centroid, 4 towards the corners, 6 towards the edges): the share of
+      // them inside a muscle scales its activation, so a coarse tet half in a thin muscle pulls
+      // half as hard and the muscle's force per volume agrees across resolutions.
+      static constexpr int ns = 11;
+      Eigen::Matrix<double, ns, 4> B;
+      B.row(0).setConstant(0.25);
+      for (int k = 0; k < 4; ++k) {
+        B.row(1 + k).setConstant(0.1);
+        B(1 + k, k) = 0.7;
+      }
+      static constexpr int edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+      for (int e = 0; e < 6; ++e) {
+        B.row(5 + e).setConstant(0.1);
+        B(5 + e, edge[e][0]) = B(5 + e, edge[e][1]) = 0.4;
+      }
+      in_muscle_.assign(std::size_t(m.T.rows()), 0);
+      std::vector<int> votes(face.muscles.size());
+      std::vector<Vec3<>> dir(face.muscles.size());
+      for (Index t = 0; t < m.T.rows(); ++t) {
+        std::fill(votes.begin(), votes.end(), 0);
+        std::fill(dir.begin(), dir.end(), Vec3<>::Zero());
+        for (int q = 0; q < ns; ++q) {
+          Vec3<> c = Vec3<>::Zero();
+          for (int k = 0; k < 4; ++k) c += B(q, k) * m.V.row(m.T(t, k)).transpose();
+          if (const auto f = muscle_fibre_at(face.muscles, c)) {
+            ++votes[std::size_t(f->muscle)];
+            // fibres are lines: align the sign before summing
+            dir[std::size_t(f->muscle)] += dir[std::size_t(f->muscle)].dot(f->direction) < 0 ? Vec3<>(-f->direction) : f->direction;
+          }
+        }
+        const auto best = std::max_element(votes.begin(), votes.end());
+        if (best == votes.end() || *best == 0) continue;
+        const std::size_t k = std::size_t(best - votes.begin());
+        in_muscle_[std::size_t(t)] = 1;
+        fibres_.push_back(physics::TeranMuscle<>::element(dir[k], 0.0));
+        muscle_of_tet_.push_back(Index(k));
+        muscle_share_.push_back(double(*best) / ns);
+      }
+    }
+    std::vector<Index> rows;
+    for (Index t = 0; t < m.T.rows(); ++t)
+      if (bool(in_muscle_[std::size_t(t)]) == muscle) rows.push_back(t);
+    TetMesh<> part{m.V, Tets(Index(rows.size()), 4)};
+    for (std::size_t r = 0; r < rows.size(); ++r) part.T.row(Index(r)) = m.T.row(rows[r]);
+    return part;
+  }
+
+  /// Runs `solve` from the warm start and moves the frame history on.
+  template <class P, class Solve>
+  physics::NewtonReport advance(P policy, Solve&& solve) {
+    start_ = x_;
+    if (opt_.extrapolate && have_previous_) {
+      start_ = 2 * x_ - previous_;
+      if (!std::isfinite(double(elastic_.energy(policy, start_)))) start_ = x_;
+    }
+    const physics::NewtonReport r = solve(start_);
+    previous_.swap(x_);
+    x_.swap(start_);
+    have_previous_ = x_is_solution_;  // extrapolate only between two solved frames
+    x_is_solution_ = true;
+    return r;
+  }
+
+  template <class P>
+  physics::EmbeddedSprings<> make_tracks(P policy) {
+    const VecX<> k = opt_.track_stiffness * face_->surface_area;
+    if (res_ == FaceResolution::low)
+      return physics::EmbeddedSprings<>(face_->surface_in_lr, mesh_.T, mesh_.num_vertices(), k, face_->surface.V);
+    const Index M = face_->surface_hr_vertex.size();
+    physics::EmbeddedSprings<>::Anchors a(M, 4);
+    physics::EmbeddedSprings<>::Weights w = physics::EmbeddedSprings<>::Weights::Zero(M, 4);
+    for (Index i = 0; i < M; ++i) {
+      a.row(i).setConstant(face_->surface_hr_vertex[i]);
+      w(i, 0) = 1;
+    }
+    (void)policy;
+    return physics::EmbeddedSprings<>(a, w, mesh_.num_vertices(), k, face_->surface.V);
+  }
+
+  /// Lip contact: vertices of one lip against triangles of the other, minus the vertices that sit
+  /// closer than contact_exclusion to the other lip at rest.
+  template <class P>
+  void make_contact(P policy) {
+    const auto keep_far = [&](const IndexVector& verts, const Tris& other) {
+      const TriMesh<> o{mesh_.V, other};
+      std::vector<VIndex> kept;
+      if (other.rows() == 0) return IndexVector(0);
+      const neighbors::SurfaceDistance<> dist(o);
+      Points<> at(verts.size(), 3);
+      for (Index i = 0; i < verts.size(); ++i) at.row(i) = mesh_.V.row(verts[i]);
+      const VecX<> d = dist.distances(policy, at);
+      for (Index i = 0; i < verts.size(); ++i)
+        if (d[i] >= opt_.contact_exclusion) kept.push_back(verts[i]);
+      return IndexVector(Eigen::Map<const IndexVector>(kept.data(), Index(kept.size())));
+    };
+    const IndexVector up = keep_far(face_->lip_upper_vertices, face_->lip_lower_triangles);
+    const IndexVector lo = keep_far(face_->lip_lower_vertices, face_->lip_upper_triangles);
+    double area = face_->surface_area.mean();
+    const double k = opt_.contact_stiffness * area;
+    contact_.emplace(physics::SelfContact<>(up, face_->lip_lower_triangles, mesh_.num_vertices(), k, opt_.contact_thickness),
+                     physics::SelfContact<>(lo, face_->lip_upper_triangles, mesh_.num_vertices(), k, opt_.contact_thickness));
+  }
+
+  const FaceModel* face_;
+  FaceResolution res_;
+  FaceSimulationOptions opt_;
+  TetMesh<> mesh_;
+  std::vector<char> in_muscle_;
+  std::vector<physics::MuscleFibre<>> fibres_;
+  std::vector<Index> muscle_of_tet_;
+  std::vector<double> muscle_share_;  ///< share of the tet's sample points inside its muscle
+  physics::ElasticEnergy<physics::MooneyRivlin<>> elastic_;
+  physics::ElasticEnergy<physics::TeranMuscle<>> muscle_;
+  physics::QuasistaticSolver<Linear> newton_;
+  physics::EmbeddedSprings<> tracks_;
+  std::optional<std::pair<physics::SelfContact<>, physics::SelfContact<>>> contact_;
+  IndexVector bone_;
+  VecX<> bone_jaw_;
+  Points<> bone_rest_;
+  physics::DirichletBoundary<> boundary_;
+  FaceControls controls_;
+  Points<> x_, previous_, start_;
+  bool have_previous_ = false, x_is_solution_ = false;
+};
+
+}  // namespace simsr::scenario
