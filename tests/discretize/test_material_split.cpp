@@ -40,16 +40,24 @@ Vec3<> centroid(const TetMesh<>& m, Index t) {
   return c;
 }
 
-}  // namespace
-
-TEST_CASE("split_by_material lists exactly the overlapping pairs (brute force) and leaves solid material unsplit") {
-  std::mt19937 rng(3);
+/// A box mesh with every vertex jittered (`boundary_too`) or only the interior ones. The draws
+/// are sequenced one by one: argument evaluation order differs between compilers.
+TetMesh<> jittered_box(std::uint32_t seed, bool boundary_too) {
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(-0.015, 0.015);
-  TetMesh<> box = box_tet_mesh<double>(5, 4, 3, Vec3<>(0.05, 0.1, 0.0), Vec3<>(0.95, 0.8, 0.55));
-  for (Index v = 0; v < box.V.rows(); ++v) box.V.row(v) += Eigen::RowVector3d(jitter(rng), jitter(rng), jitter(rng));
-  const auto L = discretize::bcc_lattice(box, 0.3);
-  const auto split = discretize::split_by_material(exec::seq, L, box);
-  // brute force over all pairs
+  const Vec3<> lo(0.05, 0.1, 0.0), hi(0.95, 0.8, 0.55);
+  TetMesh<> box = box_tet_mesh<double>(5, 4, 3, lo, hi);
+  for (Index v = 0; v < box.V.rows(); ++v) {
+    bool on_boundary = false;
+    for (int a = 0; a < 3; ++a) on_boundary = on_boundary || std::abs(box.V(v, a) - lo[a]) < 1e-12 || std::abs(box.V(v, a) - hi[a]) < 1e-12;
+    if (on_boundary && !boundary_too) continue;
+    for (int a = 0; a < 3; ++a) box.V(v, a) += jitter(rng);
+  }
+  return box;
+}
+
+/// Every (lattice tet, M-tet) pair split_by_material lists, checked against all pairs.
+void check_pairs_by_brute_force(const discretize::Lattice<>& L, const TetMesh<>& box, const discretize::MaterialSplit<>& split) {
   std::set<std::pair<Index, Index>> truth, listed;
   for (Index t = 0; t < L.mesh.T.rows(); ++t)
     for (Index e = 0; e < box.T.rows(); ++e)
@@ -60,15 +68,60 @@ TEST_CASE("split_by_material lists exactly the overlapping pairs (brute force) a
     for (Index q = split.piece_offsets[std::size_t(s)]; q < split.piece_offsets[std::size_t(s) + 1]; ++q)
       listed.insert({split.tet_parent[s], split.piece_material[std::size_t(q)]});
   CHECK(listed == truth);
-  CHECK(split.split_lattice_tets == 0);
-  CHECK(split.duplicated_nodes == 0);
-  CHECK(connected_components(split.mesh.T, split.num_nodes()).count == 1);
-  // the split mesh is the lattice minus the tets without material
-  CHECK(split.num_tets() + split.lattice_tets_without_material == L.mesh.T.rows());
-  for (Index s = 0; s < split.num_tets(); ++s)
-    for (int c = 0; c < 4; ++c) CHECK(split.node_parent[split.mesh.T(s, c)] == L.mesh.T(split.tet_parent[s], c));
-  // every M-tet is held somewhere
-  for (Index e = 0; e < box.T.rows(); ++e) CHECK(split.material_offsets[std::size_t(e) + 1] > split.material_offsets[std::size_t(e)]);
+}
+
+}  // namespace
+
+TEST_CASE("split_by_material lists exactly the overlapping pairs (brute force); its pieces are the vertex-connected groups") {
+  for (const std::uint32_t seed : {3u, 4u, 5u}) {
+    CAPTURE(seed);
+    const TetMesh<> box = jittered_box(seed, true);
+    const auto L = discretize::bcc_lattice(box, 0.3);
+    const auto split = discretize::split_by_material(exec::seq, L, box);
+    check_pairs_by_brute_force(L, box, split);
+    // pieces of one lattice tet share no M-vertex; inside a piece the M-tets are vertex-connected
+    for (Index s = 0; s < split.num_tets(); ++s) {
+      std::vector<Index> piece(split.piece_material.begin() + split.piece_offsets[std::size_t(s)],
+                               split.piece_material.begin() + split.piece_offsets[std::size_t(s) + 1]);
+      auto shares = [&](Index a, Index b) {
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j)
+            if (box.T(a, i) == box.T(b, j)) return true;
+        return false;
+      };
+      std::vector<bool> reached(piece.size(), false);
+      reached[0] = true;
+      for (bool grew = true; grew;) {
+        grew = false;
+        for (std::size_t i = 0; i < piece.size(); ++i)
+          for (std::size_t j = 0; j < piece.size(); ++j)
+            if (reached[i] && !reached[j] && shares(piece[i], piece[j])) reached[j] = grew = true;
+      }
+      CHECK(std::count(reached.begin(), reached.end(), true) == Index(piece.size()));
+      for (Index r = s + 1; r < split.num_tets() && split.tet_parent[r] == split.tet_parent[s]; ++r)
+        for (Index q = split.piece_offsets[std::size_t(r)]; q < split.piece_offsets[std::size_t(r) + 1]; ++q)
+          for (Index e : piece) CHECK_FALSE(shares(e, split.piece_material[std::size_t(q)]));
+    }
+  }
+}
+
+TEST_CASE("split_by_material leaves convex material unsplit (a convex set meets a lattice tet in one piece)") {
+  for (const std::uint32_t seed : {3u, 4u, 5u}) {
+    CAPTURE(seed);
+    const TetMesh<> box = jittered_box(seed, false);  // flat faces: the material is the box itself
+    const auto L = discretize::bcc_lattice(box, 0.3);
+    const auto split = discretize::split_by_material(exec::seq, L, box);
+    check_pairs_by_brute_force(L, box, split);
+    CHECK(split.split_lattice_tets == 0);
+    CHECK(split.duplicated_nodes == 0);
+    CHECK(connected_components(split.mesh.T, split.num_nodes()).count == 1);
+    // the split mesh is the lattice minus the tets without material
+    CHECK(split.num_tets() + split.lattice_tets_without_material == L.mesh.T.rows());
+    for (Index s = 0; s < split.num_tets(); ++s)
+      for (int c = 0; c < 4; ++c) CHECK(split.node_parent[split.mesh.T(s, c)] == L.mesh.T(split.tet_parent[s], c));
+    // every M-tet is held somewhere
+    for (Index e = 0; e < box.T.rows(); ++e) CHECK(split.material_offsets[std::size_t(e) + 1] > split.material_offsets[std::size_t(e)]);
+  }
 }
 
 TEST_CASE("two slabs closer than a cell: every shared cell is split and the lattice falls into two bodies") {
