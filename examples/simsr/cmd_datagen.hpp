@@ -57,7 +57,7 @@ inline int datagen(const DatagenArgs& a) {
   scenario::PerformanceOptions po;
   po.frames = a.frames;
   for (const auto& name : a.performances) perfs.push_back(scenario::builtin_performance(name, face.expression_names, a.seed, po));
-  for (const auto& file : a.controls) perfs.push_back(scenario::read_controls(file, std::filesystem::path(file).stem().string()));
+  for (const auto& file : a.controls) perfs.push_back(scenario::read_controls(file, scenario::performance_name_of(file)));
   Index total = 0;
   for (const auto& p : perfs) total += p.num_frames();
   Index done = 0;
@@ -89,7 +89,7 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--performances", a->performances, "built-in performances: amazement, anger, fear, pain (none: only --controls)")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--controls", a->controls, "a controls file (.npz: names C strings, weights F×C), simulated as a performance named after the file");
+  cmd->add_option("--controls", a->controls, "a controls file (.npz: names C strings, weights F×C), simulated as a performance named after the file (less a trailing _controls)");
   cmd->add_option("--frames", a->frames, "frames per built-in performance")->capture_default_str()->check(CLI::Range(14, 100000));
   cmd->add_option("--seed", a->seed, "seed of the built-in performances")->capture_default_str();
   cmd->add_option("--preset", a->preset, "mesh sizes: default (12.5x more tets at HR), paper-ratio (~26x), paper-lr (LR ~73k tets)")->capture_default_str();

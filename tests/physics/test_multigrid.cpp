@@ -89,6 +89,29 @@ TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG
     if (s.fixed[std::size_t(i)]) CHECK(z_seq[i] == 0.0);
 }
 
+TEST_CASE("Multigrid: a second compute starts its eigenvalue estimate warm; forget_estimates makes it a fresh one's, bitwise") {
+  auto s = stiffness_system(12, 4, 3);
+  const SparseMatrix<>& A = s.A();
+  const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
+  SparseMatrix<> B = A;  // another matrix of the same pattern (the next Newton iteration's)
+  B *= 1.5;
+  Multigrid<> used(prolongations), fresh(prolongations);
+  used.compute(exec::omp, A);
+  used.compute(exec::omp, B);  // warm: 2 power iterations from A's vector
+  fresh.compute(exec::omp, B);  // cold: 12 from the fixed start
+  REQUIRE(used.num_levels() >= 2);
+  bool differs = false;
+  for (Index l = 0; l + 1 < used.num_levels(); ++l) differs = differs || used.damping(l) != fresh.damping(l);
+  CHECK(differs);  // the history shows (else this test could not fail)
+  used.forget_estimates();
+  used.compute(exec::omp, B);
+  for (Index l = 0; l + 1 < used.num_levels(); ++l) CHECK(used.damping(l) == fresh.damping(l));
+  VecX<> zu, zf;
+  used.apply(exec::omp, s.b, zu);
+  fresh.apply(exec::omp, s.b, zf);
+  CHECK(zu == zf);
+}
+
 TEST_CASE("PCG + multigrid solves stiffness systems like a dense LDLT, in far fewer iterations than block-Jacobi") {
   for (unsigned seed = 1; seed <= 3; ++seed) {
     auto s = stiffness_system(24, 4, seed);

@@ -11,6 +11,7 @@
 #include "quality.hpp"
 #include "rigid_motion.hpp"
 #include "tet_overlap.hpp"
+#include "triangle_intersection.hpp"
 #include "tet_mesh.hpp"
 #include "topology.hpp"
 #include "tri_mesh.hpp"

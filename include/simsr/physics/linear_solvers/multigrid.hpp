@@ -172,6 +172,11 @@ class Multigrid {
   Index level_size(Index l) const { return Index(levels_.at(std::size_t(l)).b.size()); }
   /// ω used on level ℓ by the last compute().
   double damping(Index l) const { return levels_.at(std::size_t(l)).omega; }
+  /// Forgets the power iterations' vectors: the next compute() starts cold, as the first did. A
+  /// run that must not depend on its history (a resumed frame sequence, bitwise) calls it per frame.
+  void forget_estimates() {
+    for (Level& L : levels_) L.v.resize(0);
+  }
 
   /// Galerkin coarse operators, smoothers and the coarsest factorization for A. The structures
   /// of the products and the coarsest symbolic factorization are kept while A's pattern stays.

@@ -14,11 +14,14 @@
 /// from the settled neutral (all controls 0), solved once and kept in DIR/.state. A run checkpoints
 /// each performance every `checkpoint_every` frames (DIR/.state/<name>.npz: the frames so far and
 /// the last two states of both meshes, atomically), so a killed run resumes where it stopped and
-/// loses no finished frame; the resumed output is bitwise the uninterrupted one (the warm start
-/// is restored exactly). A file from another run (another mesh, options or controls) is refused
-/// by fingerprint, never continued. A Newton failure, or an inverted tet after a solve, is an
+/// loses no finished frame. The warm start is restored exactly, but the resumed frames are not
+/// yet bitwise the uninterrupted run's (some solver state still carries over between frames;
+/// they agree to the solver tolerance, tests/scenario/test_face_datagen.cpp). A file from another run (another mesh, options or controls) is refused
+/// by fingerprint, never continued. A Newton failure or an inverted tet after a solve is an
 /// Error naming the performance, the frame, the resolution and the residual: nothing is written
-/// for that frame.
+/// for that frame. Every HR frame's lips are checked by an exact triangle–triangle test
+/// (mesh/triangle_intersection.hpp) and counted in the stats and face_data.json (not yet an
+/// error: the kit's own neutral has its lips crossing near the corners, see face_simulator.hpp).
 
 #include <chrono>
 #include <cstdio>
@@ -36,6 +39,7 @@
 #include "../../io/atomic_file.hpp"
 #include "../../io/mesh_io.hpp"
 #include "../../io/npz.hpp"
+#include "../../mesh/triangle_intersection.hpp"
 #include "face_model.hpp"
 #include "face_simulator.hpp"
 #include "performances.hpp"
@@ -59,7 +63,15 @@ struct PerformanceStats {
   Index lr_iterations = 0, hr_iterations = 0;
   Index simulated = 0;                     ///< frames simulated in this run (the rest were resumed or reused)
   bool reused = false;                     ///< the finished file was there already
+  Index lip_intersecting_frames = 0;       ///< HR frames whose upper and lower lip triangles intersect
+  Index lip_max_pairs = 0;                 ///< the most intersecting triangle pairs in one frame
 };
+
+/// The pairs (upper lip triangle, lower lip triangle) that intersect at HR positions X, exactly
+/// (a 2^-36 m grid, ±4 m).
+inline std::vector<std::pair<Index, Index>> intersecting_lip_pairs(const FaceModel& face, const Points<>& X) {
+  return intersecting_triangle_pairs(X, face.lip_upper_triangles, face.lip_lower_triangles, 0x1p-36);
+}
 
 namespace detail {
 
@@ -67,8 +79,14 @@ namespace detail {
 inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulationOptions& o, const Performance* p) {
   Fingerprint f;
   f.add(face.hr.V).add(face.hr.T).add(face.lr.V).add(face.lr.T).add(face.surface.F);
-  f.add(o.mu10).add(o.mu01).add(o.kappa).add(o.muscle_max_stress).add(o.track_stiffness).add(o.contact_stiffness).add(o.contact_thickness);
-  f.add(o.contact_exclusion).add(o.newton.relative_tolerance).add(o.newton.max_iterations).add(o.linear.tolerance).add(std::int64_t(o.extrapolate));
+  f.add(face.hr_bone).add(face.hr_bone_jaw).add(face.lr_bone).add(face.lr_bone_jaw).add(face.hinge.point).add(face.hinge.axis).add(face.hinge.angle);
+  for (const auto& m : face.muscles) {
+    f.add_bytes(m.spec.name.data(), m.spec.name.size()).add(m.insertion).add(m.origin).add(m.ring).add(m.spec.radius);
+    for (const auto& d : m.spec.drivers) f.add_bytes(d.expression.data(), d.expression.size()).add(d.gain);
+  }
+  f.add(o.inversion_threshold).add(o.mu10).add(o.mu01).add(o.kappa).add(o.muscle_max_stress).add(o.track_stiffness).add(o.contact_stiffness).add(o.contact_thickness);
+  f.add(o.contact_exclusion).add(o.newton.relative_tolerance).add(o.newton.absolute_tolerance).add(o.newton.max_iterations).add(o.linear.tolerance).add(std::int64_t(o.extrapolate));
+  f.add(o.substep_levels);
   if (p) {
     f.add(p->weights);
     for (const auto& n : p->names) f.add_bytes(n.data(), n.size());
@@ -136,6 +154,11 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
   write_face_rest_shapes(face, dir);
   const std::string model_print = detail::face_run_fingerprint(face, opt.simulation, nullptr);
 
+  for (const auto& p : performances) {  // another run's checkpoint: refused before any solve
+    const auto partial = state / (p.name + ".npz");
+    if (std::filesystem::exists(partial) && detail::fingerprint_of(io::read_npz(partial)) != detail::face_run_fingerprint(face, opt.simulation, &p))
+      throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
+  }
   FaceSimulator<Linear> lr(policy, face, FaceResolution::low, opt.simulation);
   FaceSimulator<Linear> hr(policy, face, FaceResolution::high, opt.simulation);
 
@@ -196,6 +219,12 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     out.sequence.assign(std::size_t(F), 0);
     out.sequence_names = {perf.name};
     Index start = 0;
+    // positions are taken as solved under the controls set before them (continuation walks from
+    // those): the neutral under zero controls, a checkpoint under its last frame's
+    FaceControls zero;
+    zero.blendshapes = VecX<>::Zero(face.num_expressions());
+    lr.set_controls(zero);
+    hr.set_controls(zero);
     lr.set_positions(lr_neutral);
     hr.set_positions(hr_neutral);
     if (std::filesystem::exists(partial)) {
@@ -210,6 +239,9 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       out.lowres.topRows(start) = lo;
       out.highres.topRows(start) = hi;
       const Points<> lx = detail::points_of(z, "lr_state", N, partial.string()), hx = detail::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
+      const FaceControls last = face_controls(perf, start - 1, face);
+      lr.set_controls(last);
+      hr.set_controls(last);
       if (start >= 2) {
         lr.set_positions(detail::points_of(z, "lr_before", N, partial.string()), lx);
         hr.set_positions(detail::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()), hx);
@@ -231,6 +263,10 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       const auto rh = detail::solve_frame(policy, hr, perf.name, f);
       const auto t2 = std::chrono::steady_clock::now();
       const double sl = std::chrono::duration<double>(t1 - t0).count(), sh = std::chrono::duration<double>(t2 - t1).count();
+      if (const Index pairs = Index(intersecting_lip_pairs(face, hr.positions()).size())) {
+        ++st.lip_intersecting_frames;
+        st.lip_max_pairs = std::max(st.lip_max_pairs, pairs);
+      }
       out.lr(f) = lr.positions();
       out.hr(f) = hr.surface(policy);
       st.lr_seconds += sl;
@@ -297,11 +333,22 @@ inline nlohmann::ordered_json face_data_report(const FaceModel& face, const std:
       p["hr_seconds_per_frame"] = s.hr_seconds / n;
       p["lr_newton_iterations_per_frame"] = double(s.lr_iterations) / n;
       p["hr_newton_iterations_per_frame"] = double(s.hr_iterations) / n;
+      p["hr_frames_with_intersecting_lips"] = s.lip_intersecting_frames;
+      p["hr_most_intersecting_lip_triangle_pairs"] = s.lip_max_pairs;
     }
     perf.push_back(p);
   }
   j["performances"] = perf;
   return j;
+}
+
+/// The performance a controls file stands for: its stem, less a trailing "_controls" (so the
+/// DIR/<name>_controls.npz a run writes simulates again as <name>, and never overwrites itself).
+inline std::string performance_name_of(const std::filesystem::path& controls_file) {
+  std::string s = controls_file.stem().string();
+  const std::string tail = "_controls";
+  if (s.size() > tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0) s.resize(s.size() - tail.size());
+  return s;
 }
 
 /// Reads a controls file (`names`: C strings, `weights`: F×C) as a performance called `name`.
@@ -315,6 +362,9 @@ inline Performance read_controls(const std::filesystem::path& file, const std::s
   if (w.ndim() != 2 || w.shape[1] != std::int64_t(p.names.size()))
     throw ShapeError(file.string() + ": weights", {-1, Index(p.names.size())}, {w.ndim() > 0 ? Index(w.shape[0]) : 0, w.ndim() > 1 ? Index(w.shape[1]) : 0});
   if (w.shape[0] < 1 || w.shape[0] > data::max_frames) throw ArgumentError(file.string() + ": " + std::to_string(w.shape[0]) + " frames (expected 1 to " + std::to_string(data::max_frames) + ")");
+  for (std::size_t i = 0; i < p.names.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (p.names[i] == p.names[j]) throw ArgumentError(file.string() + ": control '" + p.names[i] + "' appears twice (columns " + std::to_string(j) + " and " + std::to_string(i) + ")");
   p.weights = w.to_matrix<double>();
   return p;
 }

@@ -11,9 +11,14 @@
 ///     lies nearest to the kit's face, mouth or eye region, and above the chin: no neck, no back
 ///     of the head), then split by material (discretize/material_split.hpp) so no LR element
 ///     spans both lips.
-///  5. Bones: HR vertices on the skull surface; LR nodes inside the skull. Each gets a jaw weight
-///     (jaw_weights.hpp): the cranium (0) stays, the jaw (1) turns about the hinge, the few in
-///     between are blended (linear blend skinning, as the paper's rest pose).
+///  5. Bones: HR vertices on the skull surface; LR nodes inside the skull. Two rigid bones: a
+///     point whose jaw weight (jaw_weights.hpp) is at least `jaw_weight_min` is mandible and turns
+///     with the hinge, one at most `cranium_weight_max` is cranium and stays; the band between
+///     (the floor of the mouth, the cheeks between the jaw and the cheekbone) is soft tissue and
+///     held by nothing. Blending the two motions there instead (linear blend skinning) shears the
+///     skull surface itself: with the weight rising over ~2 cm under the chin and the chin moving
+///     ~3 cm at a wide-open jaw, the blended map has det ≈ 1 + ∇w·r ≈ 0.1 and crushed the flesh
+///     under the chin to inverted tets in the first full run.
 ///  6. The output surface: the kit's face skin where it lies inside the LR mesh, its vertices
 ///     HR vertices (the skin is kept by -Y) and embedded in LR tets.
 ///  7. Lips: the HR surface vertices and triangles within `lip_radius` of the lips' inner edge,
@@ -63,6 +68,8 @@ struct FaceModelOptions {
   TetgenOptions hr{.max_volume = 0.1, .radius_edge = 1.5, .min_dihedral = 12, .preserve_boundary = true};
   double chin_margin = 3.5;       ///< the LR mask drops cells lower than the lower teeth's bottom minus this
   double lip_radius = 1.5;        ///< surface within this distance of the lips' inner edge takes part in lip contact
+  double jaw_weight_min = 0.6;     ///< skull points with at least this jaw weight are mandible (rigid, weight 1)
+  double cranium_weight_max = 0.15; ///< skull points with at most this jaw weight are cranium (fixed)
   std::vector<MuscleSpec> muscles = default_muscle_specs();
 };
 
@@ -141,6 +148,19 @@ inline IndexVector flagged(const std::vector<char>& f) {
   return Eigen::Map<const IndexVector>(v.data(), Index(v.size()));
 }
 
+/// The bone points of `candidates` (jaw weights `w`) as two rigid bones: weight ≥ jaw_weight_min
+/// → 1, ≤ cranium_weight_max → 0, the band between dropped (file comment, step 5).
+inline std::pair<IndexVector, VecX<>> rigid_bones(const IndexVector& candidates, const VecX<>& w, const FaceModelOptions& opt) {
+  std::vector<VIndex> ids;
+  std::vector<double> jaw;
+  for (Index i = 0; i < candidates.size(); ++i)
+    if (w[i] >= opt.jaw_weight_min || w[i] <= opt.cranium_weight_max) {
+      ids.push_back(candidates[i]);
+      jaw.push_back(w[i] >= opt.jaw_weight_min ? 1.0 : 0.0);
+    }
+  return {Eigen::Map<const IndexVector>(ids.data(), Index(ids.size())), Eigen::Map<const VecX<>>(jaw.data(), Index(jaw.size()))};
+}
+
 }  // namespace detail
 
 /// Builds the face model from `kit` (see the file comment); tetgen's files go to `work_dir`.
@@ -150,6 +170,9 @@ template <exec::HostPolicy P>
 FaceModel build_face_model(P policy, const IctKit& kit, const FaceModelOptions& opt, const std::filesystem::path& work_dir) {
   if (!(opt.lr_cell > 0) || !(opt.skull_lattice > 0) || !(opt.lip_radius > 0) || !(opt.rest_jaw_open >= 0 && opt.rest_jaw_open < 1))
     throw ArgumentError("build_face_model: lr_cell, skull_lattice and lip_radius must be > 0 and rest_jaw_open in [0, 1)");
+  if (!(opt.cranium_weight_max >= 0 && opt.cranium_weight_max < opt.jaw_weight_min && opt.jaw_weight_min <= 1))
+    throw ArgumentError("build_face_model: need 0 <= cranium_weight_max < jaw_weight_min <= 1, got " + std::to_string(opt.cranium_weight_max) +
+                        " and " + std::to_string(opt.jaw_weight_min));
   constexpr double m_per_cm = 0.01;
   FaceModel face;
   face.expression_names = kit.expression_names;
@@ -207,13 +230,11 @@ FaceModel build_face_model(P policy, const IctKit& kit, const FaceModelOptions& 
   {
     IndexVector hb(skull.surface.V.rows());
     for (Index i = 0; i < hb.size(); ++i) hb[i] = VIndex(head.mesh.V.rows() + i);
-    face.hr_bone = hb;
-    face.hr_bone_jaw = jw.at(policy, skull.surface.V);
-    const auto inside = discretize::inside_surface(skull.surface, face.lr_split.mesh.V);
-    face.lr_bone = detail::flagged(inside);
-    Points<> at(face.lr_bone.size(), 3);
-    for (Index i = 0; i < at.rows(); ++i) at.row(i) = face.lr_split.mesh.V.row(face.lr_bone[i]);
-    face.lr_bone_jaw = jw.at(policy, at);
+    std::tie(face.hr_bone, face.hr_bone_jaw) = detail::rigid_bones(hb, jw.at(policy, skull.surface.V), opt);
+    const IndexVector lb = detail::flagged(discretize::inside_surface(skull.surface, face.lr_split.mesh.V));
+    Points<> at(lb.size(), 3);
+    for (Index i = 0; i < at.rows(); ++i) at.row(i) = face.lr_split.mesh.V.row(lb[i]);
+    std::tie(face.lr_bone, face.lr_bone_jaw) = detail::rigid_bones(lb, jw.at(policy, at), opt);
   }
 
   // 6. output surface: face skin inside the LR mesh

@@ -87,6 +87,8 @@ namespace detail {
 inline double unit_double(std::mt19937_64& g) { return double(g() >> 11) * 0x1.0p-53; }
 
 inline double catmull_rom(double p0, double p1, double p2, double p3, double t) {
+  if (t <= 0) return p1;  // the keys exactly (the polynomial leaves round-off at t = 1)
+  if (t >= 1) return p2;
   const double t2 = t * t, t3 = t2 * t;
   return 0.5 * (2 * p1 + (-p0 + p2) * t + (2 * p0 - 5 * p1 + 4 * p2 - p3) * t2 + (-p0 + 3 * p1 - 3 * p2 + p3) * t3);
 }
