@@ -3,7 +3,6 @@
 // same code paths as the default model at a size the sanitizer builds can afford.
 #include <simsr/scenario/face/face_model.hpp>
 
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -31,7 +30,7 @@ namespace simsr::test {
       SIMSR_MISSING("ICT kit not found in " << ::simsr::test::ict_kit_dir);      \
       return;                                                                    \
     }                                                                            \
-    if (std::system("command -v tetgen > /dev/null 2>&1") != 0) {                \
+    if (!::simsr::test::have_tetgen()) {                                         \
       SIMSR_MISSING("the tetgen program (apt-get install tetgen)");              \
       return;                                                                    \
     }                                                                            \

@@ -2,6 +2,7 @@
 // The bundled ICT kit, read once per test executable (each read parses ~8 MB of OBJ and npz).
 #include <simsr/scenario/face/ict_kit.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -13,6 +14,9 @@ inline bool have_ict_kit() {
   return std::filesystem::exists(ict_kit_dir / "full_neutral.obj") && std::filesystem::exists(ict_kit_dir / "expressions_full.npz") &&
          std::filesystem::exists(ict_kit_dir / "regions.json");
 }
+
+/// Debian's tetgen program on the PATH (the HR mesher the scenario runs).
+inline bool have_tetgen() { return std::system("command -v tetgen > /dev/null 2>&1") == 0; }
 
 /// The kit (have_ict_kit() must be true).
 inline const scenario::IctKit& ict_kit() {

@@ -9,14 +9,14 @@
 #include <simsr/mesh/volume.hpp>
 #include <simsr/scenario/tetgen_mesher.hpp>
 
+#include "kit_fixture.hpp"
+
 #include <cstdlib>
 #include <filesystem>
 
 using namespace simsr;
 
 namespace {
-
-bool have_tetgen() { return std::system("command -v tetgen > /dev/null 2>&1") == 0; }
 
 /// The boundary of an axis-aligned box [lo, hi], 2 triangles per side (8 vertices).
 TriMesh<> box_surface(const Vec3<>& lo, const Vec3<>& hi) { return boundary_surface(box_tet_mesh<double>(1, 1, 1, lo, hi)); }
@@ -31,7 +31,7 @@ double area(const TriMesh<>& s, const Tris& F) {
 }  // namespace
 
 TEST_CASE("tetgen_mesh: a box with a cavity, its volume and boundary exact, input vertices first and unmoved") {
-  if (!have_tetgen()) {
+  if (!test::have_tetgen()) {
     SIMSR_MISSING("the tetgen program (apt-get install tetgen)");
     return;
   }
@@ -54,7 +54,7 @@ TEST_CASE("tetgen_mesh: a box with a cavity, its volume and boundary exact, inpu
 }
 
 TEST_CASE("tetgen_mesh: a missing program and self-intersecting facets are named errors") {
-  if (!have_tetgen()) {
+  if (!test::have_tetgen()) {
     SIMSR_MISSING("the tetgen program (apt-get install tetgen)");
     return;
   }

@@ -14,10 +14,11 @@
 /// from the settled neutral (all controls 0), solved once and kept in DIR/.state. A run checkpoints
 /// each performance every `checkpoint_every` frames (DIR/.state/<name>.npz: the frames so far and
 /// the last two states of both meshes, atomically), so a killed run resumes where it stopped and
-/// loses no finished frame. The warm start is restored exactly, but the resumed frames are not
-/// yet bitwise the uninterrupted run's (some solver state still carries over between frames;
-/// they agree to the solver tolerance, tests/scenario/test_face_datagen.cpp). A file from another run (another mesh, options or controls) is refused
-/// by fingerprint, never continued. A Newton failure or an inverted tet after a solve is an
+/// loses no finished frame. A frame depends on the two states before it and its controls only
+/// (the warm start is restored exactly, the solver keeps no estimates across frames), so a resumed
+/// run's frames equal the uninterrupted run's bitwise (tests/scenario/test_face_datagen.cpp;
+/// the policies' reductions use fixed chunks). A file from another run (another mesh, options or
+/// controls) is refused by fingerprint, never continued. A Newton failure or an inverted tet after a solve is an
 /// Error naming the performance, the frame, the resolution and the residual: nothing is written
 /// for that frame. Every HR frame's lips are checked by an exact triangle–triangle test
 /// (mesh/triangle_intersection.hpp) and counted in the stats and face_data.json (not yet an
@@ -27,6 +28,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -86,7 +88,7 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
   }
   f.add(o.inversion_threshold).add(o.mu10).add(o.mu01).add(o.kappa).add(o.muscle_max_stress).add(o.track_stiffness).add(o.contact_stiffness).add(o.contact_thickness);
   f.add(o.contact_exclusion).add(o.newton.relative_tolerance).add(o.newton.absolute_tolerance).add(o.newton.max_iterations).add(o.linear.tolerance).add(std::int64_t(o.extrapolate));
-  f.add(o.substep_levels);
+  f.add(o.substep_levels).add(std::int64_t(o.carry_with_jaw));
   if (p) {
     f.add(p->weights);
     for (const auto& n : p->names) f.add_bytes(n.data(), n.size());
@@ -146,19 +148,27 @@ template <class Linear = physics::ConjugateGradient<physics::Multigrid<>>, exec:
 std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face, const std::vector<Performance>& performances,
                                                  const std::filesystem::path& dir, const FaceDatagenOptions& opt = {}) {
   if (opt.checkpoint_every < 1) throw ArgumentError("generate_face_data: checkpoint_every must be ≥ 1");
-  for (const auto& p : performances)
+  const auto state = dir / ".state";
+  // every performance checked, and another run's checkpoint refused, before anything is written
+  // or solved; the checkpoints read here are the ones resumed below
+  std::vector<std::string> prints;
+  std::vector<std::optional<io::NpzArrays>> checkpoints;
+  for (const auto& p : performances) {
     if (p.name.empty() || p.name.find_first_of("/\\. ") != std::string::npos)
       throw ArgumentError("generate_face_data: performance name '" + p.name + "' cannot be a file name");
-  const auto state = dir / ".state";
+    if (p.num_frames() < 1) throw ArgumentError("generate_face_data: performance '" + p.name + "' has no frames");
+    prints.push_back(detail::face_run_fingerprint(face, opt.simulation, &p));
+    const auto partial = state / (p.name + ".npz");
+    checkpoints.emplace_back();
+    if (!std::filesystem::exists(partial)) continue;
+    checkpoints.back() = io::read_npz(partial);
+    if (detail::fingerprint_of(*checkpoints.back()) != prints.back())
+      throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
+  }
   std::filesystem::create_directories(state);
   write_face_rest_shapes(face, dir);
   const std::string model_print = detail::face_run_fingerprint(face, opt.simulation, nullptr);
 
-  for (const auto& p : performances) {  // another run's checkpoint: refused before any solve
-    const auto partial = state / (p.name + ".npz");
-    if (std::filesystem::exists(partial) && detail::fingerprint_of(io::read_npz(partial)) != detail::face_run_fingerprint(face, opt.simulation, &p))
-      throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
-  }
   FaceSimulator<Linear> lr(policy, face, FaceResolution::low, opt.simulation);
   FaceSimulator<Linear> hr(policy, face, FaceResolution::high, opt.simulation);
 
@@ -174,9 +184,8 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       have_neutral = true;
     }
   }
+  const FaceControls zero = neutral_controls(face);
   if (!have_neutral) {
-    FaceControls zero;
-    zero.blendshapes = VecX<>::Zero(face.num_expressions());
     lr.set_controls(zero);
     hr.set_controls(zero);
     detail::solve_frame(policy, lr, "neutral", 0);
@@ -194,11 +203,10 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
   for (std::size_t pi = 0; pi < performances.size(); ++pi) {
     const Performance& perf = performances[pi];
     const Index F = perf.num_frames(), N = face.lr.num_vertices(), M = face.surface.num_vertices();
-    if (F < 1) throw ArgumentError("generate_face_data: performance '" + perf.name + "' has no frames");
     PerformanceStats st;
     st.name = perf.name;
     st.frames = F;
-    const std::string print = detail::face_run_fingerprint(face, opt.simulation, &perf);
+    const std::string& print = prints[pi];
     const auto final_file = dir / (perf.name + ".npz");
     const auto partial = state / (perf.name + ".npz");
     // a finished file of this very run: reuse
@@ -221,16 +229,12 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     Index start = 0;
     // positions are taken as solved under the controls set before them (continuation walks from
     // those): the neutral under zero controls, a checkpoint under its last frame's
-    FaceControls zero;
-    zero.blendshapes = VecX<>::Zero(face.num_expressions());
     lr.set_controls(zero);
     hr.set_controls(zero);
     lr.set_positions(lr_neutral);
     hr.set_positions(hr_neutral);
-    if (std::filesystem::exists(partial)) {
-      const auto z = io::read_npz(partial);
-      if (detail::fingerprint_of(z) != print)
-        throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
+    if (checkpoints[pi]) {
+      const io::NpzArrays& z = *checkpoints[pi];
       start = z.at("frames_done").item<std::int64_t>();
       if (start < 1 || start > F) throw ArgumentError(partial.string() + ": frames_done " + std::to_string(start) + " outside [1, " + std::to_string(F) + "]");
       const auto lo = z.at("lowres").to_matrix<double>(), hi = z.at("highres").to_matrix<double>();
@@ -242,13 +246,10 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       const FaceControls last = face_controls(perf, start - 1, face);
       lr.set_controls(last);
       hr.set_controls(last);
-      if (start >= 2) {
-        lr.set_positions(detail::points_of(z, "lr_before", N, partial.string()), lx);
-        hr.set_positions(detail::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()), hx);
-      } else {
-        lr.set_positions(lx);
-        hr.set_positions(hx);
-      }
+      // the frame before the last: as the uninterrupted run had it (the neutral before frame 0)
+      const FaceControls before = start >= 2 ? face_controls(perf, start - 2, face) : zero;
+      lr.set_positions(start >= 2 ? detail::points_of(z, "lr_before", N, partial.string()) : lr_neutral, before, lx);
+      hr.set_positions(start >= 2 ? detail::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()) : hr_neutral, before, hx);
     }
     Points<> lr_before = lr.positions(), hr_before = hr.positions();
     for (Index f = start; f < F; ++f) {

@@ -21,6 +21,12 @@
 ///     auto report = hr.step(exec::omp);           // ConvergenceError names the residual
 ///     Points<> skin = hr.surface(exec::omp);      // M×3, the output surface
 ///
+/// The warm start follows the jaw: the free vertices are carried from the last frame's jaw angle
+/// to this frame's by the hinge rotation weighted with a harmonic field that is 1 on the jaw bone
+/// and 0 on the cranium (mesh/harmonic_field.hpp), so flesh near the jaw moves with it instead of
+/// being torn from it by the bone's Dirichlet step. Of that start and the same carried
+/// extrapolation of the last two frames, the one of lower total energy starts Newton.
+///
 /// A frame whose Newton solve fails is retried by continuation: from the last solved state the
 /// controls are walked to the frame's in 2, 4, … 2^substep_levels equal steps (every control is
 /// linear in the forces, so the substeps are the frame's load split into parts). A fast
@@ -38,6 +44,8 @@
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
 #include "../../discretize/embedding.hpp"
+#include "../../mesh/harmonic_field.hpp"
+#include "../../mesh/topology.hpp"
 #include "../../physics/dirichlet_boundary.hpp"
 #include "../../physics/elastic_energy.hpp"
 #include "../../physics/forces/embedded_springs.hpp"
@@ -64,6 +72,13 @@ struct FaceControls {
   VecX<> muscles;      ///< one activation in [0, 1] per FaceModel::muscles; empty: from the blendshapes (muscle_activations)
   double jaw = 0;      ///< rad, the jaw's rotation from the neutral about the hinge (≥ 0 opens)
 };
+
+/// All controls at rest: no blendshape, muscles from the blendshapes (none), the jaw closed.
+inline FaceControls neutral_controls(const FaceModel& face) {
+  FaceControls c;
+  c.blendshapes = VecX<>::Zero(face.num_expressions());
+  return c;
+}
 
 /// Material and force parameters, per unit volume or area (SI).
 struct FaceSimulationOptions {
@@ -95,10 +110,14 @@ struct FaceSimulationOptions {
   /// (the corners of the mouth, where the lips are one piece of skin).
   double contact_exclusion = 3e-3;
   physics::NewtonOptions newton = default_newton();
-  /// Start each frame's Newton from the linear extrapolation of the last two frames (2x₁ − x₀)
-  /// instead of the last frame: along a smooth performance it halves the Newton iterations. A
-  /// start whose energy is not finite falls back to the last frame.
+  /// Also try the linear extrapolation of the last two frames (2x₁ − x₀, carried by the jaw) as
+  /// the warm start, taken when its total energy is lower than the last frame's: along a smooth
+  /// performance it halves the Newton iterations; where the motion turns, the last frame wins.
   bool extrapolate = true;
+  /// Carry the warm start with the jaw (file comment); false starts from the last frame as it
+  /// was, with only the bones moved (the ablation: the first Newton step then has to pull the
+  /// flesh after the jaw, several iterations of a large residual).
+  bool carry_with_jaw = true;
   /// A failed frame is retried in 2, 4, … 2^substep_levels steps of its controls (file comment).
   Index substep_levels = 3;
   physics::ConjugateGradientOptions linear{.tolerance = 1e-4};
@@ -125,10 +144,10 @@ class FaceSimulator {
     bone_jaw_ = high ? face.hr_bone_jaw : face.lr_bone_jaw;
     bone_rest_.resize(bone_.size(), 3);
     for (Index i = 0; i < bone_.size(); ++i) bone_rest_.row(i) = mesh_.V.row(bone_[i]);
+    jaw_field_ = harmonic_field(policy, vertex_adjacency(mesh_.T, mesh_.num_vertices()), bone_, bone_jaw_);
     if (high) make_contact(policy);
     x_ = mesh_.V;
-    FaceControls rest;
-    rest.blendshapes = VecX<>::Zero(face.num_expressions());
+    FaceControls rest = neutral_controls(face);
     rest.jaw = face.rest_jaw_angle;
     set_controls(rest);
     solved_controls_ = rest;
@@ -138,7 +157,7 @@ class FaceSimulator {
   const TetMesh<>& mesh() const { return mesh_; }
   const Points<>& positions() const { return x_; }
   /// Starts the next solve from these positions (a resumed run's last frame), taken as solved
-  /// under the current controls (continuation walks from them).
+  /// under the current controls (continuation and the warm start walk from them).
   void set_positions(const Points<>& x) {
     if (x.rows() != mesh_.num_vertices() || x.cols() != 3) throw ShapeError("FaceSimulator::set_positions", {mesh_.num_vertices(), 3}, {x.rows(), x.cols()});
     if (!x.allFinite()) throw ArgumentError("FaceSimulator::set_positions: non-finite positions");
@@ -147,11 +166,14 @@ class FaceSimulator {
     x_is_solution_ = true;
     solved_controls_ = controls_;
   }
-  /// As set_positions, with the frame before it too (the warm start extrapolates from both).
-  void set_positions(const Points<>& before, const Points<>& x) {
+  /// As set_positions, with the frame before it too, solved under `before_controls` (the warm
+  /// start extrapolates from both): a resumed run repeats the uninterrupted one's frames bitwise.
+  void set_positions(const Points<>& before, const FaceControls& before_controls, const Points<>& x) {
     set_positions(before);
     set_positions(x);
     previous_ = before;
+    previous_jaw_ = before_controls.jaw;
+    if (!std::isfinite(previous_jaw_)) throw ArgumentError("FaceSimulator::set_positions: non-finite jaw angle of the frame before");
     have_previous_ = true;
   }
   void reset() {
@@ -165,7 +187,7 @@ class FaceSimulator {
     if (c.blendshapes.size() != E) throw ShapeError("FaceSimulator::set_controls: blendshape weights", {E, 1}, {c.blendshapes.size(), 1});
     if (!c.blendshapes.allFinite() || !std::isfinite(c.jaw)) throw ArgumentError("FaceSimulator::set_controls: non-finite control");
     const Index nm = Index(face_->muscles.size());
-    const VecX<> act = c.muscles.size() ? c.muscles : muscle_activations(face_->muscles, face_->expression_names, c.blendshapes);
+    const VecX<> act = activations_of(c);
     if (act.size() != nm) throw ShapeError("FaceSimulator::set_controls: muscle activations", {nm, 1}, {act.size(), 1});
     for (Index k = 0; k < nm; ++k)
       if (!(act[k] >= 0 && act[k] <= 1)) throw ArgumentError("FaceSimulator::set_controls: activation of muscle '" + face_->muscles[std::size_t(k)].spec.name + "' is " + std::to_string(act[k]) + ", not in [0, 1]");
@@ -192,21 +214,21 @@ class FaceSimulator {
   /// One quasistatic frame from the current positions; ConvergenceError when Newton fails.
   template <exec::HostPolicy P>
   physics::NewtonReport step(P policy) {
-    return advance(policy, [&](Points<>& x) {
-      if (contact_) return newton_.solve(policy, x, boundary_, elastic_, muscle_, tracks_, contact_->first, contact_->second);
-      return newton_.solve(policy, x, boundary_, elastic_, muscle_, tracks_);
-    });
+    return advance([&](Points<>& x) { return with_terms([&](const auto&... t) { return newton_.solve(policy, x, boundary_, t...); }); },
+                   [&](const Points<>& x) { return with_terms([&](const auto&... t) { return (0.0 + ... + double(t.energy(policy, x))); }); });
   }
 
   /// As step, with one more energy term for this frame (the §5.3 "unseen forces": a spring, an
   /// obstacle).
   template <exec::HostPolicy P, class Extra>
   physics::NewtonReport step_with(P policy, const Extra& extra) {
-    return advance(policy, [&](Points<>& x) {
-      if (contact_) return newton_.solve(policy, x, boundary_, elastic_, muscle_, tracks_, contact_->first, contact_->second, extra);
-      return newton_.solve(policy, x, boundary_, elastic_, muscle_, tracks_, extra);
-    });
+    return advance([&](Points<>& x) { return with_terms([&](const auto&... t) { return newton_.solve(policy, x, boundary_, t...); }, extra); },
+                   [&](const Points<>& x) { return with_terms([&](const auto&... t) { return (0.0 + ... + double(t.energy(policy, x))); }, extra); });
   }
+
+  /// The jaw weight of every vertex: 1 on the jaw bone, 0 on the cranium, harmonic in between
+  /// (the warm start's skinning weights).
+  const VecX<>& jaw_field() const { return jaw_field_; }
 
   /// The output surface (M×3) at the current positions.
   template <exec::HostPolicy P>
@@ -296,6 +318,11 @@ class FaceSimulator {
     return part;
   }
 
+  /// The muscle activations of c: given, or from its blendshapes.
+  VecX<> activations_of(const FaceControls& c) const {
+    return c.muscles.size() ? c.muscles : muscle_activations(face_->muscles, face_->expression_names, c.blendshapes);
+  }
+
   /// Whether point c lies in one of LR tet t's pieces (HR tets, closed up to round-off).
   static bool in_flesh(const FaceModel& face, Index t, const Vec3<>& c) {
     const auto& split = face.lr_split;
@@ -311,17 +338,43 @@ class FaceSimulator {
     return false;
   }
 
+  /// f(every energy term of this simulator, extra...).
+  template <class F, class... Extra>
+  decltype(auto) with_terms(F&& f, const Extra&... extra) {
+    if (contact_) return f(elastic_, muscle_, tracks_, contact_->first, contact_->second, extra...);
+    return f(elastic_, muscle_, tracks_, extra...);
+  }
+
+  /// x (solved with the jaw at angle `from`) carried to the jaw at `to`: every vertex rotated
+  /// about the hinge by (to − from) × its jaw weight, the bones set to their targets.
+  Points<> carried_by_jaw(const Points<>& x, double from, double to) const {
+    Points<> y = x;
+    const Mat3<> R = Eigen::AngleAxisd(to - from, face_->hinge.axis.normalized()).toRotationMatrix();
+    const Vec3<> p = face_->hinge.point;
+    if (opt_.carry_with_jaw && to != from)
+      for (Index v = 0; v < y.rows(); ++v)
+        if (const double w = jaw_field_[v]; w != 0) {
+          const Vec3<> a = x.row(v).transpose();
+          y.row(v) = (a + w * (R * (a - p) + p - a)).transpose();
+        }
+    for (Index i = 0; i < bone_.size(); ++i) y.row(bone_[i]) = boundary_.targets.row(i);
+    return y;
+  }
+
   /// Runs `solve` from the warm start and moves the frame history on.
-  template <class P, class Solve>
-  physics::NewtonReport advance(P policy, Solve&& solve) {
-    // a frame depends on x_, previous_ and the controls only (a resumed run repeats it bitwise):
-    // the multigrid's warm eigenvalue estimate would carry the last frame's history
+  template <class Solve, class Energy>
+  physics::NewtonReport advance(Solve&& solve, Energy&& energy) {
+    // a frame depends on x_, previous_, their jaw angles and the controls only (a resumed run
+    // repeats it bitwise): the multigrid's warm eigenvalue estimate would carry the last
+    // frame's history
     if constexpr (requires { newton_.linear_solver().preconditioner().forget_estimates(); })
       newton_.linear_solver().preconditioner().forget_estimates();
-    start_ = x_;
+    const double jaw = solved_controls_.jaw;
+    start_ = carried_by_jaw(x_, jaw, controls_.jaw);
     if (opt_.extrapolate && have_previous_) {
-      start_ = 2 * x_ - previous_;
-      if (!std::isfinite(double(elastic_.energy(policy, start_)))) start_ = x_;
+      Points<> ahead = carried_by_jaw(2 * x_ - previous_, 2 * jaw - previous_jaw_, controls_.jaw);
+      const double e = energy(ahead);
+      if (std::isfinite(e) && !(e >= energy(start_))) start_.swap(ahead);  // lower, or the last frame's not finite
     }
     physics::NewtonReport r;
     try {
@@ -329,6 +382,7 @@ class FaceSimulator {
     } catch (const ConvergenceError& failed) {
       r = continuation(solve, failed);
     }
+    previous_jaw_ = jaw;
     solved_controls_ = controls_;
     previous_.swap(x_);
     x_.swap(start_);
@@ -346,12 +400,8 @@ class FaceSimulator {
     auto lerp = [&](double s) {
       FaceControls c;
       c.blendshapes = (1 - s) * solved_controls_.blendshapes + s * target.blendshapes;
-      if (target.muscles.size() || solved_controls_.muscles.size()) {
-        const VecX<> a = solved_controls_.muscles.size() ? solved_controls_.muscles
-                                                         : muscle_activations(face_->muscles, face_->expression_names, solved_controls_.blendshapes);
-        const VecX<> b = target.muscles.size() ? target.muscles : muscle_activations(face_->muscles, face_->expression_names, target.blendshapes);
-        c.muscles = ((1 - s) * a + s * b).cwiseMax(0.0).cwiseMin(1.0);  // round-off only: a, b are in [0, 1]
-      }
+      if (target.muscles.size() || solved_controls_.muscles.size())  // given on either side: interpolate the activations
+        c.muscles = ((1 - s) * activations_of(solved_controls_) + s * activations_of(target)).cwiseMax(0.0).cwiseMin(1.0);  // clamp: round-off only
       c.jaw = (1 - s) * solved_controls_.jaw + s * target.jaw;
       return c;
     };
@@ -359,10 +409,13 @@ class FaceSimulator {
     for (Index level = 1; level <= opt_.substep_levels; ++level) {
       const Index n = Index(1) << level;
       Points<> x = x_;
+      double jaw = solved_controls_.jaw;
       physics::NewtonReport r;
       bool ok = true;
       for (Index i = 1; i <= n && ok; ++i) {
         set_controls(i == n ? target : lerp(double(i) / double(n)));
+        x = carried_by_jaw(x, jaw, controls_.jaw);
+        jaw = controls_.jaw;
         try {
           r = solve(x);
           spent += r.iterations;
@@ -447,7 +500,9 @@ class FaceSimulator {
   Points<> bone_rest_;
   physics::DirichletBoundary<> boundary_;
   FaceControls controls_;
+  VecX<> jaw_field_;  ///< per vertex: 1 on the jaw bone, 0 on the cranium, harmonic between
   Points<> x_, previous_, start_;
+  double previous_jaw_ = 0;  ///< the jaw angle previous_ was solved under
   bool have_previous_ = false, x_is_solution_ = false;
   FaceControls solved_controls_;  ///< the controls x_ was solved under
 };
