@@ -138,25 +138,6 @@ TEST_CASE("face controls: columns by name (expressions, muscle:<name>, jaw in de
   CHECK(test::error_of([&] { scenario::read_controls(dir.path / "c.npz", "c"); }).find("twice") != std::string::npos);
 }
 
-namespace {
-
-/// A slow performance: the jaw open by `base` throughout (the lips never close again: closing
-/// them under the penalty contact is the slow part of an HR frame, open work of issue #11) and
-/// jaw, smile, pucker and brows rising by up to `peak` over F frames.
-scenario::Performance gentle_performance(Index F, double base, double peak) {
-  scenario::Performance p;
-  p.name = "gentle";
-  p.names = {"jawOpen", "mouthSmile_L", "mouthSmile_R", "mouthPucker", "browInnerUp_L", "browInnerUp_R"};
-  p.weights.resize(F, Index(p.names.size()));
-  for (Index f = 0; f < F; ++f) {
-    const double s = peak * double(f) / double(F - 1);
-    p.weights.row(f) << base + s, 0.8 * s, 0.8 * s, 0.5 * s, s, s;
-  }
-  return p;
-}
-
-}  // namespace
-
 TEST_CASE("face simulator (LR): a frame beyond the Newton iteration cap is reached by continuation, to the direct solve's answer") {
   SIMSR_REQUIRE_FACE_INPUTS();
   const auto& face = test::coarse_face();
@@ -234,6 +215,25 @@ TEST_CASE("face simulator (LR): the warm start carries the flesh with the jaw; t
 // too slow for the sanitizer builds, which run the LR simulator above, the model tests and the
 // physics suites instead.
 #if !defined(SIMSR_TEST_SANITIZED)
+namespace {
+
+/// A slow performance: the jaw open by `base` throughout (the lips never close again: closing
+/// them under the penalty contact is the slow part of an HR frame, open work of issue #11) and
+/// jaw, smile, pucker and brows rising by up to `peak` over F frames.
+scenario::Performance gentle_performance(Index F, double base, double peak) {
+  scenario::Performance p;
+  p.name = "gentle";
+  p.names = {"jawOpen", "mouthSmile_L", "mouthSmile_R", "mouthPucker", "browInnerUp_L", "browInnerUp_R"};
+  p.weights.resize(F, Index(p.names.size()));
+  for (Index f = 0; f < F; ++f) {
+    const double s = peak * double(f) / double(F - 1);
+    p.weights.row(f) << base + s, 0.8 * s, 0.8 * s, 0.5 * s, s, s;
+  }
+  return p;
+}
+
+}  // namespace
+
 TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips apart; a killed run resumes; another run's files are refused") {
   SIMSR_REQUIRE_FACE_INPUTS();
   const auto& face = test::coarse_face();
