@@ -179,6 +179,21 @@ if os.path.exists(bunny):
     hm = meshio.read(os.path.join(bdir, "heatmaps", "heatmaps_000000.vtu"))
     check(set(hm.point_data) == {"error_embedded", "error_ridge"} and len(hm.points) == 2503, "heatmap arrays")
 
+    # several --frames files are one set, a sequence each; --test-sequences holds whole ones out
+    z = np.load(os.path.join(DATA, "bunny", "train_frames.npz"))
+    for name, rows in (("first", slice(0, 160)), ("second", slice(160, 256))):
+        np.savez(os.path.join(WORK, name + ".npz"), lowres=z["lowres"][rows], highres=z["highres"][rows], frame=np.arange(rows.stop - rows.start))
+    base = ["baselines", "--lr-rest", bunny, "--hr-rest", os.path.join(DATA, "bunny", "hrestshape.obj"), "--frames",
+            os.path.join(WORK, "first.npz") + "," + os.path.join(WORK, "second.npz"), "--methods", "embedded,ridge", "--out-dir", bdir + "_seq"]
+    p = simsr(*base, "--test-sequences", "second")
+    res = json.loads(p.stdout) if p.returncode == 0 else {"methods": {}}
+    check(res.get("train_frames") == 160 and res.get("test_frames") == 96 and res.get("test_sequences") == ["second"], f"baselines by sequence: {p.stdout}")
+    check(set(res["methods"]) == {"embedded", "ridge"}, f"baselines by sequence: {res['methods']}")
+    bad_seq = subprocess.run([SIMSR, *base, "--test-sequences", "third"], capture_output=True, text=True)
+    check(bad_seq.returncode != 0 and "no sequence 'third'" in bad_seq.stderr, f"unknown sequence: {bad_seq.returncode} {bad_seq.stderr}")
+    both = subprocess.run([SIMSR, *base, "--test-sequences", "second", "--holdout-every", "4"], capture_output=True, text=True)
+    check(both.returncode != 0 and "excludes" in both.stderr, f"--test-sequences with --holdout-every: {both.returncode} {both.stderr}")
+
 # --- 6. Errors: message names the file, exit code by error class.
 bad = os.path.join(WORK, "bad.msh")
 with open(bad, "w") as f:

@@ -254,6 +254,28 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
   CHECK(frames_read.lowres.allFinite());
   CHECK(frames_read.highres.allFinite());
   CHECK((frames_read.hr(frames / 2) - face.surface.V).rowwise().norm().maxCoeff() > 1e-3);  // the face moved
+  // the discrepancy figures, by hand: the embedded LR surface point by point from the tet corners
+  {
+    const auto& e = face.surface_in_lr;
+    double dist = 0, hr_disp = 0, lr_disp = 0;
+    for (Index f = 0; f < frames; ++f)
+      for (Index i = 0; i < face.surface.num_vertices(); ++i) {
+        Vec3<> p = Vec3<>::Zero();
+        for (int k = 0; k < 4; ++k) p += e.weights(i, k) * frames_read.lr(f).row(face.lr.T(e.tet[i], k)).transpose();
+        const Vec3<> h = frames_read.hr(f).row(i).transpose(), r = face.surface.V.row(i).transpose();
+        dist += (p - h).norm();
+        hr_disp += (h - r).norm();
+        lr_disp += (p - r).norm();
+      }
+    const double n = double(frames * face.surface.num_vertices());
+    CHECK(stats[0].lr_hr_mean_distance == doctest::Approx(dist / n).epsilon(1e-9));
+    CHECK(stats[0].hr_mean_displacement == doctest::Approx(hr_disp / n).epsilon(1e-9));
+    CHECK(stats[0].lr_mean_displacement == doctest::Approx(lr_disp / n).epsilon(1e-9));
+    CHECK(stats[0].lr_hr_mean_distance > 0);
+    MESSAGE("coarse model, 4 frames: embedded LR to HR " << stats[0].lr_hr_mean_distance * 1e3 << " mm mean; skin displacement HR/LR "
+                                                         << stats[0].hr_mean_displacement / stats[0].lr_mean_displacement);
+  }
+
   // the lips in every HR frame, exactly (the whole HR mesh, as datagen checks it): the jaw stays
   // open by 0.2 here, so no upper and lower lip triangle may cross
   CHECK(stats[0].lip_intersecting_frames == 0);
@@ -282,7 +304,12 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
   // solver state carried across frames)
   CHECK(resumed_frames.lowres == frames_read.lowres);
   CHECK(resumed_frames.highres == frames_read.highres);
-  // a finished file of the same run is reused
-  CHECK(scenario::generate_face_data(exec::omp, face, perfs, resumed.path, opt)[0].reused);
+  // a finished file of the same run is reused, its figures measured again from the file
+  const auto reused = scenario::generate_face_data(exec::omp, face, perfs, resumed.path, opt);
+  CHECK(reused[0].reused);
+  CHECK(reused[0].lr_hr_mean_distance == stats[0].lr_hr_mean_distance);
+  const auto report = scenario::face_data_report(face, reused);
+  CHECK(report["performances"][0]["embedded_lr_to_hr_mean_distance_relative"].get<double>() ==
+        doctest::Approx(stats[0].lr_hr_mean_distance / report["surface_bbox_diagonal_m"].get<double>()));
 }
 #endif

@@ -5,6 +5,7 @@
 /// controls, sequences), train/test splits (every n-th frame, or whole sequences), and the
 /// network's neighbourhoods from the authors' files, simsr's own, or computed.
 
+#include "concatenate.hpp"
 #include "frame_set.hpp"
 #include "network_neighborhoods.hpp"
 #include "paired_frames.hpp"

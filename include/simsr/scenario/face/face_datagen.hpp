@@ -67,7 +67,32 @@ struct PerformanceStats {
   bool reused = false;                     ///< the finished file was there already
   Index lip_intersecting_frames = 0;       ///< HR frames whose upper and lower lip triangles intersect
   Index lip_max_pairs = 0;                 ///< the most intersecting triangle pairs in one frame
+  /// Fig. 4's discrepancy over all the performance's frames (resumed and reused ones included), m:
+  /// the mean distance between the embedded LR surface and the HR surface, and each one's mean
+  /// skin displacement from the rest surface (their ratio is the bulk agreement of SPEC §3).
+  double lr_hr_mean_distance = 0, hr_mean_displacement = 0, lr_mean_displacement = 0;
 };
+
+/// Fills the discrepancy figures of `st` from a performance's frames (LR mesh positions, HR
+/// surface positions), each averaged over every surface vertex of every frame.
+template <exec::HostPolicy P>
+void measure_discrepancy(P policy, const FaceModel& face, const data::PairedFrames<>& frames, PerformanceStats& st) {
+  const Index F = frames.num_frames(), M = face.surface.num_vertices();
+  if (frames.num_lr() != face.lr.num_vertices() || frames.num_hr() != M)
+    throw ShapeError("measure_discrepancy: frames (N, M)", {face.lr.num_vertices(), M}, {frames.num_lr(), frames.num_hr()});
+  double dist = 0, hr_disp = 0, lr_disp = 0;
+  for (Index f = 0; f < F; ++f) {
+    const Points<> lr = deform(policy, face.surface_in_lr, face.lr.T, frames.lr(f));
+    const auto hr = frames.hr(f);
+    dist += (lr - hr).rowwise().norm().sum();
+    hr_disp += (hr - face.surface.V).rowwise().norm().sum();
+    lr_disp += (lr - face.surface.V).rowwise().norm().sum();
+  }
+  const double n = double(F) * double(M);
+  st.lr_hr_mean_distance = dist / n;
+  st.hr_mean_displacement = hr_disp / n;
+  st.lr_mean_displacement = lr_disp / n;
+}
 
 /// The pairs (upper lip triangle, lower lip triangle) that intersect at HR positions X, exactly
 /// (a 2^-36 m grid, ±4 m).
@@ -214,6 +239,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       const auto z = io::read_npz(final_file);
       if (detail::fingerprint_of(z) == print) {
         st.reused = true;
+        measure_discrepancy(policy, face, data::read_paired_frames(final_file, N, M), st);
         stats.push_back(st);
         continue;
       }
@@ -291,6 +317,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
         io::write_npz(partial, z);
       }
     }
+    measure_discrepancy(policy, face, out, st);
     auto arrays = data::paired_frame_arrays(out);
     arrays["fingerprint"] = io::make_npy(std::vector<std::string>{print});
     arrays["control_names"] = io::make_npy(perf.names);
@@ -305,8 +332,10 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
   return stats;
 }
 
-/// The run's summary as JSON: mesh sizes, the split, muscles, and per performance the seconds per
-/// frame and Newton iterations per frame at each resolution (frames simulated in this run).
+/// The run's summary as JSON: mesh sizes, the split, muscles, and per performance the discrepancy
+/// (embedded LR surface to HR surface, absolute and relative to the rest surface's bounding-box
+/// diagonal; the HR/LR ratio of mean skin displacement), the seconds per frame and Newton
+/// iterations per frame at each resolution (frames simulated in this run).
 inline nlohmann::ordered_json face_data_report(const FaceModel& face, const std::vector<PerformanceStats>& stats) {
   nlohmann::ordered_json j;
   j["hr"] = {{"vertices", face.hr.num_vertices()}, {"tets", face.hr.num_tets()}, {"bone_vertices", face.hr_bone.size()}};
@@ -325,9 +354,16 @@ inline nlohmann::ordered_json face_data_report(const FaceModel& face, const std:
   nlohmann::ordered_json muscles = nlohmann::ordered_json::array();
   for (const auto& m : face.muscles) muscles.push_back(m.spec.name);
   j["muscles"] = muscles;
+  const double diagonal = (face.surface.V.colwise().maxCoeff() - face.surface.V.colwise().minCoeff()).norm();
+  j["surface_bbox_diagonal_m"] = diagonal;
   nlohmann::ordered_json perf = nlohmann::ordered_json::array();
   for (const auto& s : stats) {
     nlohmann::ordered_json p{{"name", s.name}, {"frames", s.frames}, {"reused", s.reused}, {"simulated", s.simulated}};
+    p["embedded_lr_to_hr_mean_distance_m"] = s.lr_hr_mean_distance;
+    p["embedded_lr_to_hr_mean_distance_relative"] = s.lr_hr_mean_distance / diagonal;
+    p["hr_mean_skin_displacement_m"] = s.hr_mean_displacement;
+    p["lr_mean_skin_displacement_m"] = s.lr_mean_displacement;
+    p["hr_lr_displacement_ratio"] = s.lr_mean_displacement > 0 ? s.hr_mean_displacement / s.lr_mean_displacement : 0.0;
     if (s.simulated > 0) {
       const double n = double(s.simulated);
       p["lr_seconds_per_frame"] = s.lr_seconds / n;
