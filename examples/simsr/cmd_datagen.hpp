@@ -3,7 +3,9 @@
 //  [--controls C.npz …] [--frames F] [--seed S] [--lr-cell H] [--preset default|paper-ratio|paper-lr]`:
 // the face of the core paper simulated at two resolutions from the same controls
 // (scenario/face/face_datagen.hpp). Progress (frames/s, ETA) on stderr, a JSON summary on
-// stdout and in DIR/face_data.json. A rerun resumes; a finished performance is reused.
+// stdout and in DIR/face_data.json. A rerun resumes; a finished performance is reused. Then the
+// LR-only unseen-force sequences of §5.3 in DIR/unseen/ (scenario/face/unseen_forces.hpp;
+// --no-unseen-forces skips them).
 #include <simsr/scenario/scenario.hpp>
 
 #include <CLI/CLI.hpp>
@@ -25,6 +27,8 @@ struct DatagenArgs {
   std::uint64_t seed = 1;
   double lr_cell = 0, skull_lattice = 0, hr_max_volume = 0;
   Index checkpoint_every = 10;
+  bool unseen_forces = true;
+  Index unseen_frames = 40;
 };
 
 /// The mesh options of a preset, then the explicit overrides.
@@ -74,6 +78,13 @@ inline int datagen(const DatagenArgs& a) {
   };
   const auto stats = scenario::generate_face_data(exec::omp, face, perfs, a.out, opt);
   auto j = scenario::face_data_report(face, stats);
+  if (a.unseen_forces) {
+    std::fprintf(stderr, "datagen: the unseen-force frames (LR only: a lip corner pulled, a sphere in the cheek)...\n");
+    scenario::UnseenForceOptions uo;
+    uo.frames = a.unseen_frames;
+    const auto us = scenario::generate_unseen_force_frames(exec::omp, face, a.out, uo);
+    j["unseen_forces"] = scenario::unseen_force_report(us);
+  }
   j["seconds"] = std::chrono::duration<double>(clock::now() - t0).count();
   io::write_file_atomic(std::filesystem::path(a.out) / "face_data.json", j.dump(2) + "\n");
   std::cout << j.dump() << '\n';
@@ -96,6 +107,8 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--lr-cell", a->lr_cell, "LR BCC cell size in cm (overrides the preset)")->check(CLI::PositiveNumber);
   cmd->add_option("--skull-lattice", a->skull_lattice, "skull surface resolution in cm (overrides the preset)")->check(CLI::PositiveNumber);
   cmd->add_option("--hr-max-volume", a->hr_max_volume, "largest HR tet in cm^3 (overrides the preset)")->check(CLI::PositiveNumber);
+  cmd->add_option("--unseen-frames", a->unseen_frames, "frames of each unseen-force sequence (DIR/unseen/)")->capture_default_str()->check(CLI::Range(2, 100000));
+  cmd->add_flag("!--no-unseen-forces", a->unseen_forces, "skip the LR-only unseen-force sequences (paper §5.3)");
   cmd->add_option("--checkpoint-every", a->checkpoint_every, "frames between checkpoints")->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->callback([&action, a] { action = [a] { return datagen(*a); }; });
 }

@@ -5,6 +5,7 @@
 #include "../support/error_of.hpp"
 #include "../support/require.hpp"
 
+#include <simsr/data/frame_set.hpp>
 #include <simsr/io/npz.hpp>
 #include <simsr/scenario/scenario.hpp>
 
@@ -209,6 +210,82 @@ TEST_CASE("face simulator (LR): the warm start carries the flesh with the jaw; t
   // the same equilibrium, to the solver tolerance
   const double scale = (a.positions() - face.lr.V).rowwise().norm().maxCoeff();
   CHECK((a.positions() - b.positions()).rowwise().norm().maxCoeff() < 1e-6 * scale);
+}
+
+TEST_CASE("face simulator (LR): frames at the default tolerances (most end after 0-2 Newton steps) are within 20 µm of tightly solved ones") {
+  SIMSR_REQUIRE_FACE_INPUTS();
+  const auto& face = test::coarse_face();
+  scenario::FaceSimulationOptions tight;
+  tight.newton.relative_tolerance = 1e-10;
+  tight.newton.absolute_tolerance = 1e-4;
+  tight.newton.max_iterations = 60;
+  tight.linear.tolerance = 1e-8;
+  scenario::FaceSimulator<> loose(exec::omp, face, scenario::FaceResolution::low), exact(exec::omp, face, scenario::FaceResolution::low, tight);
+  const auto perf = scenario::builtin_performance("amazement", face.expression_names, 1);
+  double worst = 0, motion = 0;
+  Index steps = 0;
+  for (const Index f : {Index(0), Index(20), Index(24), Index(28), Index(60), Index(64)}) {  // pairs of nearby frames: warm starts as in a run
+    const auto c = scenario::face_controls(perf, f, face);
+    loose.set_controls(c);
+    exact.set_controls(c);
+    steps += loose.step(exec::omp).iterations;
+    exact.step(exec::omp);
+    const Points<> a = loose.surface(exec::omp), b = exact.surface(exec::omp);
+    worst = std::max(worst, (a - b).rowwise().norm().maxCoeff());
+    motion = std::max(motion, (b - face.surface.V).rowwise().norm().maxCoeff());
+  }
+  MESSAGE("default vs tight tolerances over 6 amazement frames: surface at most " << worst * 1e6 << " µm apart (" << steps << " Newton steps; largest skin motion "
+                                                                                  << motion * 1e3 << " mm)");
+  CHECK(motion > 2e-3);
+  CHECK(worst < 2e-5);
+}
+
+TEST_CASE("unseen forces (LR, §5.3): the lip corner follows its spring, the sphere dents the cheek and no skin point sinks into it; reused when done") {
+  SIMSR_REQUIRE_FACE_INPUTS();
+  const auto& face = test::coarse_face();
+  ScratchDir dir("simsr_test_unseen");
+  scenario::UnseenForceOptions opt;
+  opt.frames = 6;
+  const auto stats = scenario::generate_unseen_force_frames(exec::omp, face, dir.path, opt);
+  REQUIRE(stats.size() == 2);
+  const Index N = face.lr.num_vertices(), F = opt.frames;
+  for (const auto& s : stats) {
+    CHECK_FALSE(s.reused);
+    const auto file = dir.path / "unseen" / (s.name + ".npz");
+    const auto z = io::read_npz(file);
+    const auto lo = data::read_frame_set(file, "lowres", N);  // what simsr infer reads
+    REQUIRE(lo.num_frames() == F);
+    const Points<> first = Eigen::Map<const Points<>>(lo.positions.row(0).data(), N, 3), last = Eigen::Map<const Points<>>(lo.positions.row(F - 1).data(), N, 3);
+    const Points<> skin_first = deform(exec::omp, face.surface_in_lr, face.lr.T, first), skin_last = deform(exec::omp, face.surface_in_lr, face.lr.T, last);
+    if (s.name == "lip_corner_pull") {
+      const Index c = z.at("spring_point").item<std::int64_t>();
+      const Points<> targets = z.at("spring_target").to_points<double>();
+      const Vec3<> pull = targets.row(F - 1) - targets.row(0), moved = skin_last.row(c) - skin_first.row(c);
+      MESSAGE("lip corner: target moved " << pull.norm() * 1e3 << " mm, the corner " << moved.norm() * 1e3 << " mm (" << moved.dot(pull.normalized()) * 1e3
+                                          << " mm along the pull)");
+      CHECK(pull.norm() == doctest::Approx(opt.pull_distance));
+      CHECK(moved.dot(pull.normalized()) > 0.2 * opt.pull_distance);  // follows the spring
+      CHECK(moved.dot(pull.normalized()) < opt.pull_distance);         // held back by the flesh
+    } else {
+      REQUIRE(s.name == "cheek_sphere");
+      const Points<> centres = z.at("sphere_centre").to_points<double>();
+      const double r = z.at("sphere_radius").item<double>();
+      const VecX<> d = (skin_last.rowwise() - centres.row(F - 1)).rowwise().norm().array() - r;
+      const Vec3<> push = (centres.row(F - 1) - centres.row(0)).transpose();
+      Index deepest = 0;
+      d.minCoeff(&deepest);
+      const double dent = (skin_last.row(deepest) - skin_first.row(deepest)).dot(push.normalized());  // inward
+      MESSAGE("cheek: " << s.max_active_points << " skin points in contact, deepest " << -d.minCoeff() * 1e3 << " mm inside, dented " << dent * 1e3 << " mm");
+      CHECK(s.max_active_points > 0);
+      CHECK(d.minCoeff() > -1e-3);  // the penalty keeps every skin point within 1 mm of the sphere's surface
+      CHECK(dent > 0.5 * opt.sphere_depth);
+    }
+  }
+  CHECK(scenario::generate_unseen_force_frames(exec::omp, face, dir.path, opt)[0].reused);
+  opt.pull_distance *= 2;
+  CHECK_FALSE(scenario::generate_unseen_force_frames(exec::omp, face, dir.path, opt)[0].reused);  // other options: simulated again
+  opt.frames = 1;
+  CHECK_THROWS_AS(scenario::generate_unseen_force_frames(exec::omp, face, dir.path, opt), ArgumentError);
 }
 
 // The HR face mesh's size is set by the kit's 8.8k-vertex skin (~10^5 tets even when coarse):

@@ -13,3 +13,4 @@
 #include "face/muscles.hpp"
 #include "face/performances.hpp"
 #include "face/skull.hpp"
+#include "face/unseen_forces.hpp"

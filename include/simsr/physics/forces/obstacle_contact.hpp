@@ -28,6 +28,20 @@
 
 namespace simsr::physics {
 
+namespace detail {
+/// The symmetric part of A with its negative eigenvalues clamped to 0 (kept exactly when PSD up
+/// to rounding): the contact blocks' definiteness fix.
+template <class S>
+Mat3<S> project_psd3(const Mat3<S>& A) {
+  const Mat3<S> sym = (A + A.transpose()) / S(2);
+  Eigen::SelfAdjointEigenSolver<Mat3<S>> es;
+  es.computeDirect(sym);
+  const S tol = S(64) * Eigen::NumTraits<S>::epsilon() * es.eigenvalues().cwiseAbs().maxCoeff();
+  if (es.eigenvalues().minCoeff() >= -tol) return sym;  // PSD up to rounding: keep the exact block
+  return es.eigenvectors() * es.eigenvalues().cwiseMax(S(0)).asDiagonal() * es.eigenvectors().transpose();
+}
+}  // namespace detail
+
 /// A rigid obstacle: signed distance d(x) (m, negative inside), its gradient ∇d (unit outward
 /// normal where d is smooth) and its Hessian ∇²d (1/m), all total functions of x ∈ ℝ³.
 template <class O, class S = typename O::scalar_type>
@@ -172,20 +186,12 @@ class ObstacleContact {
       const S d = o_.distance(p);
       if (!(d < S(0))) continue;
       const Vec3<S> n = o_.distance_gradient(p);
-      H.add(v_[i], v_[i], k_[i] * project_psd(Mat3<S>(n * n.transpose() + d * o_.distance_hessian(p))));
+      H.add(v_[i], v_[i], k_[i] * detail::project_psd3(Mat3<S>(n * n.transpose() + d * o_.distance_hessian(p))));
     }
   }
 
  private:
   Vec3<S> pos(const Points<S>& x, Index i) const { return x.row(v_[i]).transpose(); }
-  static Mat3<S> project_psd(const Mat3<S>& A) {
-    const Mat3<S> sym = (A + A.transpose()) / S(2);
-    Eigen::SelfAdjointEigenSolver<Mat3<S>> es;
-    es.computeDirect(sym);
-    const S tol = S(64) * Eigen::NumTraits<S>::epsilon() * es.eigenvalues().cwiseAbs().maxCoeff();
-    if (es.eigenvalues().minCoeff() >= -tol) return sym;  // PSD up to rounding: keep the exact block
-    return es.eigenvectors() * es.eigenvalues().cwiseMax(S(0)).asDiagonal() * es.eigenvectors().transpose();
-  }
 
   O o_;
   IndexVector v_;
