@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages simsr needs for a given job, only those missing.
 #   scripts/deps.sh run    build + run the main job
-#   scripts/deps.sh test   + test peers (meshio, scipy, torch, gmsh, tetgen) and what scripts/test.sh's
+#   scripts/deps.sh test   + test peers (meshio, scipy, torch, gmsh, tetgen; python3-vtk9 with xvfb for
+#                          scripts/render_face.py) and what scripts/test.sh's
 #                          clang builds need: clang, libclang-rt-dev (ASan, UBSan, TSan, libFuzzer),
 #                          libomp-dev (LLVM's OpenMP and its Archer tool, libarcher.so, for TSan) and
 #                          llvm (llvm-symbolizer: sanitizer reports with file and line)
@@ -14,7 +15,8 @@ pkgs=(build-essential cmake ninja-build
       doctest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
       python3 python3-numpy)
 if [[ $job == test ]]; then
-  pkgs+=(python3-meshio python3-scipy python3-torch gmsh tetgen clang libclang-rt-dev libomp-dev llvm)
+  pkgs+=(python3-meshio python3-scipy python3-torch gmsh tetgen clang libclang-rt-dev libomp-dev llvm
+        python3-vtk9 xvfb xauth)
 fi
 
 missing=()

@@ -28,6 +28,7 @@ struct DatagenArgs {
   double lr_cell = 0, skull_lattice = 0, hr_max_volume = 0;
   Index checkpoint_every = 10;
   bool unseen_forces = true;
+  Index vtk_every = 10;
   Index unseen_frames = 40;
 };
 
@@ -78,6 +79,12 @@ inline int datagen(const DatagenArgs& a) {
   };
   const auto stats = scenario::generate_face_data(exec::omp, face, perfs, a.out, opt);
   auto j = scenario::face_data_report(face, stats);
+  if (a.vtk_every > 0) {
+    std::vector<std::string> names;
+    for (const auto& p : perfs) names.push_back(p.name);
+    std::fprintf(stderr, "datagen: VTU series (every %lld frames) in %s\n", (long long)a.vtk_every, (std::filesystem::path(a.out) / "vtk").string().c_str());
+    scenario::write_face_data_views(exec::omp, face, a.out, names, a.vtk_every);
+  }
   if (a.unseen_forces) {
     std::fprintf(stderr, "datagen: the unseen-force frames (LR only: a lip corner pulled, a sphere in the cheek)...\n");
     scenario::UnseenForceOptions uo;
@@ -108,6 +115,9 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--skull-lattice", a->skull_lattice, "skull surface resolution in cm (overrides the preset)")->check(CLI::PositiveNumber);
   cmd->add_option("--hr-max-volume", a->hr_max_volume, "largest HR tet in cm^3 (overrides the preset)")->check(CLI::PositiveNumber);
   cmd->add_option("--unseen-frames", a->unseen_frames, "frames of each unseen-force sequence (DIR/unseen/)")->capture_default_str()->check(CLI::Range(2, 100000));
+  cmd->add_option("--vtk-every", a->vtk_every, "write VTU series of every n-th frame to DIR/vtk/<performance>/ for ParaView (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
   cmd->add_flag("!--no-unseen-forces", a->unseen_forces, "skip the LR-only unseen-force sequences (paper §5.3)");
   cmd->add_option("--checkpoint-every", a->checkpoint_every, "frames between checkpoints")->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->callback([&action, a] { action = [a] { return datagen(*a); }; });

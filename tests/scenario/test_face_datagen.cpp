@@ -353,16 +353,38 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
                                                          << stats[0].hr_mean_displacement / stats[0].lr_mean_displacement);
   }
 
+  // the VTU series for ParaView: every 2nd frame, three collections that list their files
+  {
+    CHECK(scenario::write_face_vtu_series(exec::omp, face, frames_read, "gentle", whole.path / "vtk", 2) == 2);
+    for (const char* series : {"lr_mesh", "lr_skin", "hr_skin"}) {
+      const auto pvd = whole.path / "vtk" / "gentle" / (std::string(series) + ".pvd");
+      REQUIRE(std::filesystem::exists(pvd));
+      std::ifstream in(pvd);
+      const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+      Index listed = 0;
+      for (std::size_t at = text.find("<DataSet"); at != std::string::npos; at = text.find("<DataSet", at + 1)) ++listed;
+      CHECK(listed == 2);
+      for (const char* frame : {"_000000.vtu", "_000001.vtu"})
+        CHECK(std::filesystem::file_size(whole.path / "vtk" / "gentle" / series / (std::string(series) + frame)) > 1000);
+    }
+    CHECK_THROWS_AS(scenario::write_face_vtu_series(exec::omp, face, frames_read, "gentle", whole.path / "vtk", 0), ArgumentError);
+  }
+
   // the lips in every HR frame, exactly (the whole HR mesh, as datagen checks it): the jaw stays
   // open by 0.2 here, so no upper and lower lip triangle may cross
   CHECK(stats[0].lip_intersecting_frames == 0);
   CHECK(stats[0].lip_max_pairs == 0);
 
-  // killed after frame 2 (a checkpoint at 2), refused under other options, then resumed
+  // killed twice, checkpointing every frame: at frame 1 (resumed from frame 0's checkpoint, the
+  // neutral as the frame before it), then at frame 3 (resumed from frame 2's, with frame 1
+  // before it); refused under other options in between
   std::filesystem::create_directories(resumed.path / ".state");
   std::filesystem::copy_file(whole.path / ".state" / "neutral.npz", resumed.path / ".state" / "neutral.npz");  // read, not solved again
+  opt.checkpoint_every = 1;  // not part of the fingerprint: it changes no frame
+  Index kill_at = 1, simulated = 0;
   opt.on_frame = [&](const std::string&, Index f, Index, const physics::NewtonReport&, const physics::NewtonReport&, double, double) {
-    if (f == 2) throw std::runtime_error("killed");
+    ++simulated;
+    if (f == kill_at) throw std::runtime_error("killed");
   };
   CHECK_THROWS_AS(scenario::generate_face_data(exec::omp, face, perfs, resumed.path, opt), std::runtime_error);
   CHECK(std::filesystem::exists(resumed.path / ".state" / "gentle.npz"));
@@ -370,15 +392,16 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
   scenario::FaceDatagenOptions other = opt;
   other.simulation.track_stiffness *= 2;
   CHECK(test::error_of([&] { scenario::generate_face_data(exec::omp, face, perfs, resumed.path, other); }).find("another run") != std::string::npos);
-  opt.on_frame = nullptr;
+  kill_at = 3;
+  CHECK_THROWS_AS(scenario::generate_face_data(exec::omp, face, perfs, resumed.path, opt), std::runtime_error);
+  kill_at = -1;
   const auto again = scenario::generate_face_data(exec::omp, face, perfs, resumed.path, opt);
-  CHECK(again[0].simulated == frames - 2);
+  CHECK(again[0].simulated == 1);
+  CHECK(simulated == frames + 2);  // frames 1 and 3 twice (each lost to its kill), no other frame again
   CHECK_FALSE(std::filesystem::exists(resumed.path / ".state" / "gentle.npz"));
   const auto resumed_frames = data::read_paired_frames(resumed.path / "gentle.npz");
-  CHECK(resumed_frames.lowres.topRows(2) == frames_read.lowres.topRows(2));  // the frames before the kill, kept as written
-  CHECK(resumed_frames.highres.topRows(2) == frames_read.highres.topRows(2));
-  // the resumed frames: bitwise the uninterrupted run's (the warm start restored exactly, no
-  // solver state carried across frames)
+  // every frame bitwise the uninterrupted run's (the warm start restored exactly, no solver state
+  // carried across frames)
   CHECK(resumed_frames.lowres == frames_read.lowres);
   CHECK(resumed_frames.highres == frames_read.highres);
   // a finished file of the same run is reused, its figures measured again from the file

@@ -14,7 +14,7 @@
 /// byte-count header encoded separately from the data (the layout VTK's own writer uses); it keeps
 /// the file self-contained and valid XML, at 4/3 the raw size. ASCII mode prints values with
 /// max_digits10 digits, so it round-trips exactly too. Points are Float64 or Float32 (the scalar type
-/// given), connectivity and offsets Int64, cell types UInt8 (VTK_TETRA 10, VTK_TRIANGLE 5).
+/// given), connectivity and offsets Int32 (Int64 past 2^31 points or indices), cell types UInt8 (VTK_TETRA 10, VTK_TRIANGLE 5).
 
 #include <array>
 #include <bit>
@@ -268,8 +268,15 @@ class VtuGrid {
       offsets[c] = o;
       types[c] = tet ? vtk_tetra : vtk_triangle;
     }
-    detail::vtu_data_array(out, "connectivity", 1, conn, fmt);
-    detail::vtu_data_array(out, "offsets", 1, offsets, fmt);
+    // Int32 cells where every index and offset fits (half the bytes: connectivity dominates a
+    // surface series' files), Int64 otherwise
+    if (num_points_ <= std::numeric_limits<std::int32_t>::max() && o <= std::numeric_limits<std::int32_t>::max()) {
+      detail::vtu_data_array(out, "connectivity", 1, std::vector<std::int32_t>(conn.begin(), conn.end()), fmt);
+      detail::vtu_data_array(out, "offsets", 1, std::vector<std::int32_t>(offsets.begin(), offsets.end()), fmt);
+    } else {
+      detail::vtu_data_array(out, "connectivity", 1, conn, fmt);
+      detail::vtu_data_array(out, "offsets", 1, offsets, fmt);
+    }
     detail::vtu_data_array(out, "types", 1, types, fmt);
     out << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
     return out.str();

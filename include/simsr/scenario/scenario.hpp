@@ -9,6 +9,7 @@
 #include "face/face_datagen.hpp"
 #include "face/face_model.hpp"
 #include "face/face_simulator.hpp"
+#include "face/face_views.hpp"
 #include "face/jaw_weights.hpp"
 #include "face/muscles.hpp"
 #include "face/performances.hpp"
