@@ -79,6 +79,10 @@ inline int datagen(const DatagenArgs& a) {
   };
   const auto stats = scenario::generate_face_data(exec::omp, face, perfs, a.out, opt);
   auto j = scenario::face_data_report(face, stats);
+  for (const auto& s : stats)
+    if (s.lip_intersecting_frames)
+      std::fprintf(stderr, "datagen: warning: %s: the HR lips intersect in %lld frames (at most %lld triangle pairs): its controls press them harder than the contact holds\n",
+                   s.name.c_str(), (long long)s.lip_intersecting_frames, (long long)s.lip_max_pairs);
   if (a.vtk_every > 0) {
     std::vector<std::string> names;
     for (const auto& p : perfs) names.push_back(p.name);

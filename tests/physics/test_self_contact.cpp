@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "../support/error_of.hpp"
 #include "forces_checks.hpp"
 
 using namespace simsr;
@@ -207,6 +208,52 @@ TEST_CASE("SelfContact: gradient matches finite differences, Gauss–Newton Hess
   CHECK(min_eig > -1e-12);
 }
 
+TEST_CASE("SelfContact: one thickness per vertex: each vertex's pairs by its own d̂ (brute force), FD gradient, PSD Hessian") {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> thick(0.005, 0.06);
+  double worst_g = 0, min_eig = 0;
+  Index active = 0, only_by_own = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    Sheets m = two_sheets(5, 0.1, 0.03);
+    m.x += test::random_points(m.x.rows(), -0.02, 0.02, rng);
+    const IndexVector& v = m.top_vertices;
+    VecX<> dhat(v.size());
+    for (Index i = 0; i < v.size(); ++i) dhat[i] = thick(rng);
+    const SelfContact<> c(v, m.bottom, m.x.rows(), 50.0, dhat);
+    CHECK(c.thickness() == dhat.maxCoeff());
+    // brute force, vertex by vertex with its own d̂
+    std::set<std::pair<VIndex, Index>> brute;
+    for (Index i = 0; i < v.size(); ++i) {
+      const IndexVector one = IndexVector::Constant(1, v[i]);
+      for (const auto& p : brute_pairs(m.x, one, m.bottom, dhat[i], true)) brute.insert(p);
+      only_by_own += Index(brute_pairs(m.x, one, m.bottom, dhat.maxCoeff(), true).size()) - Index(brute_pairs(m.x, one, m.bottom, dhat[i], true).size());
+    }
+    CHECK(hashed_pairs(c, m.x) == brute);
+    for (const auto& p : c.pairs(m.x)) {
+      const Index i = Index(std::find(v.data(), v.data() + v.size(), p.vertex) - v.data());
+      CHECK(p.thickness == dhat[i]);
+      CHECK(p.distance < dhat[i]);
+    }
+    active += Index(brute.size());
+    worst_g = std::max(worst_g, test::rel_error(test::gradient(c, m.x), test::fd_gradient(c, m.x, 1e-7)));
+    const Eigen::MatrixXd H = test::assembled_hessian(c, m.x);
+    min_eig = std::min(min_eig, test::min_eigenvalue(H) / std::max(1.0, H.cwiseAbs().maxCoeff()));
+  }
+  MESSAGE("per-vertex thickness: " << active << " active pairs, " << only_by_own << " more with the largest d̂ for all; worst gradient error " << worst_g
+                                   << ", min eigenvalue " << min_eig);
+  CHECK(active > 50);
+  CHECK(only_by_own > 20);  // the per-vertex thicknesses decide
+  CHECK(worst_g < 1e-6);
+  CHECK(min_eig > -1e-12);
+  // equal thicknesses are the uniform contact, to the bit
+  Sheets m = two_sheets(4, 0.1, 0.02);
+  m.x += test::random_points(m.x.rows(), -0.01, 0.01, rng);
+  const SelfContact<> uniform(m.top_vertices, m.bottom, m.x.rows(), 50.0, 0.04), each(m.top_vertices, m.bottom, m.x.rows(), 50.0, VecX<>::Constant(m.top_vertices.size(), 0.04));
+  CHECK(uniform.energy(exec::seq, m.x) > 0);
+  CHECK(uniform.energy(exec::seq, m.x) == each.energy(exec::seq, m.x));
+  CHECK(test::gradient(uniform, m.x) == test::gradient(each, m.x));
+}
+
 TEST_CASE("SelfContact: bad input throws typed errors") {
   Tris F(1, 3);
   F << 0, 1, 2;
@@ -218,6 +265,10 @@ TEST_CASE("SelfContact: bad input throws typed errors") {
   CHECK_THROWS_AS(SelfContact<>(v, F, 4, -1.0, 0.1), ArgumentError);
   CHECK_THROWS_AS(SelfContact<>(v, F, 4, 1.0, 0.0), ArgumentError);
   CHECK_THROWS_AS(SelfContact<>(v, F, 4, 1.0, std::nan("")), ArgumentError);
+  CHECK_THROWS_AS(SelfContact<>(v, F, 4, 1.0, VecX<>::Constant(2, 0.1)), ShapeError);  // 2 thicknesses, 1 vertex
+  CHECK_THROWS_AS(SelfContact<>(v, F, 4, 1.0, VecX<>::Constant(1, 0.0)), ArgumentError);
+  CHECK_THROWS_AS(SelfContact<>(v, F, 4, 1.0, VecX<>::Constant(1, std::nan(""))), ArgumentError);
+  CHECK(test::error_of([&] { SelfContact<>(v, F, 4, 1.0, VecX<>::Constant(1, -1.0)); }).find("vertex 3") != std::string::npos);
   SelfContactOptions opt;
   opt.cell_size = -1;
   CHECK_THROWS_AS(SelfContact<>(v, F, 4, 1.0, 0.1, opt), ArgumentError);

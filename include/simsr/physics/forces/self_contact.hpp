@@ -5,7 +5,12 @@
 /// vertices and a set of surface triangles. For each pair (p, t) closer than the contact
 /// thickness d̂, with d the unsigned point–triangle distance:
 ///
-///     E(x) = Σ_{(p,t): d < d̂} k/2 (d̂ − d)²                   (J; k in N/m, d̂ in m)
+///     E(x) = Σ_{(p,t): d < d̂_p} k/2 (d̂_p − d)²               (J; k in N/m, d̂ in m)
+///
+/// d̂_p is one thickness for every vertex, or one per vertex: surfaces that nearly touch at rest
+/// (the corners of the mouth) take d̂_p below each vertex's rest distance, so contact is off at
+/// rest and still stops the surfaces crossing there, where a uniform d̂ would press them apart
+/// from the start and leaving those vertices out lets them pass through.
 ///
 ///     physics::SelfContact<> lips(lip_vertices, lip_triangles, V.rows(), 1e3, 1e-3);
 ///     for (const auto& c : lips.pairs(x)) ...                // active pairs, for inspection
@@ -62,6 +67,7 @@ struct SelfContactPair {
   Index triangle;
   S distance;
   Vec3<S> barycentric;
+  S thickness;  ///< the vertex's d̂
 };
 
 /// Exact closest point of triangle (a, b, c) to p: barycentric weights (≥ 0, sum 1; all 7 regions).
@@ -79,11 +85,19 @@ class SelfContact {
   /// vertices (#P, indices into x), triangles (#F×3, indices into x), k (N/m, finite, ≥ 0),
   /// thickness d̂ (m, finite, > 0). ArgumentError for an index out of range, a bad k, d̂ or cell size.
   SelfContact(const IndexVector& vertices, const Tris& triangles, Index num_vertices, S stiffness, S thickness, SelfContactOptions options = {})
-      : v_(vertices), F_(triangles), n_(num_vertices), k_(stiffness), dhat_(thickness), opt_(options) {
+      : SelfContact(vertices, triangles, num_vertices, stiffness, VecX<S>::Constant(vertices.size(), thickness), options) {}
+
+  /// As above with one thickness per vertex (thicknesses[i] is vertices[i]'s d̂, each finite and
+  /// > 0); ShapeError when the counts differ.
+  SelfContact(const IndexVector& vertices, const Tris& triangles, Index num_vertices, S stiffness, const VecX<S>& thicknesses,
+              SelfContactOptions options = {})
+      : v_(vertices), F_(triangles), n_(num_vertices), k_(stiffness), dhat_v_(thicknesses), opt_(options) {
     detail::require_vertex_indices("SelfContact: vertices", v_, n_);
     detail::require_vertex_indices("SelfContact: triangles", F_, n_);
     detail::require_nonnegative("SelfContact: stiffness", k_);
-    detail::require_positive("SelfContact: thickness", dhat_);
+    if (dhat_v_.size() != v_.size()) throw ShapeError("SelfContact: thicknesses", {v_.size(), 1}, {dhat_v_.size(), 1});
+    for (Index i = 0; i < dhat_v_.size(); ++i) detail::require_positive("SelfContact: thickness of vertex " + std::to_string(v_[i]), dhat_v_[i]);
+    dhat_ = dhat_v_.size() ? dhat_v_.maxCoeff() : S(1);
     detail::require_nonnegative("SelfContact: cell size", opt_.cell_size);
     if (opt_.exclude_adjacent) build_adjacency();
   }
@@ -92,10 +106,13 @@ class SelfContact {
   const Tris& triangles() const { return F_; }
   Index num_vertices() const { return n_; }
   S stiffness() const { return k_; }
+  /// The largest d̂ (the only one when it is uniform).
   S thickness() const { return dhat_; }
+  /// Each vertex's d̂, in the order of vertices().
+  const VecX<S>& thicknesses() const { return dhat_v_; }
   const SelfContactOptions& options() const { return opt_; }
 
-  /// The active pairs (d < d̂) at x, grouped by vertex in the order of vertices().
+  /// The active pairs (d < the vertex's d̂) at x, grouped by vertex in the order of vertices().
   std::vector<SelfContactPair<S>> pairs(const Points<S>& x) const {
     detail::require_positions("SelfContact: x", x, n_);
     std::vector<SelfContactPair<S>> out;
@@ -107,7 +124,7 @@ class SelfContact {
   S energy(P, const Points<S>& x) const {
     detail::require_positions("SelfContact: x", x, n_);
     S e = S(0);
-    for_each_pair(x, [&](const SelfContactPair<S>& c, const Vec3<S>&) { e += k_ / S(2) * (dhat_ - c.distance) * (dhat_ - c.distance); });
+    for_each_pair(x, [&](const SelfContactPair<S>& c, const Vec3<S>&) { e += k_ / S(2) * (c.thickness - c.distance) * (c.thickness - c.distance); });
     return e;
   }
 
@@ -116,7 +133,7 @@ class SelfContact {
     detail::require_positions("SelfContact: x", x, n_);
     detail::require_positions("SelfContact: gradient", g, n_);
     for_each_pair(x, [&](const SelfContactPair<S>& c, const Vec3<S>& n) {
-      const Vec3<S> f = k_ * (dhat_ - c.distance) * n;  // −∂E/∂d · n
+      const Vec3<S> f = k_ * (c.thickness - c.distance) * n;  // −∂E/∂d · n
       g.row(c.vertex) -= f.transpose();
       for (int i = 0; i < 3; ++i) g.row(F_(c.triangle, i)) += c.barycentric[i] * f.transpose();
     });
@@ -162,20 +179,20 @@ class SelfContact {
       const std::size_t b = bucket(c, nb);
       for (Index e = start_[b]; e < start_[b + 1]; ++e) {
         const Entry& en = sorted_[std::size_t(e)];
-        if (en.cell == c) visit(x, v, p, en.tri, f);
+        if (en.cell == c) visit(x, v, p, dhat_v_[i], en.tri, f);
       }
-      for (VIndex t : oversized_) visit(x, v, p, t, f);
+      for (VIndex t : oversized_) visit(x, v, p, dhat_v_[i], t, f);
     }
   }
 
   template <class F>
-  void visit(const Points<S>& x, VIndex v, const Vec3<S>& p, VIndex t, F& f) const {
+  void visit(const Points<S>& x, VIndex v, const Vec3<S>& p, S dhat, VIndex t, F& f) const {
     if (excluded(v, t)) return;
     const Vec3<S> a = x.row(F_(t, 0)).transpose(), b = x.row(F_(t, 1)).transpose(), c = x.row(F_(t, 2)).transpose();
     const Vec3<S> beta = closest_point_barycentric(p, a, b, c);
     const Vec3<S> r = p - (beta[0] * a + beta[1] * b + beta[2] * c);
     const S d = r.norm();
-    if (!(d < dhat_)) return;
+    if (!(d < dhat)) return;
     Vec3<S> n;
     if (d > S(0)) {
       n = r / d;
@@ -183,7 +200,7 @@ class SelfContact {
       const Vec3<S> m = (b - a).cross(c - a);
       n = m.norm() > S(0) ? Vec3<S>(m.normalized()) : Vec3<S>::Zero();
     }
-    f(SelfContactPair<S>{v, Index(t), d, beta}, n);
+    f(SelfContactPair<S>{v, Index(t), d, beta, dhat}, n);
   }
 
   bool excluded(VIndex v, VIndex t) const {
@@ -279,7 +296,9 @@ class SelfContact {
   IndexVector v_;
   Tris F_;
   Index n_;
-  S k_, dhat_;
+  S k_;
+  VecX<S> dhat_v_;
+  S dhat_ = S(1);  ///< the largest d̂: the hash cells and the triangles' inflation
   SelfContactOptions opt_;
   std::vector<Index> nbr_start_;
   std::vector<VIndex> nbr_;

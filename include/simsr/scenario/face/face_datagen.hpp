@@ -21,10 +21,14 @@
 /// controls) is refused by fingerprint, never continued. A Newton failure or an inverted tet after a solve is an
 /// Error naming the performance, the frame, the resolution and the residual: nothing is written
 /// for that frame. Every HR frame's lips are checked by an exact triangle–triangle test
-/// (mesh/triangle_intersection.hpp) and counted in the stats and face_data.json (not yet an
-/// error: the kit's own neutral has its lips crossing near the corners, see face_simulator.hpp).
+/// (mesh/triangle_intersection.hpp) and counted in the stats and face_data.json: none in the
+/// built-in performances (the contact holds the lips apart where the kit's own neutral has them
+/// crossing, see face_simulator.hpp); a count, not an error, so that a user's performance that
+/// presses the lips harder than the penalty holds is still written and reported.
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -65,7 +69,7 @@ struct PerformanceStats {
   Index lr_iterations = 0, hr_iterations = 0;
   Index simulated = 0;                     ///< frames simulated in this run (the rest were resumed or reused)
   bool reused = false;                     ///< the finished file was there already
-  Index lip_intersecting_frames = 0;       ///< HR frames whose upper and lower lip triangles intersect
+  Index lip_intersecting_frames = 0;       ///< HR frames whose upper and lower lip triangles intersect (all frames: the files keep the counts)
   Index lip_max_pairs = 0;                 ///< the most intersecting triangle pairs in one frame
   /// Fig. 4's discrepancy over all the performance's frames (resumed and reused ones included), m:
   /// the mean distance between the embedded LR surface and the HR surface, and each one's mean
@@ -112,7 +116,7 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
     for (const auto& d : m.spec.drivers) f.add_bytes(d.expression.data(), d.expression.size()).add(d.gain);
   }
   f.add(o.inversion_threshold).add(o.mu10).add(o.mu01).add(o.kappa).add(o.muscle_max_stress).add(o.track_stiffness).add(o.contact_stiffness).add(o.contact_thickness);
-  f.add(o.contact_exclusion).add(o.newton.relative_tolerance).add(o.newton.absolute_tolerance).add(o.newton.max_iterations).add(o.linear.tolerance).add(std::int64_t(o.extrapolate));
+  f.add(o.contact_rest_fraction).add(o.newton.relative_tolerance).add(o.newton.absolute_tolerance).add(o.newton.max_iterations).add(o.linear.tolerance).add(std::int64_t(o.extrapolate));
   f.add(o.substep_levels).add(std::int64_t(o.carry_with_jaw));
   if (p) {
     f.add(p->weights);
@@ -132,6 +136,25 @@ inline Points<> points_of(const io::NpzArrays& z, const std::string& name, Index
   if (a.ndim() != 2 || a.shape[0] != rows || a.shape[1] != 3)
     throw ShapeError(file + ": " + name, {rows, 3}, {a.ndim() > 0 ? Index(a.shape[0]) : 0, a.ndim() > 1 ? Index(a.shape[1]) : 0});
   return a.to_points<double>();
+}
+
+/// A file's per-frame counts of intersecting HR lip triangle pairs (`hr_lip_pairs`, `frames` of
+/// them, each ≥ 0); ArgumentError naming the file otherwise.
+inline std::vector<std::int64_t> lip_pairs_of(const io::NpzArrays& z, Index frames, const std::string& file) {
+  if (!z.contains("hr_lip_pairs")) throw ArgumentError(file + ": no 'hr_lip_pairs' array");
+  const io::NpyArray& a = z.at("hr_lip_pairs");
+  const auto v = a.to_vector<std::int64_t>();
+  if (a.ndim() != 1 || Index(v.size()) != frames)
+    throw ArgumentError(file + ": 'hr_lip_pairs' has " + std::to_string(v.size()) + " entries, not one per frame (" + std::to_string(frames) + ")");
+  for (std::size_t f = 0; f < v.size(); ++f)
+    if (v[f] < 0) throw ArgumentError(file + ": 'hr_lip_pairs' is negative at frame " + std::to_string(f));
+  return v;
+}
+
+/// The stats' lip figures from per-frame counts.
+inline void count_lip_frames(const std::vector<std::int64_t>& pairs, PerformanceStats& st) {
+  st.lip_intersecting_frames = Index(std::count_if(pairs.begin(), pairs.end(), [](std::int64_t n) { return n > 0; }));
+  st.lip_max_pairs = pairs.empty() ? 0 : Index(*std::max_element(pairs.begin(), pairs.end()));
 }
 
 /// One resolution's Newton solve with the failure made specific.
@@ -239,6 +262,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       const auto z = io::read_npz(final_file);
       if (detail::fingerprint_of(z) == print) {
         st.reused = true;
+        detail::count_lip_frames(detail::lip_pairs_of(z, F, final_file.string()), st);
         measure_discrepancy(policy, face, data::read_paired_frames(final_file, N, M), st);
         stats.push_back(st);
         continue;
@@ -253,6 +277,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     out.sequence.assign(std::size_t(F), 0);
     out.sequence_names = {perf.name};
     Index start = 0;
+    std::vector<std::int64_t> lip_pairs(std::size_t(F), 0);  // per frame: intersecting lip triangle pairs at HR
     // positions are taken as solved under the controls set before them (continuation walks from
     // those): the neutral under zero controls, a checkpoint under its last frame's
     lr.set_controls(zero);
@@ -268,6 +293,8 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
         throw ArgumentError(partial.string() + ": its frame arrays do not match frames_done and the meshes");
       out.lowres.topRows(start) = lo;
       out.highres.topRows(start) = hi;
+      const auto lips = detail::lip_pairs_of(z, start, partial.string());
+      std::copy(lips.begin(), lips.end(), lip_pairs.begin());
       const Points<> lx = detail::points_of(z, "lr_state", N, partial.string()), hx = detail::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
       const FaceControls last = face_controls(perf, start - 1, face);
       lr.set_controls(last);
@@ -290,10 +317,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       const auto rh = detail::solve_frame(policy, hr, perf.name, f);
       const auto t2 = std::chrono::steady_clock::now();
       const double sl = std::chrono::duration<double>(t1 - t0).count(), sh = std::chrono::duration<double>(t2 - t1).count();
-      if (const Index pairs = Index(intersecting_lip_pairs(face, hr.positions()).size())) {
-        ++st.lip_intersecting_frames;
-        st.lip_max_pairs = std::max(st.lip_max_pairs, pairs);
-      }
+      lip_pairs[std::size_t(f)] = std::int64_t(intersecting_lip_pairs(face, hr.positions()).size());
       out.lr(f) = lr.positions();
       out.hr(f) = hr.surface(policy);
       st.lr_seconds += sl;
@@ -313,13 +337,16 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
         z["hr_state"] = io::make_npy(hr.positions());
         z["lr_before"] = io::make_npy(lr_before);
         z["hr_before"] = io::make_npy(hr_before);
+        z["hr_lip_pairs"] = io::make_npy<std::int64_t>({done}, lip_pairs.data());
         z["fingerprint"] = io::make_npy(std::vector<std::string>{print});
         io::write_npz(partial, z);
       }
     }
     measure_discrepancy(policy, face, out, st);
+    detail::count_lip_frames(lip_pairs, st);
     auto arrays = data::paired_frame_arrays(out);
     arrays["fingerprint"] = io::make_npy(std::vector<std::string>{print});
+    arrays["hr_lip_pairs"] = io::make_npy<std::int64_t>({F}, lip_pairs.data());
     arrays["control_names"] = io::make_npy(perf.names);
     io::write_npz(final_file, arrays);
     io::NpzArrays ctl;

@@ -106,9 +106,10 @@ struct FaceSimulationOptions {
   double track_stiffness = 3e6; ///< N/m³: track spring stiffness per unit skin area
   double contact_stiffness = 2e9;  ///< N/m³: lip contact stiffness per unit area (HR)
   double contact_thickness = 5e-4; ///< m: d̂, the lips' contact distance (HR)
-  /// Lip vertices closer than this to the other lip's triangles at rest are left out of contact
-  /// (the corners of the mouth, where the lips are one piece of skin).
-  double contact_exclusion = 3e-3;
+  /// A lip vertex's d̂ is at most this fraction of its rest distance to the other lip: near the
+  /// corners of the mouth, where the lips nearly touch at rest, contact is off at rest and
+  /// still keeps the lips from crossing (make_contact).
+  double contact_rest_fraction = 0.5;
   physics::NewtonOptions newton = default_newton();
   /// Also try the linear extrapolation of the last two frames (2x₁ − x₀, carried by the jaw) as
   /// the warm start, taken when its total energy is lower than the last frame's: along a smooth
@@ -454,32 +455,38 @@ class FaceSimulator {
     return physics::EmbeddedSprings<>(a, w, mesh_.num_vertices(), k, face_->surface.V);
   }
 
-  /// Lip contact: vertices of one lip against triangles of the other, minus the vertices that sit
-  /// closer than contact_exclusion to the other lip at rest (the corners of the mouth, where the
-  /// lips are one piece of skin). Known gap: the kit's own neutral has the lips crossing 5–8 mm
-  /// from the corners, inside that band, so the track springs pull them through there (the exact
-  /// lip check in face_datagen.hpp counts it); measuring the band along the skin instead made the
-  /// contact active where the lips touch at rest and HR Newton stalled for minutes per frame.
+  /// Lip contact: vertices of one lip against triangles of the other, each vertex with its own d̂:
+  /// contact_thickness, capped at contact_rest_fraction of its rest distance to the other lip.
+  /// The kit's own neutral has the lips crossing 1–3 mm from the corners of the mouth (86 upper
+  /// and lower triangle pairs intersect at the blendshape targets of the closed jaw), so contact
+  /// must act there. A uniform d̂ there presses the lips apart at rest; leaving out the vertices
+  /// within 3 mm of the other lip at rest (the first build) let the tracks pull the closed-jaw
+  /// frames through each other (114 intersecting pairs in every performance's first and last frame).
   template <class P>
   void make_contact(P policy) {
-    const auto keep_far = [&](const IndexVector& verts, const Tris& other) {
+    if (!(opt_.contact_rest_fraction > 0 && opt_.contact_rest_fraction <= 1) || !(opt_.contact_thickness > 0) || !(opt_.contact_stiffness >= 0))
+      throw ArgumentError("FaceSimulator: contact_rest_fraction must be in (0, 1], contact_thickness > 0 and contact_stiffness >= 0");
+    const auto thickness = [&](const IndexVector& verts, const Tris& other) {
+      VecX<> dhat = VecX<>::Constant(verts.size(), opt_.contact_thickness);
+      if (other.rows() == 0 || verts.size() == 0) return dhat;
       const TriMesh<> o{mesh_.V, other};
-      std::vector<VIndex> kept;
-      if (other.rows() == 0) return IndexVector(0);
       const neighbors::SurfaceDistance<> dist(o);
       Points<> at(verts.size(), 3);
       for (Index i = 0; i < verts.size(); ++i) at.row(i) = mesh_.V.row(verts[i]);
       const VecX<> d = dist.distances(policy, at);
-      for (Index i = 0; i < verts.size(); ++i)
-        if (d[i] >= opt_.contact_exclusion) kept.push_back(verts[i]);
-      return IndexVector(Eigen::Map<const IndexVector>(kept.data(), Index(kept.size())));
+      for (Index i = 0; i < verts.size(); ++i) {
+        if (!(d[i] > 0))
+          throw ArgumentError("FaceSimulator: lip vertex " + std::to_string(verts[i]) + " lies on the other lip at rest (distance " + std::to_string(d[i]) +
+                              "): the lips must be apart in the rest pose");
+        dhat[i] = std::min(dhat[i], opt_.contact_rest_fraction * d[i]);
+      }
+      return dhat;
     };
-    const IndexVector up = keep_far(face_->lip_upper_vertices, face_->lip_lower_triangles);
-    const IndexVector lo = keep_far(face_->lip_lower_vertices, face_->lip_upper_triangles);
-    double area = face_->surface_area.mean();
-    const double k = opt_.contact_stiffness * area;
-    contact_.emplace(physics::SelfContact<>(up, face_->lip_lower_triangles, mesh_.num_vertices(), k, opt_.contact_thickness),
-                     physics::SelfContact<>(lo, face_->lip_upper_triangles, mesh_.num_vertices(), k, opt_.contact_thickness));
+    const double k = opt_.contact_stiffness * face_->surface_area.mean();
+    contact_.emplace(physics::SelfContact<>(face_->lip_upper_vertices, face_->lip_lower_triangles, mesh_.num_vertices(), k,
+                                            thickness(face_->lip_upper_vertices, face_->lip_lower_triangles)),
+                     physics::SelfContact<>(face_->lip_lower_vertices, face_->lip_upper_triangles, mesh_.num_vertices(), k,
+                                            thickness(face_->lip_lower_vertices, face_->lip_upper_triangles)));
   }
 
   const FaceModel* face_;
