@@ -2,7 +2,7 @@
 //
 //   BM_face_frame/lr_default      the LR split lattice of the default model (~10.8k tets)
 //   BM_face_frame/lr_paper_size   the LR lattice at the paper's size (preset paper-lr: BCC cell
-//                                 0.55 cm, ~73k tets; Park et al. 2023 §4)
+//                                 0.565 cm, ~73k tets; Park et al. 2023 §4)
 //   BM_face_frame/hr_default      the HR tetgen mesh of the default model (~135k tets, lip contact)
 //
 // Scene: the ICT face from the bundled kit (data_dir()/ict_face), the model built once per
@@ -38,8 +38,7 @@ const scenario::FaceModel& face_model(const std::string& preset) {
   auto& slot = cache[preset];
   if (!slot) {
     static const scenario::IctKit kit = scenario::read_ict_kit(data_dir() / "ict_face");
-    scenario::FaceModelOptions o;
-    if (preset == "paper-lr") o.lr_cell = 0.55;  // as `simsr datagen --preset paper-lr`
+    const scenario::FaceModelOptions o = scenario::face_model_preset(preset);  // as `simsr datagen --preset`
     const auto work = std::filesystem::temp_directory_path() / ("simsr_bench_face_" + preset + "_" + std::to_string(::getpid()));
     slot = std::make_unique<scenario::FaceModel>(scenario::build_face_model(exec::omp, kit, o, work));
     std::filesystem::remove_all(work);

@@ -34,14 +34,7 @@ struct DatagenArgs {
 
 /// The mesh options of a preset, then the explicit overrides.
 inline scenario::FaceModelOptions face_model_options(const DatagenArgs& a) {
-  scenario::FaceModelOptions o;
-  if (a.preset == "paper-ratio") {  // HR/LR tets ≈ 26 (the paper's 1.9M / 73k)
-    o.lr_cell = 1.6;
-  } else if (a.preset == "paper-lr") {  // the paper's LR size, ~73k tets
-    o.lr_cell = 0.55;
-  } else if (a.preset != "default") {
-    throw ArgumentError("--preset must be default, paper-ratio or paper-lr (got '" + a.preset + "')");
-  }
+  scenario::FaceModelOptions o = scenario::face_model_preset(a.preset);
   if (a.lr_cell > 0) o.lr_cell = a.lr_cell;
   if (a.skull_lattice > 0) o.skull_lattice = a.skull_lattice;
   if (a.hr_max_volume > 0) o.hr.max_volume = a.hr_max_volume;
@@ -114,7 +107,7 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--controls", a->controls, "a controls file (.npz: names C strings, weights F×C), simulated as a performance named after the file (less a trailing _controls)");
   cmd->add_option("--frames", a->frames, "frames per built-in performance")->capture_default_str()->check(CLI::Range(14, 100000));
   cmd->add_option("--seed", a->seed, "seed of the built-in performances")->capture_default_str();
-  cmd->add_option("--preset", a->preset, "mesh sizes: default (12.5x more tets at HR), paper-ratio (~26x), paper-lr (LR ~73k tets)")->capture_default_str();
+  cmd->add_option("--preset", a->preset, "mesh sizes: default (LR 10.8k tets, 12.5x fewer than HR), paper-ratio (26x), paper-lr (LR 73k tets, the paper's)")->capture_default_str();
   cmd->add_option("--lr-cell", a->lr_cell, "LR BCC cell size in cm (overrides the preset)")->check(CLI::PositiveNumber);
   cmd->add_option("--skull-lattice", a->skull_lattice, "skull surface resolution in cm (overrides the preset)")->check(CLI::PositiveNumber);
   cmd->add_option("--hr-max-volume", a->hr_max_volume, "largest HR tet in cm^3 (overrides the preset)")->check(CLI::PositiveNumber);

@@ -178,3 +178,16 @@ TEST_CASE("face model: every named muscle is present at both resolutions with co
     CHECK(vl[k] / vh[k] < 2.0);
   }
 }
+
+TEST_CASE("face model presets: the LR cell of each (the HR mesh the same), a bad name named") {
+  const scenario::FaceModelOptions d = scenario::face_model_preset("default"), r = scenario::face_model_preset("paper-ratio"),
+                                   p = scenario::face_model_preset("paper-lr");
+  CHECK(d.lr_cell == scenario::FaceModelOptions{}.lr_cell);
+  CHECK(r.lr_cell > d.lr_cell);  // fewer LR tets: the paper's 26× ratio
+  CHECK(p.lr_cell < d.lr_cell);  // more LR tets: the paper's 73k
+  for (const auto* o : {&r, &p}) {
+    CHECK(o->hr.max_volume == d.hr.max_volume);
+    CHECK(o->skull_lattice == d.skull_lattice);
+  }
+  CHECK_THROWS_WITH_AS(scenario::face_model_preset("paper"), doctest::Contains("got 'paper'"), ArgumentError);
+}

@@ -59,7 +59,7 @@ namespace simsr::scenario {
 struct FaceModelOptions {
   double rest_jaw_open = 0.1;     ///< jawOpen weight of the rest pose
   /// h of the LR BCC lattice. 1.2 cm: 10.8k tets, against the HR default's 135k (12.5×, the
-  /// issue's ≥ 10×; the paper has 26×); 0.55 cm gives the paper's LR size (~73k tets).
+  /// issue's ≥ 10×; the paper has 26×); see face_model_preset for the paper's ratio and size.
   double lr_cell = 1.2;
   /// Spacing of the lattice the skull level set is taken on: the skull's triangle size, which
   /// with the skin's fixes most of the HR mesh (the boundary is kept as it is).
@@ -72,6 +72,24 @@ struct FaceModelOptions {
   double cranium_weight_max = 0.15; ///< skull points with at most this jaw weight are cranium (fixed)
   std::vector<MuscleSpec> muscles = default_muscle_specs();
 };
+
+/// The options of a named mesh-size preset (the HR mesh is the same in all three):
+///   default       LR h = 1.2 cm:   10,782 LR tets, 12.5× fewer than HR's 134,563 (fits the
+///                 ≤ 20 min budget of 4 × 120 frames on 2 cores with room to spare)
+///   paper-ratio   LR h = 1.6 cm:    5,144 LR tets, 26.2× (the paper's 1.9M / 73k)
+///   paper-lr      LR h = 0.565 cm: 73,066 LR tets (the paper's LR size, §4)
+/// (counts measured on the ICT kit; `simsr datagen --preset`). ArgumentError for another name.
+inline FaceModelOptions face_model_preset(const std::string& name) {
+  FaceModelOptions o;
+  if (name == "paper-ratio") {
+    o.lr_cell = 1.6;
+  } else if (name == "paper-lr") {
+    o.lr_cell = 0.565;
+  } else if (name != "default") {
+    throw ArgumentError("face model preset must be default, paper-ratio or paper-lr (got '" + name + "')");
+  }
+  return o;
+}
 
 /// One anatomy at two resolutions (metres; see the file comment).
 struct FaceModel {
