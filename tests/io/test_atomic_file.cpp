@@ -28,6 +28,8 @@
 #include <simsr/eval/report.hpp>
 #include <simsr/io/io.hpp>
 
+namespace io_test_atomic_file {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -455,3 +457,5 @@ TEST_CASE("an unwritable folder and a read-only file: WriteError (EACCES) for a 
   CHECK(entries(dir) == std::set<std::string>{"locked.txt", "readonly"});
   ::chmod((dir / "readonly").c_str(), 0755);
 }
+
+}  // namespace io_test_atomic_file

@@ -12,6 +12,8 @@
 #include <simsr/io/tetgen.hpp>
 #include <string>
 
+namespace io_test_medit {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -130,3 +132,5 @@ TEST_CASE("medit: hostile input is a ParseError at the right line") {
   expect_parse_error(rd(std::string("\x00\x01\x02\x03", 4)), 1, "NUL");
   expect_parse_error(rd(head + "Vertices\n0\nEnd\n"), 9, "second Vertices");
 }
+
+}  // namespace io_test_medit

@@ -10,6 +10,8 @@
 #include <simsr/io/msh.hpp>
 #include <string>
 
+namespace io_test_msh {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -208,3 +210,5 @@ TEST_CASE("msh: hostile input is a ParseError at the right line") {
   expect_parse_error(rd(head + "$Nodes\n1 400000000 1 4\n"), 5, "absurd count");
   expect_parse_error(rd(head + "$Entities\n0 0 0 1\n1 0 0 0 1 1 1 2 5\n$EndEntities\n"), 6, "physical tags");
 }
+
+}  // namespace io_test_msh

@@ -11,6 +11,8 @@
 
 #include <simsr/io/npy.hpp>
 
+namespace io_test_npy {
+
 namespace {
 
 namespace io = simsr::io;
@@ -340,3 +342,5 @@ TEST_CASE("npy: round trips through numpy") {
   got.insert(got.end(), u.begin(), u.end());
   CHECK(got == want);
 }
+
+}  // namespace io_test_npy

@@ -14,6 +14,8 @@
 
 #include <simsr/io/npz.hpp>
 
+namespace io_test_npz {
+
 namespace {
 
 namespace io = simsr::io;
@@ -306,3 +308,5 @@ TEST_CASE("npz: corrupt archives give ParseError naming the archive or member") 
     CHECK(e.message().find("exceeds the limit of 200 bytes") != std::string::npos);
   }
 }
+
+}  // namespace io_test_npz

@@ -9,6 +9,8 @@
 #include <simsr/io/obj.hpp>
 #include <string>
 
+namespace io_test_obj {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -219,3 +221,5 @@ TEST_CASE("obj: the official bunny rest shape is a positively oriented tet soup"
     SIMSR_MISSING("ICT face OBJ not found: " << face);
   }
 }
+
+}  // namespace io_test_obj

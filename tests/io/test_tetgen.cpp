@@ -10,6 +10,8 @@
 #include <simsr/io/tetgen.hpp>
 #include <string>
 
+namespace io_test_tetgen {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -159,3 +161,5 @@ TEST_CASE("tetgen: hostile input is a ParseError naming file and line") {
   CHECK(read_tetgen(node, ele, "1 1\n1 1 2 3 0 1 -1\n", "mem").F.rows() == 1);  // tetgen -nn
   CHECK_THROWS_AS(simsr::io::read_tetgen(fs::path("/nonexistent/a.node")), simsr::ParseError);
 }
+
+}  // namespace io_test_tetgen

@@ -12,6 +12,8 @@
 #include <simsr/io/npz.hpp>
 #include <simsr/io/vtu.hpp>
 
+namespace io_test_vtu {
+
 namespace {
 
 namespace io = simsr::io;
@@ -214,3 +216,5 @@ TEST_CASE("vtu: meshio reads back points, cells and every data array; pvd series
     CHECK(z.at("pd_err").to_matrix<double>().col(0) == s.err * static_cast<double>(f));
   }
 }
+
+}  // namespace io_test_vtu

@@ -4,6 +4,8 @@
 
 #include <random>
 
+namespace mesh_test_closest_point {
+
 using namespace simsr;
 
 TEST_CASE("closest_point_on_triangle: no sampled point of the triangle is closer; weights are barycentric") {
@@ -26,3 +28,5 @@ TEST_CASE("closest_point_on_triangle: no sampled point of the triangle is closer
     }
   }
 }
+
+}  // namespace mesh_test_closest_point

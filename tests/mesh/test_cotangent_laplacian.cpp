@@ -9,6 +9,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_cotangent_laplacian {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -115,3 +117,5 @@ TEST_CASE("cotangent_weights of an equilateral and a right triangle") {
   CHECK(C(1, 1) == doctest::Approx(0.5));  // 45°
   CHECK(C(1, 2) == doctest::Approx(0.5));
 }
+
+}  // namespace mesh_test_cotangent_laplacian

@@ -12,6 +12,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_generators {
+
 using namespace simsr;
 
 namespace {
@@ -147,3 +149,5 @@ TEST_CASE("disk_surface: counter-clockwise, area converges to pi r^2") {
     CHECK(boundary_loops(d.F).size() == 1);
   }
 }
+
+}  // namespace mesh_test_generators

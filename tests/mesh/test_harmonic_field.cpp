@@ -9,6 +9,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_harmonic_field {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -138,3 +140,5 @@ TEST_CASE("harmonic_field: bad input is refused naming what") {
   // no fixed vertex at all: everything unreachable
   CHECK(harmonic_field(exec::seq, A, IndexVector(0), VecX<>(0), 7.0) == VecX<>::Constant(5, 7.0));
 }
+
+}  // namespace mesh_test_harmonic_field

@@ -9,6 +9,8 @@
 #include <numbers>
 #include <random>
 
+namespace mesh_test_isosurface {
+
 using namespace simsr;
 
 namespace {
@@ -98,3 +100,5 @@ TEST_CASE("marching_tets: bad input is named") {
   phi[4] = 0;
   CHECK_THROWS_WITH_AS(marching_tets(exec::seq, box, phi, 0.0, {.snap = 0.5}), doctest::Contains("snap"), ArgumentError);
 }
+
+}  // namespace mesh_test_isosurface

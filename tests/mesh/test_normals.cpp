@@ -4,6 +4,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_normals {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -85,3 +87,5 @@ TEST_CASE("vertex_normals: flat grid gives +z; an isolated vertex gets zero; wei
   const Points<> Nuni = vertex_normals(V, F, NormalWeighting::uniform);
   CHECK((Nuni.row(0) - expect).norm() > 1e-3);  // (z,x) square contributes only one triangle at vertex 0
 }
+
+}  // namespace mesh_test_normals

@@ -4,6 +4,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_quality {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -82,3 +84,5 @@ TEST_CASE("element_quality of triangles: equilateral 1, collinear 0, right isosc
   CHECK(q[1] == doctest::Approx(std::sqrt(3.0) / 2));  // 4√3·½ / (1 + 1 + 2)
   CHECK(q[2] == doctest::Approx(0.0));
 }
+
+}  // namespace mesh_test_quality

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+namespace mesh_test_rigid_motion {
+
 using namespace simsr;
 
 namespace {
@@ -115,3 +117,5 @@ TEST_CASE("rigid fits refuse what they cannot answer, naming it") {
   screw.t += Vec3<>(0, 0, 0.5);  // half a unit along the axis
   CHECK_THROWS_WITH_AS(hinge_of(screw, Vec3<>::Zero()), doctest::Contains("a screw, not a hinge"), ArgumentError);
 }
+
+}  // namespace mesh_test_rigid_motion

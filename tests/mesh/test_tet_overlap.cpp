@@ -4,6 +4,8 @@
 
 #include <random>
 
+namespace mesh_test_tet_overlap {
+
 using namespace simsr;
 
 namespace {
@@ -102,3 +104,5 @@ TEST_CASE("tets that only touch do not overlap; nested and identical tets do") {
   flat[3] = Vec3<double>(0.2, 0.2, 0);
   CHECK_FALSE(tets_overlap(a, flat));
 }
+
+}  // namespace mesh_test_tet_overlap

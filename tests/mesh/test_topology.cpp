@@ -7,6 +7,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_topology {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -267,3 +269,5 @@ TEST_CASE("boundary_edges and boundary_loops of open surfaces") {
   bad << 0, 1, 2, 0, 1, 3;
   CHECK_THROWS_AS(boundary_loops(bad), MeshError);
 }
+
+}  // namespace mesh_test_topology

@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+namespace mesh_test_triangle_intersection {
+
 using namespace simsr;
 
 namespace {
@@ -375,3 +377,5 @@ TEST_CASE("intersecting_triangle_pairs: argument errors") {
   CHECK_THROWS_WITH_AS(intersecting_triangle_pairs(Y, A, B), doctest::Contains("X(3, 2)"), ArgumentError);
   CHECK_NOTHROW(intersecting_triangle_pairs(Y, A, B, 0x1p-36));
 }
+
+}  // namespace mesh_test_triangle_intersection

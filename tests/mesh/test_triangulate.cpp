@@ -10,6 +10,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_triangulate {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -184,3 +186,5 @@ TEST_CASE("real data: the ICT face (quads) triangulates, keeps vector areas, is 
   tri.V.col(2).maxCoeff(&tip);
   CHECK(vertex_normals(tri.V, tri.F, NormalWeighting::area)(tip, 2) > 0.8);
 }
+
+}  // namespace mesh_test_triangulate

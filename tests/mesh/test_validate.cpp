@@ -7,6 +7,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_validate {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -174,3 +176,5 @@ TEST_CASE("validate triangle meshes; unreferenced vertices are reported, not err
     CHECK(std::string(e.what()).find("vertex 3") == 0);
   }
 }
+
+}  // namespace mesh_test_validate

@@ -5,6 +5,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_vertex_areas {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -76,3 +78,5 @@ TEST_CASE("voronoi_areas of a regular grid: interior vertices get one cell") {
     CHECK(A[v] == doctest::Approx(wx * wy));
   }
 }
+
+}  // namespace mesh_test_vertex_areas

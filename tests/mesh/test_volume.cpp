@@ -4,6 +4,8 @@
 
 #include "fixtures.hpp"
 
+namespace mesh_test_volume {
+
 using namespace simsr;
 using namespace simsr::test;
 
@@ -57,3 +59,5 @@ TEST_CASE("signed_volumes and total_volume: seq and omp agree bitwise; float mes
   CHECK(total_volume(exec::seq, Vd, Td) == total_volume(exec::seq, m.V, m.T));
   CHECK_THROWS_AS(total_volume(exec::seq, Eigen::MatrixXd(4, 2), Td), ShapeError);
 }
+
+}  // namespace mesh_test_volume
