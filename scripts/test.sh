@@ -5,14 +5,15 @@
 # the ../shared/data folder or clang that is still missing is a real failure here, never a skip.
 #
 #   1. build/       g++ Release: every area's doctest suite, test_threads, the tool and examples, the
-#                   benchmarks (built, not run), the fuzz-corpus replays, the peers (gmsh, meshio,
-#                   numpy, scipy, torch), install + consumer project, compile-fail checks, cuda-compile
+#                   fuzz-corpus replays, the peers (gmsh, meshio, numpy, scipy, torch), install +
+#                   consumer project, compile-fail checks, cuda-compile, the benchmarks (built,
+#                   not run)
 #   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite and the corpus replays under
 #                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, no recovery)
 #   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: every suite that runs exec::omp under TSan, with
 #                   LLVM's libomp and its Archer tool (so OpenMP's synchronisation is understood)
 #   4. scripts/fuzz.sh: every libFuzzer harness (build-asan's replay binaries) for
-#                   SIMSR_FUZZ_SECONDS (default 5) seconds each
+#                   SIMSR_FUZZ_SECONDS (default 3) seconds each
 #
 # ctest must report no skipped or not-run test. The one exception, named here:
 #   cuda_compile where nvcc is absent: the CUDA toolkit is no Debian package deps.sh can install
@@ -87,7 +88,7 @@ for kind in asan tsan; do
   step "ctest ($dir)"
 done
 
-fuzz_seconds=${SIMSR_FUZZ_SECONDS:-5}
+fuzz_seconds=${SIMSR_FUZZ_SECONDS:-3}
 if ((fuzz_seconds > 0)); then
   bash scripts/fuzz.sh "$fuzz_seconds"
   step "fuzzing"

@@ -457,9 +457,9 @@ class FaceSimulator {
 
   /// Lip contact: vertices of one lip against triangles of the other, each vertex with its own d̂:
   /// contact_thickness, capped at contact_rest_fraction of its rest distance to the other lip.
-  /// The kit's own neutral has the lips crossing 1–3 mm from the corners of the mouth (86 upper
-  /// and lower triangle pairs intersect at the blendshape targets of the closed jaw), so contact
-  /// must act there. A uniform d̂ there presses the lips apart at rest; leaving out the vertices
+  /// The kit's own neutral has the lips crossing near the corners of the mouth, where they lie
+  /// 1–2.5 mm apart in the rest pose (86 upper and lower triangle pairs intersect at the
+  /// blendshape targets of the closed jaw), so contact must act there. A uniform d̂ there presses the lips apart at rest; leaving out the vertices
   /// within 3 mm of the other lip at rest (the first build) let the tracks pull the closed-jaw
   /// frames through each other (114 intersecting pairs in every performance's first and last frame).
   template <class P>
