@@ -110,6 +110,11 @@ TEST_CASE("EmbeddedObstacleContact: from an embedding; bad input named") {
   CHECK(c.num_active(x) == 1);                                          // the centroid, 0.05 below
   CHECK(c.energy(exec::seq, x) == doctest::Approx(5.0 * 0.05 * 0.05));  // k/2 d²
 
+  // the whole embedding: rows 0, 1, 2 in order
+  const Contact whole(floor, e, T, 4, VecX<>::Constant(3, 10.0)), rows(floor, e, T, 4, {0, 1, 2}, VecX<>::Constant(3, 10.0));
+  CHECK(whole.points(x) == rows.points(x));
+  CHECK(whole.energy(exec::seq, x) == rows.energy(exec::seq, x));
+
   CHECK_THROWS_AS(Contact(floor, e, T, 4, {3}, VecX<>::Ones(1)), ArgumentError);
   CHECK_THROWS_AS(Contact(floor, e, T, 4, {0}, VecX<>::Constant(1, -1.0)), ArgumentError);
   Contact::Anchors a(1, 4);

@@ -3,6 +3,8 @@
 
 #include <doctest/doctest.h>
 
+#include <vector>
+
 #include <cmath>
 #include <random>
 
@@ -124,6 +126,17 @@ TEST_CASE("EmbeddedSprings: bad input throws typed errors") {
   Embedding<> wnan = e;
   wnan.weights(0, 0) = std::nan("");
   CHECK_THROWS_AS(EmbeddedSprings<>(wnan, m.T, m.num_vertices(), k, p), ArgumentError);
+
+  // springs on some rows of an embedding: the same anchors, weights and points as those rows
+  {
+    const EmbeddedSprings<> all(e, m.T, m.num_vertices(), k, p), second(e, m.T, m.num_vertices(), std::vector<Index>{1}, VecX<>::Ones(1), p.bottomRows(1));
+    CHECK(second.num_springs() == 1);
+    CHECK(second.anchors().row(0) == all.anchors().row(1));
+    CHECK(second.weights().row(0) == all.weights().row(1));
+    CHECK(second.points(m.V).row(0) == all.points(m.V).row(1));
+    CHECK_THROWS_WITH_AS(EmbeddedSprings<>(e, m.T, m.num_vertices(), std::vector<Index>{2}, VecX<>::Ones(1), p.topRows(1)),
+                         doctest::Contains("point 2 outside"), ArgumentError);
+  }
 
   EmbeddedSprings<> s(e, m.T, m.num_vertices(), k, p);
   CHECK_THROWS_AS(s.set_targets(Points<>(3, 3)), ShapeError);

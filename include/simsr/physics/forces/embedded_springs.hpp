@@ -16,6 +16,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -27,6 +28,7 @@
 #include "../../mesh/vertex_areas.hpp"
 #include "../energy_term.hpp"
 #include "detail/checks.hpp"
+#include "detail/embedded_points.hpp"
 
 namespace simsr::physics {
 
@@ -37,31 +39,30 @@ template <class S = Scalar>
 class EmbeddedSprings {
  public:
   using scalar_type = S;
-  using Anchors = Eigen::Matrix<VIndex, Eigen::Dynamic, 4, Eigen::RowMajor>;
-  using Weights = Eigen::Matrix<S, Eigen::Dynamic, 4, Eigen::RowMajor>;
+  using Anchors = typename detail::EmbeddedPoints<S>::Anchors;
+  using Weights = typename detail::EmbeddedPoints<S>::Weights;
 
   /// The general form: spring s pulls Σ_i weights(s,i) x[anchors(s,i)] towards targets.row(s).
   /// Throws ShapeError for mismatched sizes, ArgumentError for an anchor outside
   /// [0, num_vertices), a non-finite weight or target, or a negative or non-finite stiffness.
   EmbeddedSprings(Anchors anchors, Weights weights, Index num_vertices, VecX<S> stiffness, Points<S> targets)
-      : anchors_(std::move(anchors)), weights_(std::move(weights)), n_(num_vertices) {
-    const Index q = anchors_.rows();
-    detail::require_vertex_indices("EmbeddedSprings: anchors", anchors_, n_);
-    detail::require_finite_matrix("EmbeddedSprings: weights", weights_, q, 4);
-    set_stiffness(std::move(stiffness));
-    set_targets(targets);
-  }
+      : EmbeddedSprings(detail::EmbeddedPoints<S>("EmbeddedSprings", std::move(anchors), std::move(weights), num_vertices), std::move(stiffness),
+                        std::move(targets)) {}
 
   /// Springs from the points of an embedding in the tets T of a mesh with `num_vertices` vertices
   /// (anchors = T's vertices of each point's tet, weights = its barycentric weights).
   /// Throws ArgumentError for a tet id outside T, MeshError for a tet whose vertex is out of range.
   EmbeddedSprings(const Embedding<S>& e, const Tets& T, Index num_vertices, VecX<S> stiffness, Points<S> targets)
-      : EmbeddedSprings(anchors_of(e, T, num_vertices), e.weights, num_vertices, std::move(stiffness), std::move(targets)) {}
+      : EmbeddedSprings(detail::EmbeddedPoints<S>::of("EmbeddedSprings", e, T, num_vertices), std::move(stiffness), std::move(targets)) {}
 
-  Index num_springs() const { return anchors_.rows(); }
-  Index num_vertices() const { return n_; }
-  const Anchors& anchors() const { return anchors_; }
-  const Weights& weights() const { return weights_; }
+  /// Springs on the points `rows` of embedding e only (ArgumentError for a row outside e).
+  EmbeddedSprings(const Embedding<S>& e, const Tets& T, Index num_vertices, const std::vector<Index>& rows, VecX<S> stiffness, Points<S> targets)
+      : EmbeddedSprings(detail::EmbeddedPoints<S>::of("EmbeddedSprings", e, T, num_vertices, rows), std::move(stiffness), std::move(targets)) {}
+
+  Index num_springs() const { return pts_.size(); }
+  Index num_vertices() const { return pts_.num_vertices; }
+  const Anchors& anchors() const { return pts_.anchors; }
+  const Weights& weights() const { return pts_.weights; }
   const VecX<S>& stiffness() const { return k_; }  ///< #Q, N/m
   const Points<S>& targets() const { return y_; }   ///< #Q×3, m
 
@@ -79,16 +80,14 @@ class EmbeddedSprings {
 
   /// Current positions of the anchored points, Σ_i w_si x_{a_si}: #Q×3.
   Points<S> points(const Points<S>& x) const {
-    detail::require_positions("EmbeddedSprings: x", x, n_);
-    Points<S> p(num_springs(), 3);
-    for (Index s = 0; s < num_springs(); ++s) p.row(s) = point(x, s).transpose();
-    return p;
+    detail::require_positions("EmbeddedSprings: x", x, num_vertices());
+    return pts_.points(x);
   }
 
   /// Σ_s k_s/2 ‖residual‖² (J), over the springs in order (the policy is taken for the EnergyTerm form).
   template <exec::HostPolicy P>
   S energy(P, const Points<S>& x) const {
-    detail::require_positions("EmbeddedSprings: x", x, n_);
+    detail::require_positions("EmbeddedSprings: x", x, num_vertices());
     S e = S(0);
     for (Index s = 0; s < num_springs(); ++s) e += k_[s] / S(2) * residual(x, s).squaredNorm();
     return e;
@@ -96,44 +95,27 @@ class EmbeddedSprings {
 
   template <exec::HostPolicy P>
   void add_gradient(P, const Points<S>& x, Points<S>& g) const {
-    detail::require_positions("EmbeddedSprings: x", x, n_);
-    detail::require_positions("EmbeddedSprings: gradient", g, n_);
-    for (Index s = 0; s < num_springs(); ++s) {
-      const Vec3<S> f = k_[s] * residual(x, s);
-      for (int i = 0; i < 4; ++i) g.row(anchors_(s, i)) += weights_(s, i) * f.transpose();
-    }
+    detail::require_positions("EmbeddedSprings: x", x, num_vertices());
+    detail::require_positions("EmbeddedSprings: gradient", g, num_vertices());
+    for (Index s = 0; s < num_springs(); ++s) pts_.add_force(g, s, k_[s] * residual(x, s));
   }
 
   /// Adds k_s w_si w_sj I₃ for every pair of non-zero weights (exact and PSD: the same for both
   /// Definiteness values).
   template <exec::HostPolicy P>
   void add_hessian(P, const Points<S>& x, BlockHessian<S>& H, Definiteness) const {
-    detail::require_positions("EmbeddedSprings: x", x, n_);
-    for (Index s = 0; s < num_springs(); ++s)
-      for (int i = 0; i < 4; ++i) {
-        if (weights_(s, i) == S(0)) continue;
-        for (int j = 0; j < 4; ++j)
-          if (weights_(s, j) != S(0)) H.add(anchors_(s, i), anchors_(s, j), (k_[s] * weights_(s, i) * weights_(s, j)) * Mat3<S>::Identity());
-      }
+    detail::require_positions("EmbeddedSprings: x", x, num_vertices());
+    for (Index s = 0; s < num_springs(); ++s) pts_.add_block(H, s, k_[s] * Mat3<S>::Identity());
   }
 
  private:
-  static Anchors anchors_of(const Embedding<S>& e, const Tets& T, Index num_vertices) {
-    simsr::detail::embedding_check_tets("EmbeddedSprings", e, T, num_vertices);
-    Anchors a(e.size(), 4);
-    for (Index q = 0; q < e.size(); ++q) a.row(q) = T.row(e.tet[q]);
-    return a;
+  EmbeddedSprings(detail::EmbeddedPoints<S> points, VecX<S> stiffness, Points<S> targets) : pts_(std::move(points)) {
+    set_stiffness(std::move(stiffness));
+    set_targets(targets);
   }
-  Vec3<S> point(const Points<S>& x, Index s) const {
-    Vec3<S> p = Vec3<S>::Zero();
-    for (int i = 0; i < 4; ++i) p += weights_(s, i) * x.row(anchors_(s, i)).transpose();
-    return p;
-  }
-  Vec3<S> residual(const Points<S>& x, Index s) const { return point(x, s) - y_.row(s).transpose(); }
+  Vec3<S> residual(const Points<S>& x, Index s) const { return pts_.point(x, s) - y_.row(s).transpose(); }
 
-  Anchors anchors_;
-  Weights weights_;
-  Index n_;
+  detail::EmbeddedPoints<S> pts_;
   VecX<S> k_;
   Points<S> y_;
 };

@@ -40,6 +40,31 @@ Mat3<S> project_psd3(const Mat3<S>& A) {
   if (es.eigenvalues().minCoeff() >= -tol) return sym;  // PSD up to rounding: keep the exact block
   return es.eigenvectors() * es.eigenvalues().cwiseMax(S(0)).asDiagonal() * es.eigenvectors().transpose();
 }
+
+/// One point p's penalty against obstacle o with stiffness k, the class comment's formulas shared
+/// by ObstacleContact (p a vertex) and EmbeddedObstacleContact (p an embedded point): the energy
+/// k/2 min(d, 0)², and for d < 0 the derivative k d ∇d and the PSD-projected block
+/// k (∇d ∇dᵀ + d ∇²d). The last two return false (and leave their output) where d ≥ 0.
+template <class O, class S>
+S obstacle_penalty_energy(const O& o, const Vec3<S>& p, S k) {
+  const S d = o.distance(p);
+  return d < S(0) ? k / S(2) * d * d : S(0);
+}
+template <class O, class S>
+bool obstacle_penalty_force(const O& o, const Vec3<S>& p, S k, Vec3<S>& f) {
+  const S d = o.distance(p);
+  if (!(d < S(0))) return false;
+  f = (k * d) * o.distance_gradient(p);
+  return true;
+}
+template <class O, class S>
+bool obstacle_penalty_block(const O& o, const Vec3<S>& p, S k, Mat3<S>& B) {
+  const S d = o.distance(p);
+  if (!(d < S(0))) return false;
+  const Vec3<S> n = o.distance_gradient(p);
+  B = k * project_psd3(Mat3<S>(n * n.transpose() + d * o.distance_hessian(p)));
+  return true;
+}
 }  // namespace detail
 
 /// A rigid obstacle: signed distance d(x) (m, negative inside), its gradient ∇d (unit outward
@@ -159,10 +184,7 @@ class ObstacleContact {
   S energy(P, const Points<S>& x) const {
     detail::require_positions("ObstacleContact: x", x, n_);
     S e = S(0);
-    for (Index i = 0; i < v_.size(); ++i) {
-      const S d = o_.distance(pos(x, i));
-      if (d < S(0)) e += k_[i] / S(2) * d * d;
-    }
+    for (Index i = 0; i < v_.size(); ++i) e += detail::obstacle_penalty_energy(o_, pos(x, i), k_[i]);
     return e;
   }
 
@@ -170,24 +192,18 @@ class ObstacleContact {
   void add_gradient(P, const Points<S>& x, Points<S>& g) const {
     detail::require_positions("ObstacleContact: x", x, n_);
     detail::require_positions("ObstacleContact: gradient", g, n_);
-    for (Index i = 0; i < v_.size(); ++i) {
-      const Vec3<S> p = pos(x, i);
-      const S d = o_.distance(p);
-      if (d < S(0)) g.row(v_[i]) += (k_[i] * d) * o_.distance_gradient(p).transpose();
-    }
+    Vec3<S> f;
+    for (Index i = 0; i < v_.size(); ++i)
+      if (detail::obstacle_penalty_force(o_, pos(x, i), k_[i], f)) g.row(v_[i]) += f.transpose();
   }
 
   /// The PSD-projected blocks of the class comment, for both Definiteness values.
   template <exec::HostPolicy P>
   void add_hessian(P, const Points<S>& x, BlockHessian<S>& H, Definiteness) const {
     detail::require_positions("ObstacleContact: x", x, n_);
-    for (Index i = 0; i < v_.size(); ++i) {
-      const Vec3<S> p = pos(x, i);
-      const S d = o_.distance(p);
-      if (!(d < S(0))) continue;
-      const Vec3<S> n = o_.distance_gradient(p);
-      H.add(v_[i], v_[i], k_[i] * detail::project_psd3(Mat3<S>(n * n.transpose() + d * o_.distance_hessian(p))));
-    }
+    Mat3<S> B;
+    for (Index i = 0; i < v_.size(); ++i)
+      if (detail::obstacle_penalty_block(o_, pos(x, i), k_[i], B)) H.add(v_[i], v_[i], B);
   }
 
  private:

@@ -139,7 +139,7 @@ class FaceSimulator {
         muscle_(part_of_mesh(face, true), physics::TeranMuscle<>(physics::MooneyRivlin<>(opt_.mu10, opt_.mu01, opt_.kappa, opt_.inversion_threshold), opt_.muscle_max_stress),
                 fibres_),
         newton_(mesh_.num_vertices(), mesh_.T, opt_.newton, physics::make_linear_solver<Linear>(policy, mesh_, opt_.linear)),
-        tracks_(make_tracks(policy)) {
+        tracks_(make_tracks()) {
     const bool high = resolution == FaceResolution::high;
     bone_ = high ? face.hr_bone : face.lr_bone;
     bone_jaw_ = high ? face.hr_bone_jaw : face.lr_bone_jaw;
@@ -439,20 +439,15 @@ class FaceSimulator {
     throw ConvergenceError("face frame by continuation in up to " + std::to_string(Index(1) << opt_.substep_levels) + " substeps", spent, residual);
   }
 
-  template <class P>
-  physics::EmbeddedSprings<> make_tracks(P policy) {
+  physics::EmbeddedSprings<> make_tracks() const {
     const VecX<> k = opt_.track_stiffness * face_->surface_area;
     if (res_ == FaceResolution::low)
       return physics::EmbeddedSprings<>(face_->surface_in_lr, mesh_.T, mesh_.num_vertices(), k, face_->surface.V);
-    const Index M = face_->surface_hr_vertex.size();
-    physics::EmbeddedSprings<>::Anchors a(M, 4);
-    physics::EmbeddedSprings<>::Weights w = physics::EmbeddedSprings<>::Weights::Zero(M, 4);
-    for (Index i = 0; i < M; ++i) {
-      a.row(i).setConstant(face_->surface_hr_vertex[i]);
-      w(i, 0) = 1;
-    }
-    (void)policy;
-    return physics::EmbeddedSprings<>(a, w, mesh_.num_vertices(), k, face_->surface.V);
+    // HR: the skin vertices are mesh vertices (tetgen keeps the boundary)
+    physics::EmbeddedSprings<> s = physics::vertex_springs(mesh_.V, face_->surface_hr_vertex, 0.0);
+    s.set_stiffness(k);
+    s.set_targets(face_->surface.V);
+    return s;
   }
 
   /// Lip contact: vertices of one lip against triangles of the other, each vertex with its own d̂:

@@ -182,12 +182,7 @@ std::vector<UnseenForceStats> generate_unseen_force_frames(P policy, const FaceM
     run(
         "lip_corner_pull",
         [&] {
-          Embedding<> e;
-          e.tet = IndexVector::Constant(1, face.surface_in_lr.tet[corner]);
-          e.weights = face.surface_in_lr.weights.row(corner);
-          e.inside = Eigen::Array<bool, Eigen::Dynamic, 1>::Constant(1, true);
-          e.distance = VecX<>::Zero(1);
-          return physics::EmbeddedSprings<>(e, face.lr.T, N, VecX<>::Constant(1, opt.pull_stiffness), Points<>(start.transpose()));
+          return physics::EmbeddedSprings<>(face.surface_in_lr, face.lr.T, N, {corner}, VecX<>::Constant(1, opt.pull_stiffness), Points<>(start.transpose()));
         },
         [&](physics::EmbeddedSprings<>& s, Index f) {
           const Vec3<> y = start + opt.pull_distance * detail::smoothstep(double(f) / double(F - 1)) * dir_pull;
@@ -203,8 +198,6 @@ std::vector<UnseenForceStats> generate_unseen_force_frames(P policy, const FaceM
     const Vec3<> n = detail::outward_normal(face, cheek);
     const Vec3<> p = skin0.row(cheek).transpose();
     const Vec3<> from = p + (opt.sphere_radius + opt.sphere_gap) * n, to = p + (opt.sphere_radius - opt.sphere_depth) * n;
-    std::vector<Index> rows(static_cast<std::size_t>(face.surface.num_vertices()));
-    for (Index i = 0; i < Index(rows.size()); ++i) rows[std::size_t(i)] = i;
     struct Record {
       Points<> centres;
       double radius;
@@ -220,7 +213,7 @@ std::vector<UnseenForceStats> generate_unseen_force_frames(P policy, const FaceM
     run(
         "cheek_sphere",
         [&] {
-          return physics::EmbeddedObstacleContact<physics::Sphere<>>(physics::Sphere<>(from, opt.sphere_radius), face.surface_in_lr, face.lr.T, N, rows,
+          return physics::EmbeddedObstacleContact<physics::Sphere<>>(physics::Sphere<>(from, opt.sphere_radius), face.surface_in_lr, face.lr.T, N,
                                                                      VecX<>(opt.sphere_stiffness * face.surface_area));
         },
         [&](physics::EmbeddedObstacleContact<physics::Sphere<>>& c, Index f) {
