@@ -11,11 +11,9 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <string>
 
 namespace simsr::cli {
@@ -43,54 +41,18 @@ inline scenario::FaceModelOptions face_model_options(const DatagenArgs& a) {
 
 inline int datagen(const DatagenArgs& a) {
   if (a.scenario != "face") throw ArgumentError("--scenario: only 'face' is built (got '" + a.scenario + "')");
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  const auto kit = scenario::read_ict_kit(a.kit);
-  std::fprintf(stderr, "datagen: building the face model (tetgen, lattice, muscles)...\n");
-  const scenario::FaceModel face = scenario::build_face_model(exec::omp, kit, face_model_options(a), std::filesystem::path(a.out) / "mesh");
-  std::fprintf(stderr, "datagen: HR %lld tets, LR %lld tets (%.1fx), surface %lld vertices; built in %.1f s\n", (long long)face.hr.num_tets(),
-               (long long)face.lr.num_tets(), double(face.hr.num_tets()) / double(face.lr.num_tets()), (long long)face.surface.num_vertices(),
-               std::chrono::duration<double>(clock::now() - t0).count());
-  std::vector<scenario::Performance> perfs;
-  scenario::PerformanceOptions po;
-  po.frames = a.frames;
-  for (const auto& name : a.performances) perfs.push_back(scenario::builtin_performance(name, face.expression_names, a.seed, po));
-  for (const auto& file : a.controls) perfs.push_back(scenario::read_controls(file, scenario::performance_name_of(file)));
-  Index total = 0;
-  for (const auto& p : perfs) total += p.num_frames();
-  Index done = 0;
-  const auto start = clock::now();
-  scenario::FaceDatagenOptions opt;
-  opt.checkpoint_every = a.checkpoint_every;
-  opt.on_frame = [&](const std::string& perf, Index f, Index F, const physics::NewtonReport& rl, const physics::NewtonReport& rh, double sl, double sh) {
-    ++done;
-    const double el = std::chrono::duration<double>(clock::now() - start).count();
-    const double fps = double(done) / el;
-    const double eta = double(total - done) / fps;  // upper bound: resumed frames are not simulated
-    std::fprintf(stderr, "datagen: %-10s frame %4lld/%lld | %.2f frames/s | LR %lld it %.2f s | HR %lld it %.2f s | ETA %d:%02d\n", perf.c_str(),
-                 (long long)f + 1, (long long)F, fps, (long long)rl.iterations, sl, (long long)rh.iterations, sh, int(eta) / 60, int(eta) % 60);
-  };
-  const auto stats = scenario::generate_face_data(exec::omp, face, perfs, a.out, opt);
-  auto j = scenario::face_data_report(face, stats);
-  for (const auto& s : stats)
-    if (s.lip_intersecting_frames)
-      std::fprintf(stderr, "datagen: warning: %s: the HR lips intersect in %lld frames (at most %lld triangle pairs): its controls press them harder than the contact holds\n",
-                   s.name.c_str(), (long long)s.lip_intersecting_frames, (long long)s.lip_max_pairs);
-  if (a.vtk_every > 0) {
-    std::vector<std::string> names;
-    for (const auto& p : perfs) names.push_back(p.name);
-    std::fprintf(stderr, "datagen: VTU series (every %lld frames) in %s\n", (long long)a.vtk_every, (std::filesystem::path(a.out) / "vtk").string().c_str());
-    scenario::write_face_data_views(exec::omp, face, a.out, names, a.vtk_every);
-  }
-  if (a.unseen_forces) {
-    std::fprintf(stderr, "datagen: the unseen-force frames (LR only: a lip corner pulled, a sphere in the cheek)...\n");
-    scenario::UnseenForceOptions uo;
-    uo.frames = a.unseen_frames;
-    const auto us = scenario::generate_unseen_force_frames(exec::omp, face, a.out, uo);
-    j["unseen_forces"] = scenario::unseen_force_report(us);
-  }
-  j["seconds"] = std::chrono::duration<double>(clock::now() - t0).count();
-  io::write_file_atomic(std::filesystem::path(a.out) / "face_data.json", j.dump(2) + "\n");
+  scenario::FaceDatasetOptions o;
+  o.kit = a.kit;
+  o.model = face_model_options(a);
+  o.performances = a.performances;
+  o.controls.assign(a.controls.begin(), a.controls.end());
+  o.frames = a.frames;
+  o.seed = a.seed;
+  o.checkpoint_every = a.checkpoint_every;
+  o.vtk_every = a.vtk_every;
+  o.unseen_forces = a.unseen_forces;
+  o.unseen_frames = a.unseen_frames;
+  const auto j = scenario::generate_face_dataset(exec::omp, o, a.out, [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); });
   std::cout << j.dump() << '\n';
   return 0;
 }

@@ -26,45 +26,19 @@
 namespace simsr::cli {
 
 struct TrainArgs {
-  std::string lr, hr, frames, out, neighbors, official_neighbors, profile = "official", checkpoint, resume, out_dir;
-  Index epochs = -1, batch_size = -1, knn = -1, upk = -1, holdout = 4, lr_decay_epochs = 10;
-  double lr_rate = -1, w_recon = -1, w_zreg = -1, w_fn = -1;
-  std::uint64_t seed = 0;
-  bool residual = true, without_fe = false, without_cu = false, quiet = false;
+  std::string lr, hr, frames, out, neighbors, official_neighbors, checkpoint, resume, out_dir;
+  Index holdout = 4;
+  interp::NetworkRecipe recipe;  ///< the tool's defaults (batch 8, Adam 1e-3, residual): see network_recipe.hpp
+  bool quiet = false;
 };
-
-/// Training defaults of the tool (the library's NetworkConfig keeps the official ones): batches of
-/// 8 at Adam lr 1e-3 (halved every 10 epochs) and the residual composition over Embedded. Why: on 2 CPU cores the official
-/// recipe (batch 32, lr 2e-4, 200 epochs, the network alone) is days of work; measured on the
-/// bunny, these settings improve on Embedded within the ~15 minutes the default epochs take, while
-/// the network alone is still far from it after that time (README, "Training on the bunny").
-inline constexpr Index default_batch_size = 8;
-inline constexpr double default_lr = 1e-3;
-
-/// The default number of epochs of `simsr train` for a profile: about 15 minutes on 2 cores for
-/// the bunny example (measured: see README, "Training the bunny").
-inline Index default_epochs(const std::string& profile) { return profile == "paper" ? 10 : 14; }
 
 inline int train_cmd(const TrainArgs& a) {
   using clock = std::chrono::steady_clock;
   const auto t_start = clock::now();
-  nn::NetworkConfig cfg = nn::NetworkConfig::preset(a.profile);
-  if (a.knn > 0) cfg.knn = a.knn;
-  if (a.upk > 0) cfg.up_k = a.upk;
-  cfg.residual = a.residual;
-  if (a.without_fe) cfg.disable_feature_embedding();
-  if (a.without_cu) cfg.upsampling = nn::UpsamplingKind::table;
-  cfg.epochs = a.epochs >= 0 ? a.epochs : default_epochs(a.profile);
-  cfg.batch_size = a.batch_size > 0 ? a.batch_size : default_batch_size;
-  cfg.lr = a.lr_rate > 0 ? a.lr_rate : default_lr;
-  if (a.w_recon >= 0) cfg.w_recon = a.w_recon;
-  if (a.w_zreg >= 0) cfg.w_zreg = a.w_zreg;
-  if (a.w_fn >= 0) cfg.w_fn = a.w_fn;
-  cfg.validate();
-
+  const nn::NetworkConfig cfg = a.recipe.config();
   interp::UpsamplingProblem<> problem{data::read_lr_rest(a.lr), data::read_hr_rest(a.hr), {}, {}};
   nlohmann::ordered_json j;
-  j["profile"] = a.profile;
+  j["profile"] = a.recipe.profile;
   if (!a.official_neighbors.empty()) {
     problem.use(data::read_official_neighborhoods(a.official_neighbors, problem.num_lr(), problem.num_hr()));
     j["neighbors"] = "official files in " + a.official_neighbors;
@@ -80,7 +54,7 @@ inline int train_cmd(const TrainArgs& a) {
   const auto train = frames.select(split.train), test = frames.select(split.test);
   const auto held = data::displacements(test, problem.lr.V, problem.hr.V);
 
-  interp::Learned<> net(cfg, a.seed);
+  interp::Learned<> net(cfg, a.recipe.seed);
   interp::prepare(exec::omp, net, problem, cfg.up_k);  // geometry only: training follows
   double embedded_error = -1;
   if (test.num_frames() > 0) {  // the baseline to beat, on the same held-out frames
@@ -89,9 +63,9 @@ inline int train_cmd(const TrainArgs& a) {
   }
   const auto t_geo = clock::now();
   interp::NetworkTrainOptions o;
-  o.trainer.seed = a.seed;
+  o.trainer.seed = a.recipe.seed;
   o.trainer.progress = !a.quiet;
-  o.trainer.lr_decay_epochs = a.lr_decay_epochs;
+  o.trainer.lr_decay_epochs = a.recipe.lr_decay_epochs;
   if (test.num_frames() > 0) o.holdout = &held;
   o.checkpoint = a.checkpoint;
   o.resume = a.resume;
@@ -133,22 +107,23 @@ inline void add_train(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--out", a->out, "output model .npz")->required();
   cmd->add_option("--neighbors", a->neighbors, "neighbourhoods from `simsr neighbors` (computed when absent)");
   cmd->add_option("--official-neighbors", a->official_neighbors, "folder with the authors' geo_dist_*.npy files (the bunny layout)");
-  cmd->add_option("--profile", a->profile, "official (default) | paper")->check(CLI::IsMember({"official", "paper"}));
-  cmd->add_option("--epochs", a->epochs, "epochs (default: 14 official, 10 paper: ~15 min for the bunny on 2 cores)");
-  cmd->add_option("--seed", a->seed, "seed of the initial weights and the shuffling (default 0)");
-  cmd->add_option("--batch-size", a->batch_size, "frames per batch (default 8; the official code uses 32)");
-  cmd->add_option("--lr", a->lr_rate, "Adam learning rate (default 1e-3; the official code uses 2e-4)");
-  cmd->add_option("--w-recon", a->w_recon, "weight of the L1 reconstruction term (official 10)");
-  cmd->add_option("--w-zreg", a->w_zreg, "weight of the latent regularizer (official 2; paper: the ramp's end)");
-  cmd->add_option("--w-fn", a->w_fn, "weight of the face-normal term (0.001)");
-  cmd->add_option("--lr-decay-epochs", a->lr_decay_epochs, "halve the learning rate every that many epochs (default 10; 0: never)");
-  cmd->add_option("--knn", a->knn, "EdgeConv k (default 5)");
-  cmd->add_option("--upk", a->upk, "upsampling neighbours (default: 10 official, 20 paper)");
+  auto& r = a->recipe;
+  cmd->add_option("--profile", r.profile, "official (default) | paper")->check(CLI::IsMember({"official", "paper"}));
+  cmd->add_option("--epochs", r.epochs, "epochs (default: 14 official, 10 paper: ~15 min for the bunny on 2 cores)");
+  cmd->add_option("--seed", r.seed, "seed of the initial weights and the shuffling (default 0)");
+  cmd->add_option("--batch-size", r.batch_size, "frames per batch (default 8; the official code uses 32)");
+  cmd->add_option("--lr", r.lr, "Adam learning rate (default 1e-3; the official code uses 2e-4)");
+  cmd->add_option("--w-recon", r.w_recon, "weight of the L1 reconstruction term (official 10)");
+  cmd->add_option("--w-zreg", r.w_zreg, "weight of the latent regularizer (official 2; paper: the ramp's end)");
+  cmd->add_option("--w-fn", r.w_fn, "weight of the face-normal term (0.001)");
+  cmd->add_option("--lr-decay-epochs", r.lr_decay_epochs, "halve the learning rate every that many epochs (default 10; 0: never)");
+  cmd->add_option("--knn", r.knn, "EdgeConv k (default 5)");
+  cmd->add_option("--upk", r.up_k, "upsampling neighbours (default: 10 official, 20 paper)");
   cmd->add_option("--holdout-every", a->holdout, "frames f with f % n == 0 are held out and evaluated (default 4; 0: none)");
-  cmd->add_flag("--residual,!--no-residual", a->residual,
+  cmd->add_flag("--residual,!--no-residual", r.residual,
                 "learn the correction of the Embedded interpolation, Δx = Embedded + network (default); --no-residual: the network alone");
-  cmd->add_flag("--without-fe", a->without_fe, "ablation w/o FE: h⁰ goes straight to the upsampling");
-  cmd->add_flag("--without-cu", a->without_cu, "ablation w/o CU: fixed Euclidean neighbours with free learned weights");
+  cmd->add_flag("--without-fe", r.without_fe, "ablation w/o FE: h⁰ goes straight to the upsampling");
+  cmd->add_flag("--without-cu", r.without_cu, "ablation w/o CU: fixed Euclidean neighbours with free learned weights");
   cmd->add_option("--checkpoint", a->checkpoint, "write a resumable checkpoint here after every epoch");
   cmd->add_option("--resume", a->resume, "continue from a checkpoint (same data and options)");
   cmd->add_option("--out-dir", a->out_dir, "write training_history.csv, training_loss.svg, holdout_error.svg here");

@@ -8,6 +8,8 @@
 //   simsr eval ...             error statistics of predicted HR frames against the truth
 //   simsr train ...            train the super-resolution network → one model .npz
 //   simsr infer ...            run a trained network on LR frames
+//   simsr datagen ...          simulate paired LR/HR data (the face)
+//   simsr demo ...             the paper's evaluation end to end (cmd_demo.cpp)
 // Errors: a message on stderr naming the file, and an exit code in 1..125 (errors.hpp).
 #include "cmd_baselines.hpp"
 #include "cmd_convert.hpp"
@@ -19,6 +21,7 @@
 #include "cmd_neighbors.hpp"
 #include "cmd_train.hpp"
 #include "cmd_upsample.hpp"
+#include "commands.hpp"
 #include "errors.hpp"
 
 #include <CLI/CLI.hpp>
@@ -41,6 +44,7 @@ int main(int argc, char** argv) {
   simsr::cli::add_train(app, action);
   simsr::cli::add_infer(app, action);
   simsr::cli::add_datagen(app, action);
+  simsr::cli::add_demo(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

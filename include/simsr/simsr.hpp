@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Umbrella header: every area of simsr, in the order data flows through them
-/// (core → mesh/io → discretize → physics → neighbors → data → scenario | nn → interp → eval).
+/// (core → mesh/io → discretize → physics → neighbors → data → scenario | nn → interp → eval → pipeline).
 /// Include single areas (simsr/mesh/mesh.hpp, simsr/interp/interp.hpp, ...) to keep compile
 /// times short.
 
@@ -15,4 +15,5 @@
 #include "neighbors/neighbors.hpp"
 #include "nn/nn.hpp"
 #include "physics/physics.hpp"
+#include "pipeline/pipeline.hpp"
 #include "scenario/scenario.hpp"

@@ -13,12 +13,14 @@
 /// says which methods read the §3.2 neighbourhoods.
 
 #include "apply_frames.hpp"
+#include "by_name.hpp"
 #include "beta_vae.hpp"
 #include "concepts.hpp"
 #include "embedded.hpp"
 #include "fit_and_train.hpp"
 #include "idw.hpp"
 #include "learned.hpp"
+#include "network_recipe.hpp"
 #include "mls.hpp"
 #include "problem.hpp"
 #include "rbf.hpp"

@@ -97,6 +97,13 @@ class SuperResolutionNet {
   SuperResolutionNet& operator=(const SuperResolutionNet&) = delete;
 
   const NetworkConfig& config() const { return cfg_; }
+  /// Zeroes the decoder's output layer, so the network starts by predicting 0: a correction
+  /// added to another predictor starts exactly at that predictor (done for cfg.residual at
+  /// construction). Call before training.
+  void zero_output_layer() {
+    decoder_->zero_output_layer();
+    parameters_changed();
+  }
   ParameterStore<S>& store() { return store_; }
   const ParameterStore<S>& store() const { return store_; }
   Index lr_points() const { return n_; }

@@ -7,6 +7,7 @@
 #include "face/ict_kit.hpp"
 #include "face/jaw.hpp"
 #include "face/face_datagen.hpp"
+#include "face/face_dataset.hpp"
 #include "face/face_model.hpp"
 #include "face/face_simulator.hpp"
 #include "face/face_views.hpp"

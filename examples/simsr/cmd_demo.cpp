@@ -1,0 +1,69 @@
+// `simsr demo [--dataset face|bunny] [--out DIR]`: the paper's evaluation end to end
+// (pipeline/demo.hpp): the face data (or the authors' bunny frames), the neighbourhoods, every
+// baseline, the super-resolution network trained on amazement + pain and every method evaluated
+// on anger + fear. Progress on stderr; Table 1 on stdout; DIR/report.json, DIR/results/
+// (statistics.csv, frame_errors.csv/.svg, heatmaps.pvd), DIR/predictions/, DIR/network/.
+// A rerun reuses the finished stages; a killed run continues (the network from its checkpoint).
+// Its own translation unit: the pipeline pulls in every area of the library.
+#include <simsr/pipeline/demo.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+
+namespace simsr::cli {
+
+namespace {
+struct DemoArgs {
+  pipeline::DemoOptions o;
+  std::string preset = "default";
+  bool no_network = false;
+};
+
+int demo_cmd(DemoArgs& a) {
+  a.o.face.model = scenario::face_model_preset(a.preset);
+  a.o.network = !a.no_network;
+  const auto report = pipeline::run_demo(exec::omp, a.o, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
+  std::cout << "Table 1 on the " << (a.o.dataset == "face" ? "test performances" : "held-out frames") << " (" << report.at("test_frames").get<Index>()
+            << " frames; error = distance of each HR vertex to the truth, mesh units; bbox diagonal " << report.at("bbox_diagonal").get<double>() << ")\n\n"
+            << pipeline::table1_text(report) << "report: " << (a.o.out / "report.json").string() << "; files people open: " << (a.o.out / "results").string()
+            << "/frame_errors.svg (browser), " << (a.o.out / "results").string() << "/heatmaps.pvd (ParaView)\n";
+  return 0;
+}
+}  // namespace
+
+void add_demo(CLI::App& app, std::function<int()>& action) {
+  auto* cmd = app.add_subcommand("demo", "The paper's evaluation end to end: data, neighbourhoods, baselines, the network, Table 1 and the files to open");
+  auto a = std::make_shared<DemoArgs>();
+  auto& o = a->o;
+  cmd->add_option("--dataset", o.dataset, "face (simulated from the ICT kit) or bunny (the authors' frames)")
+      ->check(CLI::IsMember({"face", "bunny"}))
+      ->capture_default_str();
+  cmd->add_option("--data", o.data, "the shared data folder (ict_face/, bunny/)")->capture_default_str();
+  cmd->add_option("--out", o.out, "output folder (a rerun reuses its finished stages)")->capture_default_str();
+  cmd->add_option("--preset", a->preset, "face mesh sizes: default, paper-ratio, paper-lr")->capture_default_str();
+  cmd->add_option("--frames", o.face.frames, "face: frames per performance")->capture_default_str()->check(CLI::Range(14, 100000));
+  cmd->add_option("--train-sequences", o.train_sequences, "face: performances trained on")->delimiter(',')->capture_default_str();
+  cmd->add_option("--test-sequences", o.test_sequences, "face: performances evaluated")->delimiter(',')->capture_default_str();
+  cmd->add_option("--holdout-every", o.bunny_holdout_every, "bunny: frames f with f % n == 0 are the test frames")->capture_default_str();
+  cmd->add_option("--methods", o.methods, "baselines (embedded idw rbf mls ridge beta_vae)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--k", o.method_parameters.k, "neighbours of the §3.2 neighbourhoods, IDW and MLS")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--vae-epochs", o.method_parameters.vae_epochs, "beta_vae: training epochs")->capture_default_str();
+  cmd->add_flag("--no-network", a->no_network, "evaluate the baselines only");
+  auto& r = o.recipe;
+  cmd->add_option("--epochs", r.epochs, "network: epochs (default 14)");
+  cmd->add_option("--batch-size", r.batch_size, "network: frames per batch")->capture_default_str();
+  cmd->add_option("--lr", r.lr, "network: Adam learning rate")->capture_default_str();
+  cmd->add_option("--lr-decay-epochs", r.lr_decay_epochs, "network: halve the learning rate every n epochs (0: never)")->capture_default_str();
+  cmd->add_option("--w-zreg", r.w_zreg, "network: weight of the latent regularizer (official 2)")->capture_default_str();
+  cmd->add_flag("--residual,!--no-residual", r.residual, "network: learn the correction of Embedded (default) or the displacement itself");
+  cmd->add_option("--seed", r.seed, "network: seed of the initial weights and the shuffling")->capture_default_str();
+  cmd->callback([&action, a] { action = [a] { return demo_cmd(*a); }; });
+}
+
+}  // namespace simsr::cli

@@ -1,0 +1,307 @@
+#pragma once
+/// \file
+/// The paper's evaluation end to end (§5, Table 1, Fig. 5), as stages a rerun reuses
+/// (pipeline/stages.hpp): on the face, the paired data (scenario::generate_face_dataset), the §3.2
+/// neighbourhoods, every baseline fitted (Embedded, IDW, RBF, MLS, ridge; the β-VAE trained), the
+/// super-resolution network trained on the training performances (resumable from its checkpoint),
+/// every method run on the test performances, and the results: Table 1 (statistics.csv and the
+/// JSON report), frame-wise errors (CSV + SVG), per-vertex error heatmaps (VTU) and every method's
+/// predictions (npz, for renders and the report page). On the bunny, the authors' frames with every
+/// 4th held out, as `simsr train` does.
+///
+///     pipeline::DemoOptions o;  o.out = "out/demo";
+///     nlohmann::ordered_json report = pipeline::run_demo(exec::omp, o, log);   // DIR/report.json too
+///
+/// Layout of DIR: data/ (face data set), neighbors.npz, predictions/<method>.npz, network/ (model,
+/// checkpoint, training history), results/ (Table 1, frame errors, heatmaps), stages/ (markers),
+/// report.json.
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "../data/data.hpp"
+#include "../eval/comparison.hpp"
+#include "../eval/evaluate.hpp"
+#include "../eval/training_history.hpp"
+#include "../interp/by_name.hpp"
+#include "../interp/learned.hpp"
+#include "../interp/network_recipe.hpp"
+#include "../scenario/face/face_dataset.hpp"
+#include "stages.hpp"
+
+namespace simsr::pipeline {
+
+struct DemoOptions {
+  std::string dataset = "face";                       ///< face | bunny
+  std::filesystem::path data = "../shared/data";      ///< the shared data folder (ict_face/, bunny/)
+  std::filesystem::path out = "out/demo";
+  scenario::FaceDatasetOptions face;                  ///< its kit is always data/ict_face
+  std::vector<std::string> train_sequences{"amazement", "pain"};  ///< face: §5's split
+  std::vector<std::string> test_sequences{"anger", "fear"};
+  Index bunny_holdout_every = 4;                      ///< bunny: frames f with f % n == 0 are the test frames
+  std::vector<std::string> methods{"embedded", "idw", "rbf", "mls", "ridge", "beta_vae"};
+  interp::MethodParameters method_parameters;         ///< k = 20: the paper's neighbourhoods
+  bool network = true;                                ///< train and evaluate the super-resolution network
+  interp::NetworkRecipe recipe;
+  std::string network_name = "network";               ///< its name in the tables (an ablation: another name)
+  bool progress = true;                               ///< training progress lines (network, β-VAE) on stderr
+};
+
+/// The frames a demo trains and tests on, and the problem they belong to.
+struct DemoData {
+  interp::UpsamplingProblem<> problem;
+  data::PairedFrames<> train, test;
+  std::string fingerprint;  ///< of the data's options (the files themselves are checked by their producers)
+  std::vector<std::string> test_names;  ///< per test frame: its sequence (face) or "holdout"
+  nlohmann::ordered_json summary;
+};
+
+namespace detail {
+
+inline data::PairedFrames<> read_sequences(const std::filesystem::path& dir, const std::vector<std::string>& names, Index n, Index m) {
+  std::vector<data::PairedFrames<>> parts;
+  for (const auto& name : names) parts.push_back(data::read_paired_frames(dir / (name + ".npz"), n, m));
+  return data::concatenate(std::span<const data::PairedFrames<>>(parts), std::span<const std::string>(names), data::FrameIds::renumber,
+                           data::FrameControls::drop);
+}
+
+/// The face data set (stage "data"), then its rest shapes and the two splits.
+template <exec::HostPolicy P>
+DemoData face_data(P policy, Stages& stages, const DemoOptions& o) {
+  auto fo = o.face;
+  fo.kit = o.data / "ict_face";
+  std::vector<std::string> wanted = o.train_sequences;
+  wanted.insert(wanted.end(), o.test_sequences.begin(), o.test_sequences.end());
+  for (const auto& w : wanted) {
+    const auto names = scenario::face_performance_names(fo);
+    if (std::find(names.begin(), names.end(), w) == names.end())
+      throw ArgumentError("demo: sequence '" + w + "' is not one of the performances simulated (" + std::to_string(names.size()) + " asked for)");
+  }
+  nlohmann::json options;
+  options["kit"] = fo.kit.string();
+  options["lr_cell"] = fo.model.lr_cell;
+  options["skull_lattice"] = fo.model.skull_lattice;
+  options["hr_max_volume"] = fo.model.hr.max_volume;
+  options["performances"] = fo.performances;
+  options["frames"] = fo.frames;
+  options["seed"] = fo.seed;
+  options["unseen_frames"] = fo.unseen_forces ? fo.unseen_frames : 0;
+  const auto dir = stages.dir() / "data";
+  DemoData d;
+  d.fingerprint = fingerprint_of(options);
+  d.summary = stages.run("data", d.fingerprint, [&] { return nlohmann::json(scenario::generate_face_dataset(policy, fo, dir, [&](const std::string& s) { stages.say(s); })); });
+  d.problem = interp::UpsamplingProblem<>{data::read_lr_rest(dir / "lr_rest.msh"), data::read_hr_rest(dir / "hr_rest.obj"), {}, {}};
+  d.train = read_sequences(dir, o.train_sequences, d.problem.num_lr(), d.problem.num_hr());
+  d.test = read_sequences(dir, o.test_sequences, d.problem.num_lr(), d.problem.num_hr());
+  for (Index f = 0; f < d.test.num_frames(); ++f) d.test_names.push_back(d.test.sequence_name(f));
+  return d;
+}
+
+/// The authors' bunny frames, every n-th held out.
+inline DemoData bunny_data(const DemoOptions& o) {
+  const auto dir = o.data / "bunny";
+  DemoData d;
+  d.problem = interp::UpsamplingProblem<>{data::read_lr_rest(dir / "lrestshape.obj"), data::read_hr_rest(dir / "hrestshape.obj"), {}, {}};
+  const auto frames = data::read_paired_frames(dir / "train_frames.npz", d.problem.num_lr(), d.problem.num_hr());
+  if (o.bunny_holdout_every < 2) throw ArgumentError("demo: the bunny's hold-out needs every n-th frame with n >= 2 (got " + std::to_string(o.bunny_holdout_every) + ")");
+  const auto split = data::holdout_every(frames.num_frames(), o.bunny_holdout_every);
+  d.train = frames.select(split.train);
+  d.test = frames.select(split.test);
+  d.test_names.assign(std::size_t(d.test.num_frames()), "holdout");
+  d.fingerprint = fingerprint_of({{"bunny", fingerprint_of_file(dir / "train_frames.npz")}, {"every", o.bunny_holdout_every}});
+  d.summary = {{"frames", frames.num_frames()}, {"holdout_every", o.bunny_holdout_every}};
+  return d;
+}
+
+inline std::filesystem::path prediction_file(const Stages& s, const std::string& method) { return s.dir() / "predictions" / (method + ".npz"); }
+
+/// Runs a fitted method on the test frames and writes its predictions (absolute HR positions,
+/// the test frames' ids); returns the apply time per frame.
+template <exec::HostPolicy P, class Method>
+double predict_test(P policy, const Method& method, const DemoData& d, const std::filesystem::path& file) {
+  data::FrameSet pred;
+  pred.has_ids = true;
+  pred.ids = d.test.ids;
+  pred.positions.resize(d.test.num_frames(), 3 * d.problem.num_hr());
+  const auto r = eval::evaluate(policy, method, d.problem.lr.V, d.problem.hr.V, d.test, [&](Index f, const Points<Scalar>& x) {
+    pred.positions.row(f) = Eigen::Map<const Eigen::Matrix<Scalar, 1, Eigen::Dynamic>>(x.data(), x.size());
+  });
+  std::filesystem::create_directories(file.parent_path());
+  data::write_frame_set(file, "highres", pred);
+  return r.seconds_per_frame;
+}
+
+}  // namespace detail
+
+/// Runs (or reuses) every stage and writes the results; returns the report (also DIR/report.json).
+template <exec::HostPolicy P>
+nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log = {}) {
+  if (o.dataset != "face" && o.dataset != "bunny") throw ArgumentError("demo: --dataset must be face or bunny (got '" + o.dataset + "')");
+  if (o.methods.empty() && !o.network) throw ArgumentError("demo: no method and no network: nothing to evaluate");
+  const auto t0 = std::chrono::steady_clock::now();
+  Stages stages(o.out, log);
+  DemoData d = o.dataset == "face" ? detail::face_data(policy, stages, o) : detail::bunny_data(o);
+  const auto& mp = o.method_parameters;
+
+  // §3.2 neighbourhoods and the LR graph, shared by IDW, MLS, RBF and the network.
+  const auto nb_file = o.out / "neighbors.npz";
+  const std::string nb_fp = fingerprint_of({{"data", d.fingerprint}, {"k", mp.k}});
+  const auto nb_result = stages.run("neighbors", nb_fp, [&] {
+    const auto nb = data::compute_network_neighborhoods(policy, d.problem.lr, d.problem.hr, mp.k, mp.k);
+    data::save_network_neighborhoods(nb_file, nb);
+    return nlohmann::json{{"k", mp.k}, {"assignment_cost", nb.upsampling.assignment_cost}, {"assignment_globally_optimal", nb.upsampling.assignment_globally_optimal}};
+  });
+  d.problem.use(data::read_network_neighborhoods(nb_file, d.problem.num_lr(), d.problem.num_hr()));
+
+  nlohmann::ordered_json methods_json;
+  std::vector<std::string> names;
+  for (const auto& name : o.methods) {
+    auto params = mp;
+    params.progress = o.progress;
+    nlohmann::json opts;
+    opts["k"] = params.k;
+    opts["power"] = params.power;
+    opts["sigma"] = params.sigma;
+    opts["degree"] = params.degree;
+    opts["mls_basis"] = params.mls_basis;
+    opts["rbf_distance"] = params.rbf_distance;
+    opts["vae_epochs"] = name == "beta_vae" ? params.vae_epochs : 0;
+    opts["seed"] = name == "beta_vae" ? params.seed : 0;
+    const std::string fp = fingerprint_of({{"neighbors", nb_fp}, {"method", name}, {"options", opts}});
+    methods_json[name] = stages.run("method-" + name, fp, [&] {
+      nlohmann::json r;
+      interp::with_method(name, params, [&](auto& method, const auto&... train_options) {
+        const auto t = std::chrono::steady_clock::now();
+        if constexpr (sizeof...(train_options) > 0)
+          interp::prepare(policy, method, d.problem, d.train, train_options..., params.k);
+        else
+          interp::prepare(policy, method, d.problem, params.k);
+        r["fit_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+        r["apply_seconds_per_frame"] = detail::predict_test(policy, method, d, detail::prediction_file(stages, name));
+      });
+      return r;
+    });
+    names.push_back(name);
+  }
+
+  nlohmann::ordered_json network_json;
+  if (o.network) {
+    const auto cfg = o.recipe.config();
+    const auto net_dir = o.out / o.network_name;
+    const std::string fp = fingerprint_of({{"neighbors", nb_fp}, {"recipe", o.recipe.to_json()}});
+    network_json = stages.run("network-" + o.network_name, fp, [&] {
+      std::filesystem::create_directories(net_dir);
+      interp::Learned<> net(cfg, o.recipe.seed);
+      interp::prepare(policy, net, d.problem, mp.k);
+      interp::NetworkTrainOptions to;
+      to.trainer.seed = o.recipe.seed;
+      to.trainer.progress = o.progress;
+      to.trainer.lr_decay_epochs = o.recipe.lr_decay_epochs;
+      to.checkpoint = net_dir / "checkpoint.npz";
+      // A checkpoint of this very run (the stage's marker is missing: it was killed) is resumed;
+      // one of another run is refused by the trainer, naming what differs.
+      const auto fp_file = net_dir / "checkpoint.fingerprint";
+      if (std::filesystem::exists(to.checkpoint) && std::filesystem::exists(fp_file)) {
+        std::ifstream in(fp_file);
+        std::string old;
+        in >> old;
+        if (old == fp) {
+          to.resume = to.checkpoint;
+          stages.say("network: resuming from " + to.checkpoint.string());
+        }
+      }
+      io::write_file_atomic(fp_file, fp + "\n");
+      const auto t = std::chrono::steady_clock::now();
+      net.train(policy, data::displacements(d.train, d.problem.lr.V, d.problem.hr.V), to);
+      const double train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+      net.save(net_dir / "model.npz");
+      const double diag = eval::bbox_diagonal(d.problem.hr.V);
+      eval::write_training_history(net_dir, net.history(), diag, -1);
+      nlohmann::json r;
+      r["model"] = (net_dir / "model.npz").string();
+      r["parameters"] = net.network().store().num_parameters();
+      r["epochs"] = net.epoch();
+      r["steps"] = net.steps();
+      r["train_seconds"] = train_seconds;
+      r["recipe"] = o.recipe.to_json();
+      r["apply_seconds_per_frame"] = detail::predict_test(policy, net, d, detail::prediction_file(stages, o.network_name));
+      return r;
+    });
+    methods_json[o.network_name] = network_json;
+    names.push_back(o.network_name);
+  }
+
+  // The results (cheap: always rewritten from the stored predictions).
+  stages.say("results: Table 1, frame errors, heatmaps");
+  eval::MethodComparison table(d.problem.hr.V, d.problem.hr.F, d.test);
+  const auto truth = [&] {
+    data::FrameSet t;
+    t.has_ids = true;
+    t.ids = d.test.ids;
+    t.positions = d.test.highres;
+    return t;
+  }();
+  for (const auto& name : names) {
+    const auto file = detail::prediction_file(stages, name);
+    const auto pred = data::read_frame_set(file, "highres", d.problem.num_hr());
+    auto r = eval::evaluate_predictions(d.problem.hr.V, pred, truth, file.string());
+    r.seconds_per_frame = methods_json[name].value("apply_seconds_per_frame", 0.0);
+    table.add(name, std::move(r));
+  }
+  table.write(o.out / "results");
+
+  nlohmann::ordered_json report;
+  report["dataset"] = o.dataset;
+  report["bbox_diagonal"] = table.diagonal();
+  report["train_frames"] = d.train.num_frames();
+  report["test_frames"] = d.test.num_frames();
+  if (o.dataset == "face") {
+    report["train_sequences"] = o.train_sequences;
+    report["test_sequences"] = o.test_sequences;
+  }
+  report["data"] = d.summary;
+  report["neighbors"] = nb_result;
+  const auto raw = table.statistics();
+  const auto norm = eval::normalized_to_largest(raw);
+  auto stats_json = [](const eval::ErrorStatistics& s) { return nlohmann::ordered_json{{"mean", s.mean}, {"median", s.median}, {"std", s.std}, {"max", s.max}, {"min", s.min}}; };
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    auto& m = report["table1"][names[i]];
+    m["raw"] = stats_json(raw[i]);
+    m["relative"] = stats_json(raw[i].scaled(table.diagonal()));
+    m["normalized"] = stats_json(norm[i]);
+    m["details"] = methods_json[names[i]];
+  }
+  report["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  io::write_file_atomic(o.out / "report.json", report.dump(2) + "\n");
+  return report;
+}
+
+/// Table 1 as aligned text (mean, median, std, max, min): raw, relative to the bounding-box
+/// diagonal and normalized to the largest, one block each.
+inline std::string table1_text(const nlohmann::ordered_json& report) {
+  std::string out;
+  char buf[256];
+  for (const char* kind : {"raw", "relative", "normalized"}) {
+    std::snprintf(buf, sizeof buf, "%-12s %12s %12s %12s %12s %12s   (%s)\n", "method", "mean", "median", "std", "max", "min", kind);
+    out += buf;
+    for (const auto& [name, m] : report.at("table1").items()) {
+      const auto& s = m.at(kind);
+      std::snprintf(buf, sizeof buf, "%-12s %12.4e %12.4e %12.4e %12.4e %12.4e\n", name.c_str(), s.at("mean").get<double>(), s.at("median").get<double>(),
+                    s.at("std").get<double>(), s.at("max").get<double>(), s.at("min").get<double>());
+      out += buf;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+}  // namespace simsr::pipeline

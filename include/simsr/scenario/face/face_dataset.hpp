@@ -1,0 +1,117 @@
+#pragma once
+/// \file
+/// The whole face data set in one call (what `simsr datagen --scenario face` and `simsr demo`
+/// run): the anatomical model from the ICT kit, every performance simulated at both resolutions
+/// (resumed and reused as face_datagen.hpp says), the VTU series for ParaView and the §5.3
+/// unseen-force LR frames; DIR/face_data.json summarizes it. Progress (frames/s, ETA) goes to the
+/// log, one line per frame.
+///
+///     scenario::FaceDatasetOptions o;  o.kit = "../shared/data/ict_face";
+///     auto report = scenario::generate_face_dataset(exec::omp, o, "out/face_data", log);
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "../../io/atomic_file.hpp"
+#include "face_datagen.hpp"
+#include "face_model.hpp"
+#include "face_views.hpp"
+#include "ict_kit.hpp"
+#include "performances.hpp"
+#include "unseen_forces.hpp"
+
+namespace simsr::scenario {
+
+/// What a face data set is made of.
+struct FaceDatasetOptions {
+  std::filesystem::path kit = "../shared/data/ict_face";
+  FaceModelOptions model = face_model_preset("default");
+  std::vector<std::string> performances{"amazement", "anger", "fear", "pain"};  ///< built-in ones
+  std::vector<std::filesystem::path> controls;  ///< controls files, each simulated as a performance
+  Index frames = 120;                           ///< per built-in performance
+  std::uint64_t seed = 1;                       ///< of the built-in performances
+  Index checkpoint_every = 10;
+  Index vtk_every = 10;                         ///< VTU series of every n-th frame (0: none)
+  bool unseen_forces = true;                    ///< the LR-only §5.3 sequences in DIR/unseen/
+  Index unseen_frames = 40;
+};
+
+/// The names of the performances `o` asks for, in the order they are simulated.
+inline std::vector<std::string> face_performance_names(const FaceDatasetOptions& o) {
+  std::vector<std::string> names = o.performances;
+  for (const auto& c : o.controls) names.push_back(performance_name_of(c));
+  return names;
+}
+
+/// Builds the model, simulates what `o` asks for into `out` and returns the summary (also written
+/// to out/face_data.json). `log` receives the progress lines (may be empty).
+template <exec::HostPolicy P>
+nlohmann::ordered_json generate_face_dataset(P policy, const FaceDatasetOptions& o, const std::filesystem::path& out,
+                                             const std::function<void(const std::string&)>& log = {}) {
+  using clock = std::chrono::steady_clock;
+  auto say = [&](const std::string& s) {
+    if (log) log(s);
+  };
+  char buf[512];
+  const auto t0 = clock::now();
+  const auto kit = read_ict_kit(o.kit);
+  say("datagen: building the face model (tetgen, lattice, muscles)...");
+  const FaceModel face = build_face_model(policy, kit, o.model, out / "mesh");
+  std::snprintf(buf, sizeof buf, "datagen: HR %lld tets, LR %lld tets (%.1fx), surface %lld vertices; built in %.1f s", (long long)face.hr.num_tets(),
+                (long long)face.lr.num_tets(), double(face.hr.num_tets()) / double(face.lr.num_tets()), (long long)face.surface.num_vertices(),
+                std::chrono::duration<double>(clock::now() - t0).count());
+  say(buf);
+  std::vector<Performance> perfs;
+  PerformanceOptions po;
+  po.frames = o.frames;
+  for (const auto& name : o.performances) perfs.push_back(builtin_performance(name, face.expression_names, o.seed, po));
+  for (const auto& file : o.controls) perfs.push_back(read_controls(file, performance_name_of(file)));
+  Index total = 0;
+  for (const auto& p : perfs) total += p.num_frames();
+  Index done = 0;
+  const auto start = clock::now();
+  FaceDatagenOptions opt;
+  opt.checkpoint_every = o.checkpoint_every;
+  opt.on_frame = [&](const std::string& perf, Index f, Index F, const physics::NewtonReport& rl, const physics::NewtonReport& rh, double sl, double sh) {
+    ++done;
+    const double el = std::chrono::duration<double>(clock::now() - start).count();
+    const double fps = double(done) / el;
+    const double eta = double(total - done) / fps;  // an upper bound: resumed frames are not simulated
+    std::snprintf(buf, sizeof buf, "datagen: %-10s frame %4lld/%lld | %.2f frames/s | LR %lld it %.2f s | HR %lld it %.2f s | ETA %d:%02d", perf.c_str(),
+                  (long long)f + 1, (long long)F, fps, (long long)rl.iterations, sl, (long long)rh.iterations, sh, int(eta) / 60, int(eta) % 60);
+    say(buf);
+  };
+  const auto stats = generate_face_data(policy, face, perfs, out, opt);
+  auto j = face_data_report(face, stats);
+  for (const auto& s : stats)
+    if (s.lip_intersecting_frames) {
+      std::snprintf(buf, sizeof buf,
+                    "datagen: warning: %s: the HR lips intersect in %lld frames (at most %lld triangle pairs): its controls press them harder than the contact holds",
+                    s.name.c_str(), (long long)s.lip_intersecting_frames, (long long)s.lip_max_pairs);
+      say(buf);
+    }
+  if (o.vtk_every > 0) {
+    std::vector<std::string> names;
+    for (const auto& p : perfs) names.push_back(p.name);
+    say("datagen: VTU series (every " + std::to_string(o.vtk_every) + " frames) in " + (out / "vtk").string());
+    write_face_data_views(policy, face, out, names, o.vtk_every);
+  }
+  if (o.unseen_forces) {
+    say("datagen: the unseen-force frames (LR only: a lip corner pulled, a sphere in the cheek)...");
+    UnseenForceOptions uo;
+    uo.frames = o.unseen_frames;
+    const auto us = generate_unseen_force_frames(policy, face, out, uo);
+    j["unseen_forces"] = unseen_force_report(us);
+  }
+  j["seconds"] = std::chrono::duration<double>(clock::now() - t0).count();
+  io::write_file_atomic(out / "face_data.json", j.dump(2) + "\n");
+  return j;
+}
+
+}  // namespace simsr::scenario
