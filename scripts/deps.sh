@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages simsr needs for a given job, only those missing.
-#   scripts/deps.sh run    build + run the main job
+#   scripts/deps.sh run    build + run the main job (tetgen for the face's HR mesh; python3-vtk9 with
+#                          xvfb for the renders of scripts/render_comparison.py)
 #   scripts/deps.sh test   + test peers (meshio, scipy, torch, gmsh, tetgen; python3-vtk9 with xvfb for
 #                          scripts/render_face.py) and what scripts/test.sh's
 #                          clang builds need: clang, libclang-rt-dev (ASan, UBSan, TSan, libFuzzer),
@@ -13,10 +14,9 @@ job=${1:-test}
 pkgs=(build-essential cmake ninja-build
       libeigen3-dev libxtensor-dev libnanoflann-dev libzip-dev
       doctest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
-      python3 python3-numpy)
+      python3 python3-numpy tetgen python3-vtk9 xvfb xauth)
 if [[ $job == test ]]; then
-  pkgs+=(python3-meshio python3-scipy python3-torch gmsh tetgen clang libclang-rt-dev libomp-dev llvm
-        python3-vtk9 xvfb xauth)
+  pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm)
 fi
 
 missing=()

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# The main job on the bundled data (installs missing Debian packages first, as root): on the bunny
-# example, the §3.2 upsampling neighbourhoods, every interpolation baseline (Embedded, IDW, MLS,
-# RBF, ridge) on the held-out frames (every 4th), then the super-resolution network trained on the
-# other frames (~15 minutes on 2 cores), run on the held-out frames and evaluated the same way:
-# Table-1 statistics, frame-wise errors (CSV + SVG), per-vertex error heatmaps (ParaView) in out/;
-# the cantilever verification of the quasistatic solver (JSON + deformed beams for ParaView);
-# plus mesh and array statistics of the bundled data and conversions to ParaView/Gmsh/MEDIT files.
+# The main job (installs missing Debian packages first, as root): `simsr demo`, the core paper's
+# evaluation on the face — the face simulated at two resolutions from the ICT kit (four
+# performances), the §3.2 neighbourhoods, every baseline (Embedded, IDW, RBF, MLS, ridge, the
+# β-VAE), the super-resolution network trained on amazement + pain, every method evaluated on
+# anger + fear: Table 1 on stdout and in out/demo/report.json, frame-wise errors (CSV + SVG),
+# per-vertex error heatmaps (ParaView), Fig. 6-style renders (PNG) in out/demo/results/; then the
+# cantilever verification of the quasistatic solver. A rerun reuses every finished stage; a killed
+# run continues where it stopped. `simsr demo --dataset bunny` runs the same on the authors' bunny.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -18,33 +19,19 @@ out=${SIMSR_OUT:-$root/out}
 mkdir -p "$out"
 simsr="$build/examples/simsr"
 set -x
-"$simsr" info "$data/bunny/lrestshape.obj"
-"$simsr" info "$data/bunny/hrestshape.obj"
-"$simsr" info "$data/bunny/train_frames.npz"
-"$simsr" info "$data/ict_face/neutral_face_head.obj"
-"$simsr" info "$data/ict_face/expressions.npz"
-"$simsr" convert "$data/bunny/lrestshape.obj" "$out/bunny_lr.vtu"
-"$simsr" convert "$data/bunny/lrestshape.obj" "$out/bunny_lr.msh"
-"$simsr" convert "$data/bunny/lrestshape.obj" "$out/bunny_lr.mesh"
-"$simsr" convert "$data/bunny/hrestshape.obj" "$out/bunny_hr.vtu"
-"$simsr" convert "$data/ict_face/neutral_face_head.obj" "$out/face.vtu"
-"$simsr" info "$out/bunny_lr.msh"
-"$simsr" neighbors --lr-rest "$data/bunny/lrestshape.obj" --hr-rest "$data/bunny/hrestshape.obj" --k 20 --lr-k 5 \
-  --out "$out/bunny_neighbors.npz"
-"$simsr" baselines --lr-rest "$data/bunny/lrestshape.obj" --hr-rest "$data/bunny/hrestshape.obj" \
-  --frames "$data/bunny/train_frames.npz" --neighbors "$out/bunny_neighbors.npz" --out-dir "$out/bunny_baselines"
-mkdir -p "$out/bunny_network"
-"$simsr" train --lr-rest "$data/bunny/lrestshape.obj" --hr-rest "$data/bunny/hrestshape.obj" \
-  --frames "$data/bunny/train_frames.npz" --neighbors "$out/bunny_neighbors.npz" --holdout-every 4 \
-  --checkpoint "$out/bunny_network/checkpoint.npz" --out-dir "$out/bunny_network" --out "$out/bunny_network/model.npz"
-"$simsr" infer --model "$out/bunny_network/model.npz" --frames "$data/bunny/train_frames.npz" --every 4 \
-  --out "$out/bunny_network/holdout_prediction.npz"
-"$simsr" eval --pred "$out/bunny_network/holdout_prediction.npz" --truth "$data/bunny/train_frames.npz" \
-  --hr-rest "$data/bunny/hrestshape.obj" --out "$out/bunny_network"
+"$simsr" demo --data "$data" --out "$out/demo" | tee "$out/demo/table1.txt.part"
+{ set +x; } 2>/dev/null
+mv "$out/demo/table1.txt.part" "$out/demo/table1.txt"
+for view in "$out"/demo/results/compare/*/; do
+  name=$(basename "$view")
+  /usr/bin/python3 scripts/render_comparison.py "$view" --out "$out/demo/results/compare_$name.png"
+done
+/usr/bin/python3 scripts/render_face.py "$out/demo/data/vtk/anger" --out "$out/demo/results/anger_lr_vs_hr.png"
+set -x
 # The quasistatic solver against Euler–Bernoulli beam theory (conforming and BCC embedded beams).
 "$build/examples/cantilever" --cells 10 --solver pcg-block-jacobi --vtu "$out/cantilever_conforming.vtu" | tee "$out/cantilever_conforming.json"
 "$build/examples/cantilever" --cells 6 --embedded --vtu "$out/cantilever_bcc.vtu" | tee "$out/cantilever_bcc.json"
 { set +x; } 2>/dev/null
-echo "simsr: wrote $(ls "$out" | tr '\n' ' ')to $out"
-echo "simsr: open out/bunny_baselines/frame_errors.svg and out/bunny_network/{holdout_error,frame_errors}.svg in a browser,"
-echo "       out/bunny_baselines/heatmaps.pvd, out/bunny_network/error_heatmap.vtu and out/*.vtu in ParaView"
+echo "simsr: Table 1 in $out/demo/table1.txt and $out/demo/report.json"
+echo "simsr: open $out/demo/results/frame_errors.svg and $out/demo/results/compare_*.png in a browser or viewer,"
+echo "       $out/demo/results/heatmaps.pvd and $out/demo/results/compare/*/*.vtu in ParaView"

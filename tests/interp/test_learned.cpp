@@ -2,10 +2,12 @@
 // geometry, training, inference and model files owned by the library, not the tool).
 #include <simsr/interp/embedded.hpp>
 #include <simsr/interp/learned.hpp>
+#include <simsr/interp/network_recipe.hpp>
 #include <simsr/mesh/generators.hpp>
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <random>
 
@@ -108,6 +110,62 @@ TEST_CASE("Learned: train, held-out error, seq == omp, save and load give the sa
   other.problem.hr.V *= 1.01;
   auto d = interp::Learned<>::from_model_file(file);
   CHECK_THROWS_WITH_AS(d.fit(exec::seq, other.problem), doctest::Contains("trained on other rest shapes"), ArgumentError);
+}
+
+TEST_CASE("Learned: the displacement scale is undone exactly: Embedded at start, the trainer's held-out error is apply's") {
+  auto s = net_scene(10, 6);
+  for (double k : {0.5, 7.0, 40.0}) {
+    CAPTURE(k);
+    nn::NetworkConfig cfg = residual_config();
+    cfg.displacement_scale = k;
+    CHECK(cfg.displacement_unit() == doctest::Approx(cfg.norm_std / k));
+    interp::Learned<> net(cfg, 2);
+    net.fit(exec::seq, s.problem);
+    interp::Embedded<> e;
+    e.fit(exec::seq, s.problem);
+    Points<> a(s.problem.num_hr(), 3), b(s.problem.num_hr(), 3);
+    const Points<> in = s.frames.lr(0);
+    net.apply(exec::seq, in, a);
+    e.apply(exec::seq, in, b);
+    CHECK((a - b).cwiseAbs().maxCoeff() <= 1e-6 * (1.0 + b.cwiseAbs().maxCoeff()));
+    // After training, the trainer's held-out error (network units × σ / k) is apply's, measured here.
+    const auto train = s.frames.select(std::vector<Index>{0, 1, 2, 3, 4, 5, 6, 7});
+    const auto held = s.frames.select(std::vector<Index>{8, 9});
+    auto o = quick(1);
+    o.holdout = &held;
+    net.train(exec::seq, train, o);
+    double sum = 0;
+    for (Index f = 0; f < 2; ++f) {
+      const Points<> x = held.lr(f);
+      net.apply(exec::seq, x, a);
+      sum += (a - held.hr(f)).rowwise().norm().sum();
+    }
+    CHECK(net.history().back().holdout_mean_error == doctest::Approx(sum / double(2 * s.problem.num_hr())).epsilon(1e-4));
+  }
+  nn::NetworkConfig bad = residual_config();
+  bad.displacement_scale = 0;
+  CHECK_THROWS_WITH_AS(bad.validate(), doctest::Contains("displacement_scale"), ArgumentError);
+  bad.displacement_scale = 3;
+  CHECK(nn::NetworkConfig::from_json(bad.to_json()).displacement_scale == 3);
+}
+
+TEST_CASE("NetworkRecipe: the automatic displacement scale makes the training frames' normalized HR RMS 1") {
+  auto s = net_scene(6, 7);
+  interp::NetworkRecipe r;
+  r.displacement_scale = 0;
+  const auto cfg = r.config(s.frames);
+  double sq = 0;
+  for (Index i = 0; i < s.frames.highres.size(); ++i) sq += std::pow(s.frames.highres.data()[i] / cfg.norm_std * cfg.displacement_scale, 2);
+  CHECK(std::sqrt(sq / double(s.frames.highres.size())) == doctest::Approx(1.0));
+  CHECK(r.config().displacement_scale == 1.0);  // without frames: nothing to measure, the official 1
+  r.displacement_scale = 4;
+  CHECK(r.config(s.frames).displacement_scale == 4);
+  r.displacement_scale = -1;
+  CHECK_THROWS_AS(r.config(), ArgumentError);
+  r.displacement_scale = 0;
+  auto still = s.frames;
+  still.highres.setZero();
+  CHECK_THROWS_WITH_AS(r.config(still), doctest::Contains("all zero"), ArgumentError);
 }
 
 TEST_CASE("Learned: a run resumed from its checkpoint ends where the uninterrupted run ends") {

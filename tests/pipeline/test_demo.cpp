@@ -88,6 +88,11 @@ TEST_CASE("pipeline::run_demo: every file, Table 1 checked independently, reuse,
     CHECK_MESSAGE(std::filesystem::exists(o.out / f), f);
   std::vector<std::string> names;
   for (const auto& [name, m] : rep["table1"].items()) names.push_back(name);
+  // Fig. 6's views: one folder (the one test "sequence" of the bunny layout) with the LR input,
+  // the truth and every method's surface; truth's error is 0, each method's its distance.
+  REQUIRE(rep["comparison_views"].size() == 1);
+  const auto views = o.out / "results" / "compare" / rep["comparison_views"][0].get<std::string>();
+  for (const char* f : {"lr_input.vtu", "truth.vtu", "embedded.vtu", "idw.vtu", "ridge.vtu", "network.vtu"}) CHECK_MESSAGE(std::filesystem::exists(views / f), f);
   CHECK(names == std::vector<std::string>{"embedded", "idw", "ridge", "network"});
 
   // Embedded's Table-1 mean recomputed here: its prediction of every held-out frame (f % 4 == 0).

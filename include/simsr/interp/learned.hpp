@@ -14,7 +14,7 @@
 /// files via `problem.use(...)`, or computed; Euclidean neighbours for the w/o CU ablation; the
 /// Embedded matrix for the residual composition), the official normalization of inputs and
 /// targets (positions (x − μ)/σ in float32 minus the normalized rest shape; predictions back to
-/// mesh units by σ), training with held-out evaluation and resumable checkpoints, and inference
+/// mesh units by σ; displacements scaled by the config's displacement_scale), training with held-out evaluation and resumable checkpoints, and inference
 /// through the precomputed upsampling weights.
 ///
 /// No silent failure: inputs must be finite and within float32's range after normalization
@@ -151,7 +151,7 @@ class Learned {
     if (hr_displacement.rows() != m) throw ShapeError("Learned::apply: HR displacement", {m, 3}, {hr_displacement.rows(), 3});
     normalize_into(lr_displacement, ldx_, "Learned::apply: LR displacement");
     net_->infer(policy, ldx_, pred_);
-    const double sigma = config_.norm_std;
+    const double sigma = config_.displacement_unit();
     for (Index r = 0; r < m; ++r)
       for (Index c = 0; c < 3; ++c) {
         const double v = double(pred_(r, c)) * sigma;
@@ -204,6 +204,7 @@ class Learned {
       }
     nn::ensure_shape(out, n, 3);
     nn::normalized_displacements(positions_, lr0_, config_.norm_mean, config_.norm_std, out);
+    if (config_.displacement_scale != 1.0) out *= network_scalar(config_.displacement_scale);
   }
 
   /// Frames of displacements as the trainer's normalized frames (HR through the same rule).
@@ -224,6 +225,7 @@ class Learned {
       hr_pos = model_.geometry.hr_rest + frames.hr(i);
       if (!hr_pos.allFinite()) throw ArgumentError("Learned::train: " + what + ", frame " + std::to_string(frames.ids[std::size_t(i)]) + ": HR displacement not finite");
       nn::normalized_displacements(hr_pos, hr0, config_.norm_mean, config_.norm_std, t.hdx.middleRows(i * m, m));
+      if (config_.displacement_scale != 1.0) t.hdx.middleRows(i * m, m) *= network_scalar(config_.displacement_scale);
     }
     return t;
   }

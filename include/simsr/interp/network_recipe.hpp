@@ -13,6 +13,8 @@
 ///     interp::NetworkRecipe r;  r.epochs = 6;  r.knn = 3;      // an EdgeConv-k ablation
 ///     interp::Learned<> net(r.config(), r.seed);
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -34,6 +36,9 @@ struct NetworkRecipe {
   Index knn = -1, up_k = -1;         ///< EdgeConv k, interpolation neighbours (−1: the preset's)
   bool without_fe = false, without_cu = false;  ///< §5.4 ablations
   std::uint64_t seed = 0;            ///< initial weights and shuffling
+  /// nn::NetworkConfig::displacement_scale: > 0 as given; 0: from the training frames (the RMS of
+  /// their normalized HR displacement becomes 1; config(frames)).
+  double displacement_scale = 1.0;
 
   /// Epochs when `epochs` < 0: about 15 minutes of the bunny example on 2 cores.
   static Index default_epochs(const std::string& profile) { return profile == "paper" ? 10 : 14; }
@@ -55,7 +60,22 @@ struct NetworkRecipe {
     if (w_zreg >= 0) cfg.w_zreg = w_zreg;
     if (w_fn >= 0) cfg.w_fn = w_fn;
     if (lr_decay_epochs < 0) throw ArgumentError("network recipe: lr decay epochs must be >= 0 (got " + std::to_string(lr_decay_epochs) + ")");
+    if (displacement_scale > 0) cfg.displacement_scale = displacement_scale;
+    else if (displacement_scale < 0 || !std::isfinite(displacement_scale)) throw ArgumentError("network recipe: displacement scale must be >= 0 (0: from the data)");
     cfg.validate();
+    return cfg;
+  }
+
+  /// config(), with displacement_scale 0 resolved from the training frames (displacements, as
+  /// interp::Learned::train takes them): 1 / RMS of every HR coordinate divided by σ.
+  template <class Frames>
+  nn::NetworkConfig config(const Frames& train_displacements) const {
+    nn::NetworkConfig cfg = config();
+    if (displacement_scale == 0) {
+      const double rms = std::sqrt(train_displacements.highres.squaredNorm() / double(std::max<Index>(1, train_displacements.highres.size()))) / cfg.norm_std;
+      if (!(rms > 0) || !std::isfinite(rms)) throw ArgumentError("network recipe: the training frames' HR displacements are all zero (or not finite): no displacement scale");
+      cfg.displacement_scale = 1.0 / rms;
+    }
     return cfg;
   }
 
@@ -63,7 +83,7 @@ struct NetworkRecipe {
   nlohmann::ordered_json to_json() const {
     return {{"profile", profile}, {"epochs", resolved_epochs()}, {"batch_size", batch_size}, {"lr", lr},          {"lr_decay_epochs", lr_decay_epochs},
             {"w_recon", w_recon}, {"w_zreg", w_zreg},            {"w_fn", w_fn},             {"residual", residual}, {"knn", knn},
-            {"up_k", up_k},       {"without_fe", without_fe},    {"without_cu", without_cu}, {"seed", seed}};
+            {"up_k", up_k},       {"without_fe", without_fe},    {"without_cu", without_cu}, {"seed", seed}, {"displacement_scale", displacement_scale}};
   }
 };
 

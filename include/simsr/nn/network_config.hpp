@@ -66,6 +66,13 @@ struct NetworkConfig {
   // --- data normalization (official dataset.py) ---------------------------------------------------
   double norm_mean = 0.5 * (0.04998 - 0.05092);
   double norm_std = 0.5 * (0.04998 + 0.05092);
+  /// simsr: displacements (the network's inputs and targets) are multiplied by this after the
+  /// official normalization, predictions divided by it; rest positions keep (x − μ)/σ. 1 is the
+  /// official code. Why: σ normalizes *positions* of a 10 cm bunny; a face's displacements of a few
+  /// mm, and the millimetre residual the network learns over Embedded, are then 1e-2…1e-3 in network
+  /// units, where Adam's fixed step size (lr) dwarfs the targets. NetworkRecipe picks it from the
+  /// training frames (the RMS of the normalized HR displacement → 1).
+  double displacement_scale = 1.0;
   // --- training ------------------------------------------------------------------------------------
   double lr = 2e-4;
   Index batch_size = 32;
@@ -122,6 +129,9 @@ struct NetworkConfig {
     if (!decoder_dims.empty()) decoder_dims.front() = latent_dim();
   }
 
+  /// Mesh units per network unit of displacement: σ / displacement_scale.
+  double displacement_unit() const { return norm_std / displacement_scale; }
+
   /// Width of the LR code z: D₀ + D₁ + … (or D₀ without feature embedding).
   Index latent_dim() const {
     if (!feature_embedding) return emb_feat_dims.at(0);
@@ -155,7 +165,7 @@ struct NetworkConfig {
     at_most("n_epochs", epochs, Index(1) << 24);
     at_most("zreg_ramp_steps", zreg_ramp_steps, Index(1) << 40);
     for (double v : {w0_initial, w0, up_w0_initial, up_w0, leaky_relu_slope, batchnorm_eps, batchnorm_momentum, lr, w_recon, w_fn, w_zreg,
-                     zreg_start, zreg_end, norm_mean, norm_std, dropout})
+                     zreg_start, zreg_end, norm_mean, norm_std, dropout, displacement_scale})
       if (!std::isfinite(v)) fail("every real-valued field must be finite");
     if (!(batchnorm_eps > 0) || !(batchnorm_momentum >= 0 && batchnorm_momentum <= 1)) fail("batchnorm eps must be > 0 and momentum in [0, 1]");
     if (pos_feat_dim < 2 || pos_feat_dim % 2) fail("pos_feat_dim must be even and >= 2");
@@ -175,6 +185,7 @@ struct NetworkConfig {
     if (!(w0_initial > 0) || !(w0 > 0) || !(up_w0_initial > 0) || !(up_w0 > 0)) fail("every ω₀ must be > 0");
     if (!(dropout >= 0 && dropout < 1)) fail("dropout must be in [0, 1)");
     if (!(norm_std > 0) || !std::isfinite(norm_mean)) fail("norm_std must be > 0 and norm_mean finite");
+    if (!(displacement_scale > 0)) fail("displacement_scale must be > 0");
     if (!(lr > 0)) fail("lr must be > 0");
     if (batch_size < 1) fail("batch_size must be >= 1");
     if (epochs < 0) fail("epochs must be >= 0");
@@ -212,6 +223,7 @@ struct NetworkConfig {
     f("residual", c.residual);
     f("norm_mean", c.norm_mean);
     f("norm_std", c.norm_std);
+    f("displacement_scale", c.displacement_scale);
     f("lr", c.lr);
     f("batch_size", c.batch_size);
     f("n_epochs", c.epochs);

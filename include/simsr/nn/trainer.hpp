@@ -78,6 +78,10 @@ TrainingFrames<S> training_frames(const NetworkConfig& cfg, const Eigen::MatrixB
                               std::to_string(r) + " is not finite");
     normalized_displacements(lo, lr0, cfg.norm_mean, cfg.norm_std, t.ldx.middleRows(i * t.n, t.n));
     normalized_displacements(hi, hr0, cfg.norm_mean, cfg.norm_std, t.hdx.middleRows(i * t.m, t.m));
+    if (cfg.displacement_scale != 1.0) {
+      t.ldx.middleRows(i * t.n, t.n) *= S(cfg.displacement_scale);
+      t.hdx.middleRows(i * t.m, t.m) *= S(cfg.displacement_scale);
+    }
     t.ids.push_back(ids.empty() ? std::int64_t(f) : ids.at(std::size_t(f)));
   }
   return t;
@@ -186,7 +190,7 @@ class Trainer {
     return rep;
   }
 
-  /// Mean HR vertex error (raw units: the normalized error × σ) over the held-out frames, eval mode.
+  /// Mean HR vertex error (raw units: the network's error × σ / displacement_scale) over the held-out frames, eval mode.
   template <exec::HostPolicy Policy>
   double holdout_error(Policy policy) {
     if (holdout_.frames == 0) return -1;
@@ -197,7 +201,7 @@ class Trainer {
       net_->infer(policy, holdout_.ldx.middleRows(f * N, N), pred_eval_);
       sum += (pred_eval_ - holdout_.hdx.middleRows(f * M, M)).template cast<double>().rowwise().norm().sum();
     }
-    const double error = sum / double(holdout_.frames * M) * net_->config().norm_std;
+    const double error = sum / double(holdout_.frames * M) * net_->config().displacement_unit();
     if (!std::isfinite(error)) throw NumericalError("nn::Trainer", "the held-out mean error", adam_.steps(), error);
     return error;
   }

@@ -142,6 +142,46 @@ double predict_test(P policy, const Method& method, const DemoData& d, const std
 
 }  // namespace detail
 
+/// Fig. 6's material for every test sequence: on its frame where the first method (Embedded in
+/// the default list) errs most, `dir/<sequence>_<frame id>/` gets lr_input.vtu (the LR simulation
+/// mesh), truth.vtu (the HR surface) and <method>.vtu (each method's predicted surface with its
+/// per-vertex `error`, mesh units), for ParaView and scripts/render_comparison.py. Returns the
+/// folders written.
+inline std::vector<std::string> write_comparison_views(const std::filesystem::path& dir, const DemoData& d, const eval::MethodComparison& table,
+                                                       const std::vector<data::FrameSet>& predictions) {
+  const auto& names = table.names();
+  std::vector<std::string> written;
+  const auto& first = table.evaluations().front().errors.frame_means();
+  std::vector<std::string> sequences = d.test_names;
+  std::sort(sequences.begin(), sequences.end());
+  sequences.erase(std::unique(sequences.begin(), sequences.end()), sequences.end());
+  for (const auto& seq : sequences) {
+    Index worst = -1;
+    for (Index f = 0; f < d.test.num_frames(); ++f)
+      if (d.test_names[std::size_t(f)] == seq && (worst < 0 || first[std::size_t(f)] > first[std::size_t(worst)])) worst = f;
+    const std::string folder = seq + "_" + std::to_string(d.test.ids[std::size_t(worst)]);
+    const auto out = dir / folder;
+    std::filesystem::create_directories(out);
+    io::VtuGrid lr;
+    lr.set_points(Points<Scalar>(d.test.lr(worst))).set_tets(d.problem.lr.T);
+    io::write_vtu(out / "lr_input.vtu", lr);
+    const Points<Scalar> truth = d.test.hr(worst);
+    io::VtuGrid t;
+    t.set_points(truth).set_triangles(d.problem.hr.F);
+    t.add_point_data("error", VecX<double>(VecX<double>::Zero(truth.rows())));
+    io::write_vtu(out / "truth.vtu", t);
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      const Points<Scalar> x = predictions[k].frame(worst);
+      io::VtuGrid g;
+      g.set_points(x).set_triangles(d.problem.hr.F);
+      g.add_point_data("error", VecX<double>((x - truth).rowwise().norm()));
+      io::write_vtu(out / (names[k] + ".vtu"), g);
+    }
+    written.push_back(folder);
+  }
+  return written;
+}
+
 /// Runs (or reuses) every stage and writes the results; returns the report (also DIR/report.json).
 template <exec::HostPolicy P>
 nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log = {}) {
@@ -250,14 +290,16 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
     t.positions = d.test.highres;
     return t;
   }();
+  std::vector<data::FrameSet> predictions;
   for (const auto& name : names) {
     const auto file = detail::prediction_file(stages, name);
-    const auto pred = data::read_frame_set(file, "highres", d.problem.num_hr());
-    auto r = eval::evaluate_predictions(d.problem.hr.V, pred, truth, file.string());
+    predictions.push_back(data::read_frame_set(file, "highres", d.problem.num_hr()));
+    auto r = eval::evaluate_predictions(d.problem.hr.V, predictions.back(), truth, file.string());
     r.seconds_per_frame = methods_json[name].value("apply_seconds_per_frame", 0.0);
     table.add(name, std::move(r));
   }
   table.write(o.out / "results");
+  const auto views = write_comparison_views(o.out / "results" / "compare", d, table, predictions);
 
   nlohmann::ordered_json report;
   report["dataset"] = o.dataset;
@@ -280,6 +322,7 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
     m["normalized"] = stats_json(norm[i]);
     m["details"] = methods_json[names[i]];
   }
+  report["comparison_views"] = views;
   report["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   io::write_file_atomic(o.out / "report.json", report.dump(2) + "\n");
   return report;
