@@ -12,7 +12,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from render_face import reexec_under_xvfb  # noqa: E402
+from render_face import read_surface, reexec_under_xvfb, write_png  # noqa: E402
 
 
 def main():
@@ -44,24 +44,10 @@ def main():
     import vtk  # Debian's python3-vtk9
     from vtk.util.numpy_support import vtk_to_numpy
 
-    def read(name):
-        r = vtk.vtkXMLUnstructuredGridReader()
-        r.SetFileName(os.path.join(a.folder, name + ".vtu"))
-        r.Update()
-        g = r.GetOutput()
-        if g.GetNumberOfPoints() == 0:
-            print(f"render_comparison.py: {name}.vtu has no points", file=sys.stderr)
-            sys.exit(2)
-        s = vtk.vtkDataSetSurfaceFilter()
-        s.SetInputData(g)
-        s.Update()
-        nrm = vtk.vtkPolyDataNormals()
-        nrm.SetInputData(s.GetOutput())
-        nrm.SplittingOff()
-        nrm.Update()
-        return nrm.GetOutput()
+    def read(name, smooth=True):
+        return read_surface(os.path.join(a.folder, name + ".vtu"), "render_comparison.py", smooth)
 
-    lr, truth = read("lr_input"), read("truth")
+    lr, truth = read("lr_input", smooth=False), read("truth")
     preds = {m: read(m) for m in methods}
     import numpy as np
     if a.max_mm > 0:
@@ -101,6 +87,8 @@ def main():
         actor.SetMapper(mapper)
         if not coloured:
             actor.GetProperty().SetColor(0.85, 0.78, 0.72)
+        if poly is lr:
+            actor.GetProperty().SetInterpolationToFlat()
         ren.AddActor(actor)
         text = vtk.vtkTextActor()
         text.SetInput(title)
@@ -121,8 +109,12 @@ def main():
     for i, m in enumerate(methods):
         panel(0, i + 1, preds[m], m, False)
         mean = float(np.mean(vtk_to_numpy(preds[m].GetPointData().GetArray("error"))))
-        panel(1, i + 1, preds[m], f"{m}: mean {mean * 1e3:.3f} mm", True)
+        panel(1, i + 1, preds[m], f"{m}: mean {mean:.3g}", True)
     panel(0, cols - 1, truth, "HR truth", False)
+    blank = vtk.vtkRenderer()  # under the truth: nothing to show, the page's white
+    blank.SetViewport((cols - 1) / cols, 0, 1, 0.5)
+    blank.SetBackground(1, 1, 1)
+    window.AddRenderer(blank)
     ren = panel(1, 0, truth, "error (m)", True)
     bar = vtk.vtkScalarBarActor()
     bar.SetLookupTable(lut)
@@ -131,16 +123,7 @@ def main():
     bar.SetWidth(0.15)
     bar.GetLabelTextProperty().SetColor(0, 0, 0)
     ren.AddActor2D(bar)
-    window.Render()
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(window)
-    grab.Update()
-    png = vtk.vtkPNGWriter()
-    tmp = a.out + ".part.png"
-    png.SetFileName(tmp)
-    png.SetInputConnection(grab.GetOutputPort())
-    png.Write()
-    os.replace(tmp, a.out)
+    write_png(window, a.out)
     print(f"render_comparison.py: wrote {a.out} ({len(methods)} methods, colour scale 0-{top * 1e3:.2f} mm)")
 
 

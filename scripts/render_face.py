@@ -27,6 +27,44 @@ def reexec_under_xvfb():
     sys.exit(subprocess.call([xvfb, "-a", "-s", "-screen 0 1920x1080x24", sys.executable, *sys.argv], env=env))
 
 
+def read_surface(path, who, smooth=True):
+    """The boundary surface of a .vtu file, with smooth normals (or flat facets: a blocky LR
+    lattice, where averaged normals of its opposite faces shade black); exit 2 when it has no points."""
+    import vtk
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(path)
+    r.Update()
+    g = r.GetOutput()
+    if g.GetNumberOfPoints() == 0:
+        print(f"{who}: {path} has no points", file=sys.stderr)
+        sys.exit(2)
+    s = vtk.vtkDataSetSurfaceFilter()
+    s.SetInputData(g)
+    s.Update()
+    if not smooth:
+        return s.GetOutput()
+    nrm = vtk.vtkPolyDataNormals()
+    nrm.SetInputData(s.GetOutput())
+    nrm.SplittingOff()
+    nrm.Update()
+    return nrm.GetOutput()
+
+
+def write_png(window, out):
+    """Renders `window` into the PNG `out`, atomically: a killed render leaves no half image under the real name."""
+    import vtk
+    window.Render()
+    grab = vtk.vtkWindowToImageFilter()
+    grab.SetInput(window)
+    grab.Update()
+    png = vtk.vtkPNGWriter()
+    tmp = out + ".part.png"
+    png.SetFileName(tmp)
+    png.SetInputConnection(grab.GetOutputPort())
+    png.Write()
+    os.replace(tmp, out)
+
+
 def series_files(folder, name):
     """The .vtu files of <folder>/<name>.pvd, in the collection's order."""
     pvd = os.path.join(folder, name + ".pvd")
@@ -63,24 +101,7 @@ def main():
             print(f"render_face.py: frame {f} outside the series' {n}", file=sys.stderr)
             sys.exit(2)
 
-    def read(path):
-        r = vtk.vtkXMLUnstructuredGridReader()
-        r.SetFileName(path)
-        r.Update()
-        g = r.GetOutput()
-        if g.GetNumberOfPoints() == 0:
-            print(f"render_face.py: {path} has no points", file=sys.stderr)
-            sys.exit(2)
-        s = vtk.vtkDataSetSurfaceFilter()
-        s.SetInputData(g)
-        s.Update()
-        nrm = vtk.vtkPolyDataNormals()
-        nrm.SetInputData(s.GetOutput())
-        nrm.SplittingOff()
-        nrm.Update()
-        return nrm.GetOutput()
-
-    rows = [(read(lr_files[f]), read(hr_files[f])) for f in frames]
+    rows = [(read_surface(lr_files[f], "render_face.py"), read_surface(hr_files[f], "render_face.py")) for f in frames]
     top = a.max_mm / 1e3 if a.max_mm > 0 else max(hr.GetPointData().GetArray("distance_to_lr").GetRange()[1] for _, hr in rows)
     lut = vtk.vtkLookupTable()
     lut.SetHueRange(0.667, 0.0)  # blue (0) to red (top)
@@ -135,16 +156,7 @@ def main():
             cam.SetViewUp(0, 1, 0)
             ren.ResetCameraClippingRange()
             window.AddRenderer(ren)
-    window.Render()
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(window)
-    grab.Update()
-    png = vtk.vtkPNGWriter()
-    tmp = a.out + ".part.png"
-    png.SetFileName(tmp)
-    png.SetInputConnection(grab.GetOutputPort())
-    png.Write()
-    os.replace(tmp, a.out)  # atomic: a killed render leaves no half image under the real name
+    write_png(window, a.out)
     print(f"render_face.py: wrote {a.out} ({len(rows)} frames, colour scale 0-{top * 1e3:.2f} mm)")
 
 

@@ -53,6 +53,8 @@ void add_demo(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--holdout-every", o.bunny_holdout_every, "bunny: frames f with f % n == 0 are the test frames")->capture_default_str();
   cmd->add_option("--methods", o.methods, "baselines (embedded idw rbf mls ridge beta_vae)")->delimiter(',')->capture_default_str();
   cmd->add_option("--k", o.method_parameters.k, "neighbours of the §3.2 neighbourhoods, IDW and MLS")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--rbf-distance", o.method_parameters.rbf_distance, "rbf: euclidean, geodesic or lr-mesh")->capture_default_str();
+  cmd->add_option("--rbf-regularization", o.method_parameters.rbf_regularization, "rbf: lambda added to the kernel's diagonal")->capture_default_str();
   cmd->add_option("--vae-epochs", o.method_parameters.vae_epochs, "beta_vae: training epochs")->capture_default_str();
   cmd->add_flag("--no-network", a->no_network, "evaluate the baselines only");
   auto& r = o.recipe;
@@ -61,8 +63,17 @@ void add_demo(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--lr", r.lr, "network: Adam learning rate")->capture_default_str();
   cmd->add_option("--lr-decay-epochs", r.lr_decay_epochs, "network: halve the learning rate every n epochs (0: never)")->capture_default_str();
   cmd->add_option("--w-zreg", r.w_zreg, "network: weight of the latent regularizer (official 2)")->capture_default_str();
+  cmd->add_option("--displacement-scale", r.displacement_scale, "network: multiply normalized displacements by this (1: official; 0: from the training frames)")
+      ->capture_default_str();
   cmd->add_flag("--residual,!--no-residual", r.residual, "network: learn the correction of Embedded (default) or the displacement itself");
   cmd->add_option("--seed", r.seed, "network: seed of the initial weights and the shuffling")->capture_default_str();
+  cmd->add_flag("--without-fe", r.without_fe, "network ablation w/o FE (§5.4)");
+  cmd->add_flag("--without-cu", r.without_cu, "network ablation w/o CU (§5.4)");
+  cmd->add_option("--knn", r.knn, "network: EdgeConv k (default 5)");
+  cmd->add_option("--upk", r.up_k, "network: interpolation neighbours (default 10; at most --k)");
+  cmd->add_option("--network-name", o.network_name,
+                  "network: its name in the tables and its folder (an ablation under another name leaves the default network's stage alone)")
+      ->capture_default_str();
   cmd->callback([&action, a] { action = [a] { return demo_cmd(*a); }; });
 }
 

@@ -35,7 +35,6 @@ struct TrainArgs {
 inline int train_cmd(const TrainArgs& a) {
   using clock = std::chrono::steady_clock;
   const auto t_start = clock::now();
-  const nn::NetworkConfig cfg = a.recipe.config();
   interp::UpsamplingProblem<> problem{data::read_lr_rest(a.lr), data::read_hr_rest(a.hr), {}, {}};
   nlohmann::ordered_json j;
   j["profile"] = a.recipe.profile;
@@ -48,11 +47,14 @@ inline int train_cmd(const TrainArgs& a) {
   } else {
     j["neighbors"] = "computed (assignment + k-label Dijkstra; LR geodesic kNN)";
   }
-  if (cfg.upsampling == nn::UpsamplingKind::table) j["neighbors"] = "Euclidean kNN (w/o CU)";
+  if (a.recipe.without_cu) j["neighbors"] = "Euclidean kNN (w/o CU)";
   const auto frames = data::read_paired_frames(a.frames, problem.num_lr(), problem.num_hr());
   const auto split = data::holdout_every(frames.num_frames(), a.holdout);
   const auto train = frames.select(split.train), test = frames.select(split.test);
+  const auto train_displacements = data::displacements(train, problem.lr.V, problem.hr.V);
+  const nn::NetworkConfig cfg = a.recipe.config(train_displacements);
   const auto held = data::displacements(test, problem.lr.V, problem.hr.V);
+  j["displacement_scale"] = cfg.displacement_scale;
 
   interp::Learned<> net(cfg, a.recipe.seed);
   interp::prepare(exec::omp, net, problem, cfg.up_k);  // geometry only: training follows
@@ -69,7 +71,7 @@ inline int train_cmd(const TrainArgs& a) {
   if (test.num_frames() > 0) o.holdout = &held;
   o.checkpoint = a.checkpoint;
   o.resume = a.resume;
-  net.train(exec::omp, data::displacements(train, problem.lr.V, problem.hr.V), o);
+  net.train(exec::omp, train_displacements, o);
   const auto t_train = clock::now();
   net.save(a.out);
 
@@ -117,6 +119,8 @@ inline void add_train(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--w-zreg", r.w_zreg, "weight of the latent regularizer (official 2; paper: the ramp's end)");
   cmd->add_option("--w-fn", r.w_fn, "weight of the face-normal term (0.001)");
   cmd->add_option("--lr-decay-epochs", r.lr_decay_epochs, "halve the learning rate every that many epochs (default 10; 0: never)");
+  cmd->add_option("--displacement-scale", r.displacement_scale,
+                  "multiply normalized displacements by this (1: official; 0: from the training frames, HR RMS 1)");
   cmd->add_option("--knn", r.knn, "EdgeConv k (default 5)");
   cmd->add_option("--upk", r.up_k, "upsampling neighbours (default: 10 official, 20 paper)");
   cmd->add_option("--holdout-every", a->holdout, "frames f with f % n == 0 are held out and evaluated (default 4; 0: none)");

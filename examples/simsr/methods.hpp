@@ -22,6 +22,7 @@ struct MethodArgs : interp::MethodParameters {
     cmd->add_option("--sigma", sigma, "rbf/mls: Gaussian width (0: from the data)");
     cmd->add_option("--degree", degree, "rbf: polynomial tail degree (-1 none, 0, 1)");
     cmd->add_option("--mls-basis", mls_basis, "mls: paper (Eq. 12-16, per coordinate, degree 2) or linear (3-D linear)");
+    cmd->add_option("--rbf-regularization", rbf_regularization, "rbf: lambda added to the kernel matrix's diagonal (0: exact interpolation)");
     cmd->add_option("--rbf-distance", rbf_distance,
                     "rbf: geodesic (HR-surface distances between mapped vertices, consistent), lr-mesh (the literal, inconsistent reading) or euclidean");
   }

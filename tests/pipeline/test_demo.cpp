@@ -173,6 +173,12 @@ TEST_CASE("pipeline::run_demo: bad options are named") {
   o.methods.clear();
   o.network = false;
   CHECK_THROWS_AS(pipeline::run_demo(exec::seq, o), ArgumentError);
+  for (const std::string bad : {"", "../x", "a b", "ridge", "data"}) {
+    o = small_options(dir);
+    o.network_name = bad;
+    CAPTURE(bad);
+    CHECK_THROWS_WITH_AS(pipeline::run_demo(exec::seq, o), doctest::Contains("network name"), ArgumentError);
+  }
   o = small_options(dir);
   o.bunny_holdout_every = 1;
   CHECK_THROWS_AS(pipeline::run_demo(exec::seq, o), ArgumentError);

@@ -32,6 +32,7 @@ struct MethodParameters {
   int degree = -1;                        ///< rbf: polynomial tail degree (-1 none, 0, 1)
   std::string mls_basis = "paper";        ///< mls: paper (Eq. 12–16) or linear (3-D linear)
   std::string rbf_distance = "geodesic";  ///< rbf: geodesic, lr-mesh or euclidean
+  double rbf_regularization = 0;          ///< rbf: λ added to Φ_LL's diagonal (coincident LR vertices need some)
   Index vae_epochs = 4;                   ///< beta_vae: training epochs
   std::uint64_t seed = 0;                 ///< beta_vae: initial weights, shuffling and noise
   bool progress = true;                   ///< beta_vae: progress line on stderr
@@ -57,6 +58,7 @@ void with_method(const std::string& name, const MethodParameters& a, Visit&& vis
     RBFOptions o;
     o.sigma = a.sigma;
     o.degree = a.degree;
+    o.regularization = a.rbf_regularization;
     if (a.rbf_distance == "euclidean")
       o.distance = RbfDistance::euclidean;
     else if (a.rbf_distance == "lr-mesh")

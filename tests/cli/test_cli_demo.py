@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""`simsr demo` on the authors' bunny (baselines only: the network is tested in tests/pipeline):
+Table 1 on stdout equal to report.json and statistics.csv, a rerun reuses every stage, the Fig. 6
+views render (scripts/render_comparison.py: non-blank panels, errors coloured), bad options fail
+with their exit codes.
+
+    /usr/bin/python3 tests/cli/test_cli_demo.py SIMSR WORK_DIR DATA_DIR REPO_DIR
+
+Exit 0: all passed; 1: a check failed; 77: numpy, python3-vtk9 or the data missing (1 under SIMSR_REQUIRE_PEERS=1)."""
+import csv
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+from checks import check, finish
+
+SIMSR, WORK, DATA, REPO = sys.argv[1:5]
+try:
+    import numpy as np
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+except ImportError as e:
+    print(f"MISSING (a failure under SIMSR_REQUIRE_PEERS=1, a skip otherwise): {e}")
+    sys.exit(1 if os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0") else 77)
+if not os.path.exists(os.path.join(DATA, "bunny", "train_frames.npz")):
+    print(f"MISSING: {DATA}/bunny/train_frames.npz")
+    sys.exit(1 if os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0") else 77)
+
+out = os.path.join(WORK, "demo")
+shutil.rmtree(out, ignore_errors=True)
+cmd = [SIMSR, "demo", "--dataset", "bunny", "--data", DATA, "--out", out, "--methods", "embedded,idw,ridge", "--no-network"]
+p = subprocess.run(cmd, capture_output=True, text=True)
+check(p.returncode == 0, f"simsr demo: exit {p.returncode}: {p.stderr[-2000:]}")
+report = json.load(open(os.path.join(out, "report.json")))
+check(report["test_frames"] == 64 and report["train_frames"] == 192, f"bunny split: {report['train_frames']} / {report['test_frames']}")
+names = list(report["table1"])
+check(names == ["embedded", "idw", "ridge"], f"methods in order: {names}")
+rows = {r["method"]: r for r in csv.DictReader(open(os.path.join(out, "results", "statistics.csv")))}
+for m in names:
+    for kind, prefix in (("raw", ""), ("relative", "rel_"), ("normalized", "norm_")):
+        for stat in ("mean", "median", "std", "max", "min"):
+            a, b = report["table1"][m][kind][stat], float(rows[m][prefix + stat])
+            check(abs(a - b) <= 1e-9 * max(abs(a), 1e-300), f"{m} {kind} {stat}: report {a} vs statistics.csv {b}")
+# the printed table: the relative block's means, to the 5 digits printed
+lines = p.stdout.splitlines()
+start = next(i for i, l in enumerate(lines) if l.strip().startswith("method") and "(relative)" in l)
+for m, line in zip(names, lines[start + 1:start + 4]):
+    fields = line.split()
+    check(fields[0] == m, f"printed row {fields[0]} is {m}")
+    check(abs(float(fields[1]) - report["table1"][m]["relative"]["mean"]) <= 1e-4 * report["table1"][m]["relative"]["mean"], f"{m}: printed mean {fields[1]}")
+check(report["table1"]["ridge"]["relative"]["mean"] < 1e-4 < report["table1"]["embedded"]["relative"]["mean"],
+      "the bunny's frames are a linear family: ridge below 1e-4 of the diagonal, Embedded above")
+for f in ("frame_errors.csv", "frame_errors.svg", "heatmaps.pvd"):
+    check(os.path.exists(os.path.join(out, "results", f)), f"results/{f} written")
+
+again = subprocess.run(cmd, capture_output=True, text=True)
+check(again.returncode == 0, f"rerun: exit {again.returncode}")
+reused = [l for l in again.stderr.splitlines() if "reused" in l]
+check(len(reused) == 4, f"rerun reuses neighbors and the three methods: {len(reused)} lines")
+check(json.load(open(os.path.join(out, "report.json")))["table1"] == report["table1"], "rerun: the same Table 1")
+
+views = report["comparison_views"]
+check(len(views) == 1, f"one comparison view (the bunny's hold-out): {views}")
+png = os.path.join(WORK, "compare.png")
+if os.path.exists(png):
+    os.remove(png)
+r = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "render_comparison.py"), os.path.join(out, "results", "compare", views[0]),
+                    "--out", png, "--size", "160"], capture_output=True, text=True)
+check(r.returncode == 0, f"render_comparison.py: exit {r.returncode}: {r.stderr.strip()}")
+if os.path.exists(png):
+    rd = vtk.vtkPNGReader()
+    rd.SetFileName(png)
+    rd.Update()
+    img = rd.GetOutput()
+    w, h, _ = img.GetDimensions()
+    check((w, h) == (5 * 160, 2 * 160), f"LR, 3 methods, truth × 2 rows of 160 px: {w}×{h}")
+    rgb = vtk_to_numpy(img.GetPointData().GetScalars()).reshape(h, w, -1)[:, :, :3].astype(int)[::-1]
+    for row in range(2):
+        for col in range(5):
+            if row == 1 and col == 4:
+                continue  # no panel under the truth
+            panel = rgb[row * 160:(row + 1) * 160, col * 160:(col + 1) * 160]
+            drawn = (np.abs(panel - 255).sum(-1) > 60).mean()
+            check(drawn > 0.05, f"panel ({row}, {col}) shows the surface: {drawn:.2f} drawn")
+    emb = rgb[160:320, 160:320]
+    check(((emb[:, :, 0] > emb[:, :, 2] + 80)).sum() > 20, "Embedded's error panel has red (large error) pixels")
+bad = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "render_comparison.py"), os.path.join(WORK, "missing"), "--out", png],
+                     capture_output=True, text=True)
+check(bad.returncode == 2 and "not found" in bad.stderr, f"render_comparison.py on a missing folder: exit {bad.returncode}")
+
+bad = subprocess.run([SIMSR, "demo", "--dataset", "cat", "--out", out], capture_output=True, text=True)
+check(bad.returncode == 64, f"--dataset cat: usage error 64, got {bad.returncode}")
+bad = subprocess.run([SIMSR, "demo", "--dataset", "bunny", "--data", DATA, "--out", out, "--methods", "embedded,spline", "--no-network"],
+                     capture_output=True, text=True)
+check(bad.returncode == 5 and "spline" in bad.stderr, f"--methods spline: argument error 5 naming it, got {bad.returncode}: {bad.stderr.strip()}")
+finish()
