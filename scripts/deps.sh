@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages simsr needs for a given job, only those missing.
 #   scripts/deps.sh run    build + run the main job (tetgen for the face's HR mesh; python3-vtk9 with
-#                          xvfb for the renders of scripts/render_comparison.py)
+#                          xvfb for the renders of scripts/render_comparison.py; npm, with which the
+#                          build vendors three.js for the report page)
 #   scripts/deps.sh test   + test peers (meshio, scipy, torch, gmsh, tetgen; python3-vtk9 with xvfb for
-#                          scripts/render_face.py) and what scripts/test.sh's
+#                          scripts/render_face.py; chromium for the report page) and what scripts/test.sh's
 #                          clang builds need: clang, libclang-rt-dev (ASan, UBSan, TSan, libFuzzer),
 #                          libomp-dev (LLVM's OpenMP and its Archer tool, libarcher.so, for TSan) and
 #                          llvm (llvm-symbolizer: sanitizer reports with file and line)
@@ -14,9 +15,9 @@ job=${1:-test}
 pkgs=(build-essential cmake ninja-build
       libeigen3-dev libxtensor-dev libnanoflann-dev libzip-dev
       doctest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
-      python3 python3-numpy tetgen python3-vtk9 xvfb xauth)
+      python3 python3-numpy tetgen python3-vtk9 xvfb xauth npm)
 if [[ $job == test ]]; then
-  pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm)
+  pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium)
 fi
 
 missing=()

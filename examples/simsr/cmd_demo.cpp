@@ -2,7 +2,8 @@
 // (pipeline/demo.hpp): the face data (or the authors' bunny frames), the neighbourhoods, every
 // baseline, the super-resolution network trained on amazement + pain and every method evaluated
 // on anger + fear. Progress on stderr; Table 1 on stdout; DIR/report.json, DIR/results/
-// (statistics.csv, frame_errors.csv/.svg, heatmaps.pvd), DIR/predictions/, DIR/network/.
+// (statistics.csv, frame_errors.csv/.svg, heatmaps.pvd), DIR/report/index.html (the page to open:
+// Table 1, the plot, a 3D viewer), DIR/predictions/, DIR/network/.
 // A rerun reuses the finished stages; a killed run continues (the network from its checkpoint).
 // Its own translation unit: the pipeline pulls in every area of the library.
 #include <simsr/pipeline/demo.hpp>
@@ -15,6 +16,10 @@
 #include <string>
 
 #include "commands.hpp"
+
+#ifndef SIMSR_VENDOR_DIR
+#define SIMSR_VENDOR_DIR ""
+#endif
 
 namespace simsr::cli {
 
@@ -32,7 +37,8 @@ int demo_cmd(DemoArgs& a) {
   std::cout << "Table 1 on the " << (a.o.dataset == "face" ? "test performances" : "held-out frames") << " (" << report.at("test_frames").get<Index>()
             << " frames; error = distance of each HR vertex to the truth, mesh units; bbox diagonal " << report.at("bbox_diagonal").get<double>() << ")\n\n"
             << pipeline::table1_text(report) << "report: " << (a.o.out / "report.json").string() << "; files people open: " << (a.o.out / "results").string()
-            << "/frame_errors.svg (browser), " << (a.o.out / "results").string() << "/heatmaps.pvd (ParaView)\n";
+            << "/frame_errors.svg (browser), " << (a.o.out / "results").string() << "/heatmaps.pvd (ParaView), "
+            << (a.o.out / "report" / "index.html").string() << " (browser)\n";
   return 0;
 }
 }  // namespace
@@ -41,11 +47,14 @@ void add_demo(CLI::App& app, std::function<int()>& action) {
   auto* cmd = app.add_subcommand("demo", "The paper's evaluation end to end: data, neighbourhoods, baselines, the network, Table 1 and the files to open");
   auto a = std::make_shared<DemoArgs>();
   auto& o = a->o;
+  o.vendor_dir = SIMSR_VENDOR_DIR;
   cmd->add_option("--dataset", o.dataset, "face (simulated from the ICT kit) or bunny (the authors' frames)")
       ->check(CLI::IsMember({"face", "bunny"}))
       ->capture_default_str();
   cmd->add_option("--data", o.data, "the shared data folder (ict_face/, bunny/)")->capture_default_str();
   cmd->add_option("--out", o.out, "output folder (a rerun reuses its finished stages)")->capture_default_str();
+  cmd->add_option("--vendor-dir", o.vendor_dir, "node_modules holding three@0.147.0 for the report page (default: the build's)")->capture_default_str();
+  cmd->add_option("--viewer-frames", o.viewer_frames, "frames of each test sequence the report page's viewer plays")->capture_default_str()->check(CLI::Range(1, 1000));
   cmd->add_option("--preset", a->preset, "face mesh sizes: default, paper-ratio, paper-lr")->capture_default_str();
   cmd->add_option("--frames", o.face.frames, "face: frames per performance")->capture_default_str()->check(CLI::Range(14, 100000));
   cmd->add_option("--train-sequences", o.train_sequences, "face: performances trained on")->delimiter(',')->capture_default_str();
@@ -58,11 +67,11 @@ void add_demo(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--vae-epochs", o.method_parameters.vae_epochs, "beta_vae: training epochs")->capture_default_str();
   cmd->add_flag("--no-network", a->no_network, "evaluate the baselines only");
   auto& r = o.recipe;
-  cmd->add_option("--epochs", r.epochs, "network: epochs (default 14)");
+  cmd->add_option("--epochs", r.epochs, "network: epochs")->capture_default_str();
   cmd->add_option("--batch-size", r.batch_size, "network: frames per batch")->capture_default_str();
   cmd->add_option("--lr", r.lr, "network: Adam learning rate")->capture_default_str();
   cmd->add_option("--lr-decay-epochs", r.lr_decay_epochs, "network: halve the learning rate every n epochs (0: never)")->capture_default_str();
-  cmd->add_option("--w-zreg", r.w_zreg, "network: weight of the latent regularizer (official 2)")->capture_default_str();
+  cmd->add_option("--w-zreg", r.w_zreg, "network: weight of the latent regularizer (-1: the official 2)")->capture_default_str();
   cmd->add_option("--displacement-scale", r.displacement_scale, "network: multiply normalized displacements by this (1: official; 0: from the training frames)")
       ->capture_default_str();
   cmd->add_flag("--residual,!--no-residual", r.residual, "network: learn the correction of Embedded (default) or the displacement itself");

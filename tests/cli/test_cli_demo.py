@@ -4,9 +4,11 @@ Table 1 on stdout equal to report.json and statistics.csv, a rerun reuses every 
 views render (scripts/render_comparison.py: non-blank panels, errors coloured), bad options fail
 with their exit codes.
 
-    /usr/bin/python3 tests/cli/test_cli_demo.py SIMSR WORK_DIR DATA_DIR REPO_DIR
+    /usr/bin/python3 tests/cli/test_cli_demo.py SIMSR WORK_DIR DATA_DIR REPO_DIR NODE NODE_MODULES
 
-Exit 0: all passed; 1: a check failed; 77: numpy, python3-vtk9 or the data missing (1 under SIMSR_REQUIRE_PEERS=1)."""
+Then the report page in headless chromium (tests/cli/test_report_page.js, node + playwright-core).
+Exit 0: all passed; 1: a check failed; 77: numpy, python3-vtk9, the data, node, playwright-core or
+chromium missing (1 under SIMSR_REQUIRE_PEERS=1)."""
 import csv
 import json
 import os
@@ -16,7 +18,8 @@ import sys
 
 from checks import check, finish
 
-SIMSR, WORK, DATA, REPO = sys.argv[1:5]
+SIMSR, WORK, DATA, REPO, NODE, MODULES = sys.argv[1:7]
+REQUIRE = os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0")
 try:
     import numpy as np
     import vtk
@@ -95,4 +98,17 @@ check(bad.returncode == 64, f"--dataset cat: usage error 64, got {bad.returncode
 bad = subprocess.run([SIMSR, "demo", "--dataset", "bunny", "--data", DATA, "--out", out, "--methods", "embedded,spline", "--no-network"],
                      capture_output=True, text=True)
 check(bad.returncode == 5 and "spline" in bad.stderr, f"--methods spline: argument error 5 naming it, got {bad.returncode}: {bad.stderr.strip()}")
+
+# The report page: loads from disk without console errors, Table 1 = report.json, the viewer draws.
+check(os.path.exists(os.path.join(out, "report", "index.html")), "report/index.html written")
+if not NODE or not MODULES:
+    print("MISSING: node or the vendored node_modules (npm at configure time): the report page's browser test did not run")
+    check(not REQUIRE, "SIMSR_REQUIRE_PEERS: the report page's browser test must run")
+else:
+    page = subprocess.run([NODE, os.path.join(REPO, "tests", "cli", "test_report_page.js"), out, MODULES], capture_output=True, text=True)
+    print(page.stdout.strip())
+    if page.returncode == 77:
+        check(not REQUIRE, "SIMSR_REQUIRE_PEERS: the report page's browser test must run: " + page.stdout.strip())
+    else:
+        check(page.returncode == 0, f"report page in headless chromium: exit {page.returncode}: {page.stdout[-1500:]} {page.stderr[-1500:]}")
 finish()
