@@ -11,7 +11,7 @@ const path = require('path');
 const [outDir, modules, chromiumPath = '/usr/bin/chromium'] = process.argv.slice(2);
 let chromium;
 try {
-  ({ chromium } = require(path.join(modules, 'playwright-core')));
+  ({ chromium } = require(path.resolve(modules, 'playwright-core')));
 } catch (e) {
   console.log('MISSING: playwright-core in ' + modules + ': ' + e.message);
   process.exit(77);
