@@ -173,7 +173,7 @@ TEST_CASE("pipeline::run_demo: bad options are named") {
   o.methods.clear();
   o.network = false;
   CHECK_THROWS_AS(pipeline::run_demo(exec::seq, o), ArgumentError);
-  for (const std::string bad : {"", "../x", "a b", "ridge", "data"}) {
+  for (const std::string bad : {"", "../x", "a b", "ridge", "data", "report"}) {
     o = small_options(dir);
     o.network_name = bad;
     CAPTURE(bad);

@@ -217,7 +217,7 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
   });
   if (!plain_name || std::find(o.methods.begin(), o.methods.end(), o.network_name) != o.methods.end() || o.network_name == "data" ||
-      o.network_name == "results" || o.network_name == "predictions" || o.network_name == "stages")
+      o.network_name == "results" || o.network_name == "predictions" || o.network_name == "stages" || o.network_name == "report")
     throw ArgumentError("demo: network name '" + o.network_name + "' must be letters, digits, _ or - and not a method's or a folder's name");
   const auto t0 = std::chrono::steady_clock::now();
   Stages stages(o.out, log);
@@ -278,8 +278,9 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
       to.trainer.progress = o.progress;
       to.trainer.lr_decay_epochs = o.recipe.lr_decay_epochs;
       to.checkpoint = net_dir / "checkpoint.npz";
-      // A checkpoint of this very run (the stage's marker is missing: it was killed) is resumed;
-      // one of another run is refused by the trainer, naming what differs.
+      // A checkpoint of this very stage (same fingerprint; its marker is missing: the run was
+      // killed) is resumed; one written under other options is not: training starts over and
+      // replaces it. (The trainer itself refuses a checkpoint of other data or options.)
       const auto fp_file = net_dir / "checkpoint.fingerprint";
       if (std::filesystem::exists(to.checkpoint) && std::filesystem::exists(fp_file)) {
         std::ifstream in(fp_file);
