@@ -12,7 +12,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from render_face import read_surface, reexec_under_xvfb, write_png  # noqa: E402
+from render_face import label_and_frame, read_surface, reexec_under_xvfb, write_png  # noqa: E402
 
 
 def main():
@@ -90,18 +90,7 @@ def main():
         if poly is lr:
             actor.GetProperty().SetInterpolationToFlat()
         ren.AddActor(actor)
-        text = vtk.vtkTextActor()
-        text.SetInput(title)
-        text.GetTextProperty().SetColor(0, 0, 0)
-        text.GetTextProperty().SetFontSize(14)
-        text.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-        text.GetPositionCoordinate().SetValue(0.03, 0.03)
-        ren.AddActor2D(text)
-        cam = ren.GetActiveCamera()
-        cam.SetFocalPoint(*centre)
-        cam.SetPosition(centre[0] + 0.35 * height, centre[1] + 0.1 * height, centre[2] + 2.2 * height)
-        cam.SetViewUp(0, 1, 0)
-        ren.ResetCameraClippingRange()
+        label_and_frame(ren, title, centre, height)
         window.AddRenderer(ren)
         return ren
 

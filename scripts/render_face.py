@@ -50,6 +50,24 @@ def read_surface(path, who, smooth=True):
     return nrm.GetOutput()
 
 
+def label_and_frame(ren, title, centre, height):
+    """A black title in the panel's lower left and the camera every render uses: the face from
+    the front, a little from the left, its height filling the panel."""
+    import vtk
+    text = vtk.vtkTextActor()
+    text.SetInput(title)
+    text.GetTextProperty().SetColor(0, 0, 0)
+    text.GetTextProperty().SetFontSize(14)
+    text.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+    text.GetPositionCoordinate().SetValue(0.03, 0.03)
+    ren.AddActor2D(text)
+    cam = ren.GetActiveCamera()
+    cam.SetFocalPoint(*centre)
+    cam.SetPosition(centre[0] + 0.35 * height, centre[1] + 0.1 * height, centre[2] + 2.2 * height)
+    cam.SetViewUp(0, 1, 0)
+    ren.ResetCameraClippingRange()
+
+
 def write_png(window, out):
     """Renders `window` into the PNG `out`, atomically: a killed render leaves no half image under the real name."""
     import vtk
@@ -143,18 +161,7 @@ def main():
             if c < 2:
                 actor.GetProperty().SetColor(0.85, 0.78, 0.72)
             ren.AddActor(actor)
-            text = vtk.vtkTextActor()
-            text.SetInput(f"{titles[c]}  (series frame {frames[r]})" if c == 0 else titles[c])
-            text.GetTextProperty().SetColor(0, 0, 0)
-            text.GetTextProperty().SetFontSize(14)
-            text.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-            text.GetPositionCoordinate().SetValue(0.03, 0.03)
-            ren.AddActor2D(text)
-            cam = ren.GetActiveCamera()
-            cam.SetFocalPoint(*centre)
-            cam.SetPosition(centre[0] + 0.35 * height, centre[1] + 0.1 * height, centre[2] + 2.2 * height)  # front, a little from the left
-            cam.SetViewUp(0, 1, 0)
-            ren.ResetCameraClippingRange()
+            label_and_frame(ren, f"{titles[c]}  (series frame {frames[r]})" if c == 0 else titles[c], centre, height)
             window.AddRenderer(ren)
     write_png(window, a.out)
     print(f"render_face.py: wrote {a.out} ({len(rows)} frames, colour scale 0-{top * 1e3:.2f} mm)")

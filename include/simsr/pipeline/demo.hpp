@@ -89,6 +89,14 @@ struct DemoData {
   std::string fingerprint;  ///< of the data's options (the files themselves are checked by their producers)
   std::vector<std::string> test_names;  ///< per test frame: its sequence (face) or "holdout"
   nlohmann::ordered_json summary;
+
+  /// The distinct test sequences, in the order their frames come.
+  std::vector<std::string> test_sequences() const {
+    std::vector<std::string> out;
+    for (const auto& n : test_names)
+      if (std::find(out.begin(), out.end(), n) == out.end()) out.push_back(n);
+    return out;
+  }
 };
 
 namespace detail {
@@ -178,10 +186,7 @@ inline std::vector<std::string> write_comparison_views(const std::filesystem::pa
   const auto& names = table.names();
   std::vector<std::string> written;
   const auto& first = table.evaluations().front().errors.frame_means();
-  std::vector<std::string> sequences = d.test_names;
-  std::sort(sequences.begin(), sequences.end());
-  sequences.erase(std::unique(sequences.begin(), sequences.end()), sequences.end());
-  for (const auto& seq : sequences) {
+  for (const auto& seq : d.test_sequences()) {
     Index worst = -1;
     for (Index f = 0; f < d.test.num_frames(); ++f)
       if (d.test_names[std::size_t(f)] == seq && (worst < 0 || first[std::size_t(f)] > first[std::size_t(worst)])) worst = f;
@@ -266,7 +271,8 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
 
   nlohmann::ordered_json network_json;
   if (o.network) {
-    const auto cfg = o.recipe.config(data::displacements(d.train, d.problem.lr.V, d.problem.hr.V));
+    const auto train_displacements = data::displacements(d.train, d.problem.lr.V, d.problem.hr.V);
+    const auto cfg = o.recipe.config(train_displacements);
     const auto net_dir = o.out / o.network_name;
     const std::string fp = fingerprint_of({{"neighbors", nb_fp}, {"recipe", o.recipe.to_json()}});
     network_json = stages.run("network-" + o.network_name, fp, [&] {
@@ -293,7 +299,7 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
       }
       io::write_file_atomic(fp_file, fp + "\n");
       const auto t = std::chrono::steady_clock::now();
-      net.train(policy, data::displacements(d.train, d.problem.lr.V, d.problem.hr.V), to);
+      net.train(policy, train_displacements, to);
       const double train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
       net.save(net_dir / "model.npz");
       const double diag = eval::bbox_diagonal(d.problem.hr.V);
@@ -360,10 +366,7 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
     ViewerData v;
     v.rest = d.problem.hr.V;
     v.faces = d.problem.hr.F;
-    std::vector<std::string> sequences;
-    for (const auto& n : d.test_names)
-      if (std::find(sequences.begin(), sequences.end(), n) == sequences.end()) sequences.push_back(n);
-    for (const auto& seq : sequences) {
+    for (const auto& seq : d.test_sequences()) {
       std::vector<Index> rows;
       for (Index f = 0; f < d.test.num_frames(); ++f)
         if (d.test_names[std::size_t(f)] == seq) rows.push_back(f);

@@ -137,9 +137,9 @@ th:first-child, td:first-child { text-align: left; }
     body.appendChild(tr);
   }
   if (typeof THREE === 'undefined' || !S.sequences.length) { document.title = 'simsr report: ready'; return; }
-  const decode = (b64) => { const s = atob(b64), u = new Uint8Array(s.length); for (let i = 0; i < s.length; ++i) u[i] = s.charCodeAt(i); return new Int16Array(u.buffer); };
-  const faces = (() => { const s = atob(S.faces), u = new Uint8Array(s.length); for (let i = 0; i < s.length; ++i) u[i] = s.charCodeAt(i); return new Uint32Array(u.buffer); })();
-  const rest = (() => { const s = atob(S.rest), u = new Uint8Array(s.length); for (let i = 0; i < s.length; ++i) u[i] = s.charCodeAt(i); return new Float64Array(u.buffer); })();
+  const bytes = (b64) => { const s = atob(b64), u = new Uint8Array(s.length); for (let i = 0; i < s.length; ++i) u[i] = s.charCodeAt(i); return u.buffer; };
+  const decode = (b64) => new Int16Array(bytes(b64));
+  const faces = new Uint32Array(bytes(S.faces)), rest = new Float64Array(bytes(S.rest));
   const M = rest.length / 3;
   const canvas = document.getElementById('viewer');
   const renderer = new THREE.WebGLRenderer({ canvas: canvas, antialias: true, preserveDrawingBuffer: true });
