@@ -15,7 +15,10 @@ job=${1:-test}
 pkgs=(build-essential cmake ninja-build
       libeigen3-dev libxtensor-dev libnanoflann-dev libzip-dev
       doctest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
-      python3 python3-numpy tetgen python3-vtk9 xvfb xauth npm)
+      python3 python3-numpy tetgen python3-vtk9 xvfb xauth)
+# npm: Debian's package where no npm command exists yet. A nodejs from another repository ships
+# its own npm and conflicts with Debian's (apt then refuses: "nodejs : Conflicts: npm").
+command -v npm >/dev/null || pkgs+=(npm)
 if [[ $job == test ]]; then
   pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium)
 fi
