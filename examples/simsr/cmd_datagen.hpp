@@ -44,7 +44,9 @@ inline int datagen(const DatagenArgs& a) {
   scenario::FaceDatasetOptions o;
   o.kit = a.kit;
   o.model = face_model_options(a);
-  o.performances = a.performances;
+  o.performances.clear();  // `--performances ""`: none (only --controls)
+  for (const auto& p : a.performances)
+    if (!p.empty()) o.performances.push_back(p);
   o.controls.assign(a.controls.begin(), a.controls.end());
   o.frames = a.frames;
   o.seed = a.seed;
@@ -63,7 +65,7 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--scenario", a->scenario, "what to simulate: face")->capture_default_str();
   cmd->add_option("--out", a->out, "output directory (rest shapes, one .npz per performance, face_data.json)")->required();
   cmd->add_option("--kit", a->kit, "the ICT face kit directory (full_neutral.obj, regions.json, expressions_full.npz)")->capture_default_str();
-  cmd->add_option("--performances", a->performances, "built-in performances: amazement, anger, fear, pain (none: only --controls)")
+  cmd->add_option("--performances", a->performances, "built-in performances: amazement, anger, fear, pain (\"\": none, only --controls)")
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--controls", a->controls, "a controls file (.npz: names C strings, weights F×C), simulated as a performance named after the file (less a trailing _controls)");

@@ -1,10 +1,13 @@
 #pragma once
-// Subcommands compiled in their own translation units (the heavy ones: two cores build them in
-// parallel, and a change to one does not rebuild the others).
+// Subcommands in source files of their own (the heavy ones). The tool builds as one unity
+// translation unit (examples/CMakeLists.txt): its commands instantiate the same library templates
+// (the face simulation, the network's training and inference, every interpolator), which one
+// translation unit compiles once.
 #include <CLI/CLI.hpp>
 
 #include <functional>
 
 namespace simsr::cli {
 void add_demo(CLI::App& app, std::function<int()>& action);
+void add_animate(CLI::App& app, std::function<int()>& action);
 }  // namespace simsr::cli

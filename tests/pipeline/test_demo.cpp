@@ -159,12 +159,12 @@ TEST_CASE("pipeline::run_demo: bad options are named") {
   const auto dir = small_dataset("errors", 8);
   auto o = small_options(dir);
   o.dataset = "cat";
-  CHECK_THROWS_AS(pipeline::run_demo(exec::seq, o), ArgumentError);
+  CHECK_THROWS_AS(pipeline::run_demo(exec::omp, o), ArgumentError);
   o = small_options(dir);
   o.methods = {"embedded", "spline"};
   o.network = false;
   try {
-    pipeline::run_demo(exec::seq, o);
+    pipeline::run_demo(exec::omp, o);
     FAIL("no error");
   } catch (const ArgumentError& e) {
     CHECK(std::string(e.what()).find("spline") != std::string::npos);
@@ -172,16 +172,16 @@ TEST_CASE("pipeline::run_demo: bad options are named") {
   o = small_options(dir);
   o.methods.clear();
   o.network = false;
-  CHECK_THROWS_AS(pipeline::run_demo(exec::seq, o), ArgumentError);
+  CHECK_THROWS_AS(pipeline::run_demo(exec::omp, o), ArgumentError);
   for (const std::string bad : {"", "../x", "a b", "ridge", "data", "report"}) {
     o = small_options(dir);
     o.network_name = bad;
     CAPTURE(bad);
-    CHECK_THROWS_WITH_AS(pipeline::run_demo(exec::seq, o), doctest::Contains("network name"), ArgumentError);
+    CHECK_THROWS_WITH_AS(pipeline::run_demo(exec::omp, o), doctest::Contains("network name"), ArgumentError);
   }
   o = small_options(dir);
   o.bunny_holdout_every = 1;
-  CHECK_THROWS_AS(pipeline::run_demo(exec::seq, o), ArgumentError);
+  CHECK_THROWS_AS(pipeline::run_demo(exec::omp, o), ArgumentError);
 }
 
 }  // namespace pipeline_demo

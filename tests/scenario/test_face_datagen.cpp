@@ -342,6 +342,19 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
   CHECK(frames_read.lowres.allFinite());
   CHECK(frames_read.highres.allFinite());
   CHECK((frames_read.hr(frames / 2) - face.surface.V).rowwise().norm().maxCoeff() > 1e-3);  // the face moved
+  // the live source (pipeline::FrameSource: simsr animate) plays the same performance to datagen's
+  // LR frames: the same settled neutral, warm start and solver, frame after frame
+  {
+    scenario::FaceLrSource<> source(exec::omp, face, perfs[0]);
+    CHECK(source.num_frames() == frames);
+    CHECK(source.num_vertices() == face.lr.num_vertices());
+    Points<> x;
+    for (Index f = 0; f < frames; ++f) {
+      source.next(exec::omp, x);
+      CHECK((x - frames_read.lr(f)).cwiseAbs().maxCoeff() <= 1e-12);
+    }
+    CHECK_THROWS_AS(source.next(exec::omp, x), ArgumentError);  // past the last frame
+  }
   // the discrepancy figures, by hand: the embedded LR surface point by point from the tet corners
   {
     const auto& e = face.surface_in_lr;

@@ -12,6 +12,7 @@
 #include <type_traits>
 
 #include "exec/omp.hpp"
+#include "exec/omp_threads.hpp"
 #include "exec/policy.hpp"
 #include "exec/seq.hpp"
 

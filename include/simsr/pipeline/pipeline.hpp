@@ -1,7 +1,11 @@
 #pragma once
 /// \file
-/// Umbrella of pipeline/: long runs as stages a rerun reuses (stages.hpp) and the paper's
-/// evaluation end to end on the face or the bunny (demo.hpp, `simsr demo`).
+/// Umbrella of pipeline/: long runs as stages a rerun reuses (stages.hpp), the paper's
+/// evaluation end to end on the face or the bunny (demo.hpp, `simsr demo`), an LR simulation and
+/// an interpolator run live, pipelined (live.hpp), and the face animated that way (animate.hpp,
+/// `simsr animate`).
 
+#include "animate.hpp"
 #include "demo.hpp"
+#include "live.hpp"
 #include "stages.hpp"

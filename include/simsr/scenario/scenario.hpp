@@ -8,6 +8,7 @@
 #include "face/jaw.hpp"
 #include "face/face_datagen.hpp"
 #include "face/face_dataset.hpp"
+#include "face/face_lr_source.hpp"
 #include "face/face_model.hpp"
 #include "face/face_simulator.hpp"
 #include "face/face_views.hpp"
