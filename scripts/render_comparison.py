@@ -5,6 +5,12 @@ per-vertex error on one colour scale (blue 0 → red top).
 
     /usr/bin/python3 scripts/render_comparison.py out/demo/results/compare/anger_41 --out anger_41.png [--max-mm 1] [--methods embedded,ridge,network]
 
+Fig. 7 (the unseen forces, DIR/results/unseen/<sequence>/): each method at the peak force coloured
+by its change from its own rest-pose prediction, the network's rest pose on the right:
+
+    /usr/bin/python3 scripts/render_comparison.py out/demo/results/unseen/cheek_sphere --out cheek.png \
+        --reference rest_network --reference-title "network, rest pose" --field change
+
 VTK from Debian's python3-vtk9, offscreen; without a display the script runs itself under
 xvfb-run (Debian's xvfb), as render_face.py does. Exit 2 for a missing or malformed folder."""
 import argparse
@@ -22,8 +28,11 @@ def main():
     ap.add_argument("--methods", default="", help="methods to show, comma-separated (default: every <method>.vtu, report order)")
     ap.add_argument("--max-mm", type=float, default=0.0, help="top of the error colour scale in mm (default: the 99th percentile of Embedded's error, else of all)")
     ap.add_argument("--size", type=int, default=300, help="pixels per panel")
+    ap.add_argument("--reference", default="truth", help="the right-most surface's file stem (default truth: the HR truth)")
+    ap.add_argument("--reference-title", default="HR truth", help="its title")
+    ap.add_argument("--field", default="error", help="the point data the bottom row colours by (default error; change for Fig. 7)")
     a = ap.parse_args()
-    for f in ("lr_input.vtu", "truth.vtu"):
+    for f in ("lr_input.vtu", a.reference + ".vtu"):
         if not os.path.exists(os.path.join(a.folder, f)):
             print(f"render_comparison.py: {os.path.join(a.folder, f)} not found (run simsr demo first)", file=sys.stderr)
             sys.exit(2)
@@ -31,7 +40,8 @@ def main():
         methods = [m for m in a.methods.split(",") if m]
     else:
         order = ["embedded", "idw", "rbf", "mls", "ridge", "beta_vae", "network"]
-        found = [f[:-4] for f in os.listdir(a.folder) if f.endswith(".vtu") and f not in ("lr_input.vtu", "truth.vtu")]
+        found = [f[:-4] for f in os.listdir(a.folder)
+                 if f.endswith(".vtu") and f not in ("lr_input.vtu", "truth.vtu", a.reference + ".vtu") and not f.startswith("rest_")]
         methods = sorted(found, key=lambda m: (order.index(m) if m in order else len(order), m))
     for m in methods:
         if not os.path.exists(os.path.join(a.folder, m + ".vtu")):
@@ -47,14 +57,18 @@ def main():
     def read(name, smooth=True):
         return read_surface(os.path.join(a.folder, name + ".vtu"), "render_comparison.py", smooth)
 
-    lr, truth = read("lr_input", smooth=False), read("truth")
+    lr, truth = read("lr_input", smooth=False), read(a.reference)
     preds = {m: read(m) for m in methods}
+    for m, poly in list(preds.items()) + [(a.reference, truth)]:
+        if poly.GetPointData().GetArray(a.field) is None:
+            print(f"render_comparison.py: {m}.vtu has no point data '{a.field}'", file=sys.stderr)
+            sys.exit(2)
     import numpy as np
     if a.max_mm > 0:
         top = a.max_mm / 1e3
     else:
         ref = preds.get("embedded")
-        errs = vtk_to_numpy((ref or next(iter(preds.values()))).GetPointData().GetArray("error"))
+        errs = vtk_to_numpy((ref or next(iter(preds.values()))).GetPointData().GetArray(a.field))
         top = float(np.percentile(errs, 99)) or 1e-6
     lut = vtk.vtkLookupTable()
     lut.SetHueRange(0.667, 0.0)
@@ -77,7 +91,7 @@ def main():
         mapper.SetInputData(poly)
         if coloured:
             mapper.SetScalarModeToUsePointFieldData()
-            mapper.SelectColorArray("error")
+            mapper.SelectColorArray(a.field)
             mapper.SetLookupTable(lut)
             mapper.SetScalarRange(0, top)
             mapper.ScalarVisibilityOn()
@@ -97,14 +111,14 @@ def main():
     panel(0, 0, lr, "LR input", False)
     for i, m in enumerate(methods):
         panel(0, i + 1, preds[m], m, False)
-        mean = float(np.mean(vtk_to_numpy(preds[m].GetPointData().GetArray("error"))))
+        mean = float(np.mean(vtk_to_numpy(preds[m].GetPointData().GetArray(a.field))))
         panel(1, i + 1, preds[m], f"{m}: mean {mean:.3g}", True)
-    panel(0, cols - 1, truth, "HR truth", False)
+    panel(0, cols - 1, truth, a.reference_title, False)
     blank = vtk.vtkRenderer()  # under the truth: nothing to show, the page's white
     blank.SetViewport((cols - 1) / cols, 0, 1, 0.5)
     blank.SetBackground(1, 1, 1)
     window.AddRenderer(blank)
-    ren = panel(1, 0, truth, "error (m)", True)
+    ren = panel(1, 0, truth, f"{a.field} (m)", True)
     bar = vtk.vtkScalarBarActor()
     bar.SetLookupTable(lut)
     bar.SetNumberOfLabels(3)

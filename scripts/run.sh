@@ -4,7 +4,7 @@
 # performances), the §3.2 neighbourhoods, every baseline (Embedded, IDW, RBF, MLS, ridge, the
 # β-VAE), the super-resolution network trained on amazement + pain, every method evaluated on
 # anger + fear: Table 1 on stdout and in out/demo/report.json, frame-wise errors (CSV + SVG),
-# per-vertex error heatmaps (ParaView), Fig. 6-style renders (PNG) in out/demo/results/; then the
+# per-vertex error heatmaps (ParaView), Fig. 6- and Fig. 7-style renders (PNG) in out/demo/results/; then the
 # cantilever verification of the quasistatic solver. A rerun reuses every finished stage; a killed
 # run continues where it stopped. `simsr demo --dataset bunny` runs the same on the authors' bunny.
 set -euo pipefail
@@ -25,6 +25,13 @@ mv "$out/demo/table1.txt.part" "$out/demo/table1.txt"
 for view in "$out"/demo/results/compare/*/; do
   name=$(basename "$view")
   /usr/bin/python3 scripts/render_comparison.py "$view" --out "$out/demo/results/compare_$name.png"
+done
+# Fig. 7: the unseen forces (LR only) through Embedded and the network, beside its rest pose
+for view in "$out"/demo/results/unseen/*/; do
+  [[ -d $view ]] || continue
+  name=$(basename "$view")
+  /usr/bin/python3 scripts/render_comparison.py "$view" --out "$out/demo/results/unseen_$name.png" \
+    --reference rest_network --reference-title "network, rest pose" --field change
 done
 /usr/bin/python3 scripts/render_face.py "$out/demo/data/vtk/anger" --out "$out/demo/results/anger_lr_vs_hr.png"
 set -x

@@ -65,6 +65,17 @@ if p.returncode == 0:
     for f in (0, 1):
         check(os.path.getsize(os.path.join(out, "vtk", "smile", "hr_skin", f"hr_skin_{f:06d}.vtu")) > 1000, f"VTU of frame {f}")
 
+# Embedded instead of the network (no model): the same LR frames
+p = subprocess.run([SIMSR, "animate", "--method", "embedded", "--out", os.path.join(WORK, "embedded"), "--vtk-every", "0", "--no-unpipelined"] + common,
+                   capture_output=True, text=True)
+check(p.returncode == 0, f"simsr animate --method embedded: exit {p.returncode}: {p.stderr[-2000:]}")
+if p.returncode == 0:
+    report = json.loads(p.stdout)
+    check(report["method"] == "embedded" and report["network"] is None, "the report names Embedded and no network")
+    check("unpipelined" not in report["performances"][0], "--no-unpipelined: no unpipelined run")
+    e = np.load(os.path.join(WORK, "embedded", "smile.npz"))
+    check(np.abs(e["lowres"] - np.load(os.path.join(out, "smile.npz"))["lowres"]).max() <= 1e-12, "the same LR frames as the network's run")
+
 # bad options: exit codes of errors.hpp
 p = subprocess.run([SIMSR, "animate", "--model", os.path.join(WORK, "missing.npz"), "--out", os.path.join(WORK, "x")] + common, capture_output=True, text=True)
 check(p.returncode == 2 and "missing.npz" in p.stderr, f"missing model: exit 2 naming it ({p.returncode}: {p.stderr.strip()})")
@@ -72,4 +83,6 @@ p = subprocess.run([SIMSR, "animate", "--out", os.path.join(WORK, "x")] + common
 check(p.returncode == 5 and "no model file" in p.stderr, f"no model and not untrained: exit 5 ({p.returncode}: {p.stderr.strip()})")
 p = subprocess.run([SIMSR, "animate", "--untrained", "--out", os.path.join(WORK, "x")], capture_output=True, text=True)
 check(p.returncode == 64, f"no --controls: usage exit 64 ({p.returncode})")
+p = subprocess.run([SIMSR, "animate", "--method", "embedded", "--untrained", "--out", os.path.join(WORK, "x")] + common, capture_output=True, text=True)
+check(p.returncode == 5 and "embedded takes no model" in p.stderr, f"embedded + untrained: exit 5 ({p.returncode}: {p.stderr.strip()})")
 finish()

@@ -89,6 +89,28 @@ if os.path.exists(png):
             check(drawn > 0.05, f"panel ({row}, {col}) shows the surface: {drawn:.2f} drawn")
     emb = rgb[160:320, 160:320]
     check(((emb[:, :, 0] > emb[:, :, 2] + 80)).sum() > 20, "Embedded's error panel has red (large error) pixels")
+# Fig. 7's layout (results/unseen/<sequence>/: rest_<method>.vtu beside each method, coloured by
+# a field of the caller's choice), made here from the Fig. 6 folder: the rest_* files are not
+# methods, the reference is the right-most panel, a field a method lacks is named
+fig7 = os.path.join(WORK, "fig7")
+shutil.rmtree(fig7, ignore_errors=True)
+shutil.copytree(os.path.join(out, "results", "compare", views[0]), fig7)
+shutil.copy(os.path.join(fig7, "truth.vtu"), os.path.join(fig7, "rest_ridge.vtu"))
+os.remove(os.path.join(fig7, "truth.vtu"))
+png7 = os.path.join(WORK, "fig7.png")
+r = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "render_comparison.py"), fig7, "--out", png7, "--size", "100",
+                    "--reference", "rest_ridge", "--reference-title", "ridge, rest pose", "--field", "error"], capture_output=True, text=True)
+check(r.returncode == 0 and "3 methods" in r.stdout, f"render_comparison.py --reference rest_ridge: exit {r.returncode}: {r.stdout.strip()} {r.stderr.strip()}")
+if os.path.exists(png7):
+    rd = vtk.vtkPNGReader()
+    rd.SetFileName(png7)
+    rd.Update()
+    w, h, _ = rd.GetOutput().GetDimensions()
+    check((w, h) == (5 * 100, 2 * 100), f"Fig. 7 layout: LR, 3 methods (rest_ridge not one), the reference: {w}×{h}")
+r = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "render_comparison.py"), fig7, "--out", png7, "--reference", "rest_ridge", "--field", "change"],
+                   capture_output=True, text=True)
+check(r.returncode == 2 and "no point data 'change'" in r.stderr, f"a field the views lack: exit 2 naming it ({r.returncode}: {r.stderr.strip()})")
+
 bad = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "render_comparison.py"), os.path.join(WORK, "missing"), "--out", png],
                      capture_output=True, text=True)
 check(bad.returncode == 2 and "not found" in bad.stderr, f"render_comparison.py on a missing folder: exit {bad.returncode}")

@@ -125,6 +125,11 @@ TEST_CASE("pipeline::animate_face: live frames on the coarse face, pipelined = u
     b.network = dir / "missing.npz";
     CHECK_THROWS_AS(pipeline::animate_face(exec::omp, b), ParseError);
     b = o;
+    b.method = "embedded";
+    CHECK_THROWS_WITH_AS(pipeline::animate_face(exec::omp, b), doctest::Contains("embedded takes no model"), ArgumentError);
+    b.method = "spline";
+    CHECK_THROWS_WITH_AS(pipeline::animate_face(exec::omp, b), doctest::Contains("network or embedded"), ArgumentError);
+    b = o;
     b.controls = {o.controls[0], o.controls[0]};
     CHECK_THROWS_WITH_AS(pipeline::animate_face(exec::omp, b), doctest::Contains("two controls files"), ArgumentError);
   }

@@ -2,12 +2,14 @@
 // interpolator (hr = A · lr displacement): every frame reaches the sink once, in order, equal to
 // the method applied by hand; pipelined and unpipelined give the same frames; the pipeline really
 // overlaps (the method's frame t waits for the source to start frame t+1, which only a concurrent
-// source can do) and never runs more than one frame ahead; each stage runs with its thread share;
+// source can do) and never runs more than one frame ahead; each stage runs with its thread share,
+// by default the slower stage with every core;
 // a failure in either stage is rethrown and nothing after it reaches the sink.
 #include <simsr/pipeline/live.hpp>
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -16,6 +18,7 @@
 #include <mutex>
 #include <random>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 using namespace simsr;
@@ -151,7 +154,9 @@ TEST_CASE("pipeline::run_live: pipelined, the source computes frame t+1 while th
     std::unique_lock lock(mutex);
     if (!cv.wait_for(lock, std::chrono::seconds(20), [&] { return source_started >= f + 1; })) waited_too_long = true;
   };
-  const auto r = pipeline::run_live(exec::omp, s.source, s.method, s.lr_rest, s.hr_rest, [&](Index, const Points<>&, const Points<>&) { ++sunk; });
+  pipeline::LiveOptions o;  // threads given: every frame pipelined (the automatic split runs frame 0 alone)
+  o.source_threads = o.method_threads = 1;
+  const auto r = pipeline::run_live(exec::omp, s.source, s.method, s.lr_rest, s.hr_rest, [&](Index, const Points<>&, const Points<>&) { ++sunk; }, o);
   CHECK_FALSE(waited_too_long);
   CHECK_FALSE(ran_ahead);
   CHECK(sunk.load() == frames);
@@ -179,6 +184,31 @@ TEST_CASE("pipeline::run_live: each stage runs with its share of the threads; th
   run(u, false, ug);
   for (int t : u.source.threads) CHECK(t == before);
   for (int t : u.method.threads) CHECK(t == before);
+}
+
+TEST_CASE("pipeline::run_live: by default the slower stage (timed on the first frame, run alone) gets every core, the other one thread") {
+  const int cores = std::max(1, exec::omp_max_threads());
+  for (bool slow_source : {true, false}) {
+    CAPTURE(slow_source);
+    Setup s(4, 7, 6, 5);
+    auto wait = [](Index) { std::this_thread::sleep_for(std::chrono::milliseconds(20)); };
+    if (slow_source)
+      s.source.before = wait;
+    else
+      s.method.before = wait;
+    Received got;
+    const auto r = run(s, true, got);
+    CHECK(r.source_threads == (slow_source ? cores : 1));
+    CHECK(r.method_threads == (slow_source ? 1 : cores));
+    CHECK(got.order == std::vector<Index>{0, 1, 2, 3, 4, 5});
+#if defined(_OPENMP)
+    // frame 0 ran on the calling thread with all of its threads, the rest with their shares
+    CHECK(s.source.threads[0] == cores);
+    CHECK(s.method.threads[0] == cores);
+    for (std::size_t f = 1; f < s.source.threads.size(); ++f) CHECK(s.source.threads[f] == r.source_threads);
+    for (std::size_t f = 1; f < s.method.threads.size(); ++f) CHECK(s.method.threads[f] == r.method_threads);
+#endif
+  }
 }
 
 TEST_CASE("pipeline::run_live: a failure in either stage is rethrown; nothing after it reaches the sink") {

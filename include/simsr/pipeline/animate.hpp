@@ -16,6 +16,9 @@
 /// refused. `untrained` times a freshly initialized network of the recipe's architecture on the
 /// face model's meshes instead: the paper's LR size (preset paper-lr) has no trained network
 /// here, and the frame rates do not depend on the weights (the HR frames are then meaningless).
+/// `method = "embedded"` runs Embedded instead of a network: the paper-lr preset's LR mesh has more
+/// vertices (16.9k) than the HR surface (9.0k), which the network's §3.2 neighbourhoods (one HR
+/// vertex per LR vertex) cannot take, and its LR simulation rate is measured that way.
 /// A run takes seconds to minutes and is not resumed: a killed run is run again.
 
 #include <algorithm>
@@ -28,6 +31,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../data/paired_frames.hpp"
+#include "../interp/embedded.hpp"
 #include "../interp/fit_and_train.hpp"
 #include "../interp/learned.hpp"
 #include "../interp/network_recipe.hpp"
@@ -45,6 +49,10 @@ struct AnimateOptions {
   std::filesystem::path kit = "../shared/data/ict_face";
   scenario::FaceModelOptions model = scenario::face_model_preset("default");  ///< as the network's data was made
   scenario::FaceSimulationOptions simulation;
+  /// What upsamples the LR frames: "network" (a model file, or `untrained`) or "embedded" (the
+  /// LR surface itself: no model, no §3.2 neighbourhoods, so it runs at LR sizes the network's
+  /// neighbourhoods cannot take: more LR vertices than HR surface vertices, the paper-lr preset).
+  std::string method = "network";
   std::filesystem::path network;               ///< a model file (simsr demo / train); empty with `untrained`
   bool untrained = false;                      ///< timing only: a fresh network of `recipe` (file comment)
   interp::NetworkRecipe recipe;                ///< the untrained network's architecture
@@ -94,49 +102,15 @@ interp::Learned<> animate_network(P policy, const AnimateOptions& o, const scena
 
 }  // namespace detail
 
-/// Builds the face, runs every performance live (see the file comment) and returns the report
-/// (also OUT/animate.json).
-template <exec::HostPolicy P>
-nlohmann::ordered_json animate_face(P policy, const AnimateOptions& o, const Log& log = {}) {
+namespace detail {
+
+/// Every performance live with `method`, pipelined and (o.unpipelined) not; its files written and
+/// its figures added to report["performances"].
+template <exec::HostPolicy P, interp::Interpolator I, class Say>
+void animate_performances(P policy, const AnimateOptions& o, const scenario::FaceModel& face, const std::vector<scenario::Performance>& perfs, const I& method,
+                          nlohmann::ordered_json& report, const Say& say) {
   using clock = std::chrono::steady_clock;
-  auto say = [&](const std::string& s) {
-    if (log) log(s);
-  };
-  if (o.controls.empty()) throw ArgumentError("animate: no controls file (--controls C.npz: names C, weights F×C)");
-  if (o.untrained == !o.network.empty())
-    throw ArgumentError(o.untrained ? "animate: a model file and untrained both given: pick one" : "animate: no model file (--model M.npz), and not untrained");
-  if (o.max_frames < 0 || o.vtk_every < 0) throw ArgumentError("animate: max frames and the VTU interval must be >= 0");
-  std::vector<scenario::Performance> perfs;
-  for (const auto& file : o.controls) {
-    perfs.push_back(scenario::read_controls(file, scenario::performance_name_of(file)));
-    for (std::size_t i = 0; i + 1 < perfs.size(); ++i)
-      if (perfs[i].name == perfs.back().name) throw ArgumentError("animate: two controls files name the performance '" + perfs.back().name + "'");
-    if (o.max_frames > 0 && perfs.back().num_frames() > o.max_frames) perfs.back().weights.conservativeResize(o.max_frames, Eigen::NoChange);
-  }
-  if (!o.untrained && !std::filesystem::exists(o.network)) throw ParseError(o.network.string(), 0, "no such model file");
-
   char buf[512];
-  const auto t0 = clock::now();
-  say("animate: building the face model (tetgen, lattice, muscles)...");
-  const auto kit = scenario::read_ict_kit(o.kit);
-  const scenario::FaceModel face = scenario::build_face_model(policy, kit, o.model, o.out / "mesh");
-  const double model_seconds = std::chrono::duration<double>(clock::now() - t0).count();
-  std::snprintf(buf, sizeof buf, "animate: LR %lld tets, %lld vertices; HR surface %lld vertices; built in %.1f s", (long long)face.lr.num_tets(),
-                (long long)face.lr.num_vertices(), (long long)face.surface.num_vertices(), model_seconds);
-  say(buf);
-  const auto t1 = clock::now();
-  const interp::Learned<> net = detail::animate_network(policy, o, face);
-  const double network_seconds = std::chrono::duration<double>(clock::now() - t1).count();
-
-  nlohmann::ordered_json report;
-  report["network"] = o.untrained ? nlohmann::ordered_json("untrained (timing only)") : nlohmann::ordered_json(o.network.string());
-  report["lr"] = {{"tets", face.lr.num_tets()}, {"vertices", face.lr.num_vertices()}, {"lr_cell_cm", o.model.lr_cell}};
-  report["hr_surface_vertices"] = face.surface.num_vertices();
-  report["threads"] = exec::omp_max_threads();
-  report["model_seconds"] = model_seconds;
-  report["network_setup_seconds"] = network_seconds;
-  std::filesystem::create_directories(o.out);
-
   for (const auto& perf : perfs) {
     const Index F = perf.num_frames(), M = face.surface.num_vertices(), N = face.lr.num_vertices();
     nlohmann::ordered_json pj;
@@ -158,7 +132,7 @@ nlohmann::ordered_json animate_face(P policy, const AnimateOptions& o, const Log
       unpiped.resize(F, 3 * M);
       LiveOptions lo = o.live;
       lo.pipelined = false;
-      const auto r = run_live(policy, source, net, face.lr.V, face.surface.V, [&](Index f, const Points<Scalar>&, const Points<Scalar>& hr) {
+      const auto r = run_live(policy, source, method, face.lr.V, face.surface.V, [&](Index f, const Points<Scalar>&, const Points<Scalar>& hr) {
         unpiped.row(f) = Eigen::Map<const Eigen::Matrix<Scalar, 1, Eigen::Dynamic>>(hr.data(), hr.size());
       }, lo);
       pj["unpipelined"] = r.to_json();
@@ -171,7 +145,7 @@ nlohmann::ordered_json animate_face(P policy, const AnimateOptions& o, const Log
     LiveOptions lo = o.live;
     lo.pipelined = true;
     const auto live_start = clock::now();
-    const auto r = run_live(policy, source, net, face.lr.V, face.surface.V, [&](Index f, const Points<Scalar>& lr, const Points<Scalar>& hr) {
+    const auto r = run_live(policy, source, method, face.lr.V, face.surface.V, [&](Index f, const Points<Scalar>& lr, const Points<Scalar>& hr) {
       frames.lr(f) = lr;
       frames.hr(f) = hr;
       if ((f + 1) % 20 == 0 || f + 1 == F) {
@@ -203,6 +177,64 @@ nlohmann::ordered_json animate_face(P policy, const AnimateOptions& o, const Log
       pj["vtk"] = (o.out / "vtk" / perf.name / "hr_skin.pvd").string();
     }
     report["performances"].push_back(pj);
+  }
+}
+
+}  // namespace detail
+
+/// Builds the face, runs every performance live (see the file comment) and returns the report
+/// (also OUT/animate.json).
+template <exec::HostPolicy P>
+nlohmann::ordered_json animate_face(P policy, const AnimateOptions& o, const Log& log = {}) {
+  using clock = std::chrono::steady_clock;
+  auto say = [&](const std::string& s) {
+    if (log) log(s);
+  };
+  if (o.controls.empty()) throw ArgumentError("animate: no controls file (--controls C.npz: names C, weights F×C)");
+  if (o.method != "network" && o.method != "embedded") throw ArgumentError("animate: method must be network or embedded (got '" + o.method + "')");
+  if (o.method == "embedded" && (o.untrained || !o.network.empty())) throw ArgumentError("animate: embedded takes no model file and is never untrained");
+  if (o.method == "network" && o.untrained == !o.network.empty())
+    throw ArgumentError(o.untrained ? "animate: a model file and untrained both given: pick one" : "animate: no model file (--model M.npz), and not untrained");
+  if (o.max_frames < 0 || o.vtk_every < 0) throw ArgumentError("animate: max frames and the VTU interval must be >= 0");
+  std::vector<scenario::Performance> perfs;
+  for (const auto& file : o.controls) {
+    perfs.push_back(scenario::read_controls(file, scenario::performance_name_of(file)));
+    for (std::size_t i = 0; i + 1 < perfs.size(); ++i)
+      if (perfs[i].name == perfs.back().name) throw ArgumentError("animate: two controls files name the performance '" + perfs.back().name + "'");
+    if (o.max_frames > 0 && perfs.back().num_frames() > o.max_frames) perfs.back().weights.conservativeResize(o.max_frames, Eigen::NoChange);
+  }
+  if (o.method == "network" && !o.untrained && !std::filesystem::exists(o.network)) throw ParseError(o.network.string(), 0, "no such model file");
+
+  char buf[512];
+  const auto t0 = clock::now();
+  say("animate: building the face model (tetgen, lattice, muscles)...");
+  const auto kit = scenario::read_ict_kit(o.kit);
+  const scenario::FaceModel face = scenario::build_face_model(policy, kit, o.model, o.out / "mesh");
+  const double model_seconds = std::chrono::duration<double>(clock::now() - t0).count();
+  std::snprintf(buf, sizeof buf, "animate: LR %lld tets, %lld vertices; HR surface %lld vertices; built in %.1f s", (long long)face.lr.num_tets(),
+                (long long)face.lr.num_vertices(), (long long)face.surface.num_vertices(), model_seconds);
+  say(buf);
+  nlohmann::ordered_json report;
+  report["method"] = o.method;
+  report["network"] = o.method == "embedded" ? nlohmann::ordered_json(nullptr)
+                      : o.untrained           ? nlohmann::ordered_json("untrained (timing only)")
+                                              : nlohmann::ordered_json(o.network.string());
+  report["lr"] = {{"tets", face.lr.num_tets()}, {"vertices", face.lr.num_vertices()}, {"lr_cell_cm", o.model.lr_cell}};
+  report["hr_surface_vertices"] = face.surface.num_vertices();
+  report["threads"] = exec::omp_max_threads();
+  report["model_seconds"] = model_seconds;
+  std::filesystem::create_directories(o.out);
+  const auto t1 = clock::now();
+  if (o.method == "embedded") {
+    interp::Embedded<> embedded;
+    interp::UpsamplingProblem<> problem{face.lr, face.surface, {}, {}};
+    embedded.fit(policy, problem);
+    report["method_setup_seconds"] = std::chrono::duration<double>(clock::now() - t1).count();
+    detail::animate_performances(policy, o, face, perfs, embedded, report, say);
+  } else {
+    const interp::Learned<> net = detail::animate_network(policy, o, face);
+    report["method_setup_seconds"] = std::chrono::duration<double>(clock::now() - t1).count();
+    detail::animate_performances(policy, o, face, perfs, net, report, say);
   }
   report["seconds"] = std::chrono::duration<double>(clock::now() - t0).count();
   io::write_file_atomic(o.out / "animate.json", report.dump(2) + "\n");

@@ -5,15 +5,16 @@
 /// neighbourhoods, every baseline fitted (Embedded, IDW, RBF, MLS, ridge; the β-VAE trained), the
 /// super-resolution network trained on the training performances (resumable from its checkpoint),
 /// every method run on the test performances, and the results: Table 1 (statistics.csv and the
-/// JSON report), frame-wise errors (CSV + SVG), per-vertex error heatmaps (VTU) and every method's
-/// predictions (npz, for renders and the report page). On the bunny, the authors' frames with every
+/// JSON report), frame-wise errors (CSV + SVG), per-vertex error heatmaps (VTU), every method's
+/// predictions (npz, for renders and the report page), Fig. 6's views and, on the face, Fig. 7's:
+/// the unseen-force frames through Embedded and the network (unseen_views.hpp). On the bunny, the authors' frames with every
 /// 4th held out, as `simsr train` does.
 ///
 ///     pipeline::DemoOptions o;  o.out = "out/demo";
 ///     nlohmann::ordered_json report = pipeline::run_demo(exec::omp, o, log);   // DIR/report.json too
 ///
 /// Layout of DIR: data/ (face data set), neighbors.npz, predictions/<method>.npz, network/ (model,
-/// checkpoint, training history), results/ (Table 1, frame errors, heatmaps), report/ (the page
+/// checkpoint, training history), results/ (Table 1, frame errors, heatmaps, compare/: Fig. 6, unseen/: Fig. 7), report/ (the page
 /// people open: report_page.hpp), stages/ (markers), report.json.
 
 #include <algorithm>
@@ -33,11 +34,13 @@
 #include "../eval/evaluate.hpp"
 #include "../eval/training_history.hpp"
 #include "../interp/by_name.hpp"
+#include "../interp/embedded.hpp"
 #include "../interp/learned.hpp"
 #include "../interp/network_recipe.hpp"
 #include "../scenario/face/face_dataset.hpp"
 #include "report_page.hpp"
 #include "stages.hpp"
+#include "unseen_views.hpp"
 
 namespace simsr::pipeline {
 
@@ -362,6 +365,17 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
     m["details"] = methods_json[names[i]];
   }
   report["comparison_views"] = views;
+  // Fig. 7 (§5.3): the LR-only unseen-force frames through Embedded and the network
+  const auto unseen_dir = o.out / "data" / "unseen";
+  if (o.dataset == "face" && o.network && std::filesystem::is_directory(unseen_dir)) {
+    stages.say("results: Fig. 7, the unseen forces through Embedded and the network");
+    interp::Embedded<> embedded;
+    embedded.fit(policy, d.problem);
+    const auto net = interp::Learned<>::from_model_file(o.out / o.network_name / "model.npz");
+    const std::vector<NamedApply> apply{{"embedded", [&](const Points<Scalar>& in, Points<Scalar>& out) { embedded.apply(policy, in, out); }},
+                                        {o.network_name, [&](const Points<Scalar>& in, Points<Scalar>& out) { net.apply(policy, in, out); }}};
+    report["unseen_forces"] = write_unseen_force_views(unseen_dir, o.out / "results" / "unseen", d.problem, apply);
+  }
   {
     ViewerData v;
     v.rest = d.problem.hr.V;

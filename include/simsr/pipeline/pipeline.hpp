@@ -9,3 +9,4 @@
 #include "demo.hpp"
 #include "live.hpp"
 #include "stages.hpp"
+#include "unseen_views.hpp"
