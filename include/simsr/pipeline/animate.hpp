@@ -14,8 +14,8 @@
 /// point data) and animate.json (the figures). The face model is built as datagen builds it (same
 /// kit and options, OUT/mesh for tetgen); a network trained on another LR mesh or HR surface is
 /// refused. `untrained` times a freshly initialized network of the recipe's architecture on the
-/// face model's meshes instead: the paper's LR size (preset paper-lr) has no trained network
-/// here, and the frame rates do not depend on the weights (the HR frames are then meaningless).
+/// face model's meshes instead, for meshes no network was trained on (the paper-ratio preset):
+/// the frame rates do not depend on the weights (the HR frames are then meaningless).
 /// `method = "embedded"` runs Embedded instead of a network: the paper-lr preset's LR mesh has more
 /// vertices (16.9k) than the HR surface (9.0k), which the network's §3.2 neighbourhoods (one HR
 /// vertex per LR vertex) cannot take, and its LR simulation rate is measured that way.
@@ -99,10 +99,6 @@ interp::Learned<> animate_network(P policy, const AnimateOptions& o, const scena
                         " m apart)");
   return net;
 }
-
-}  // namespace detail
-
-namespace detail {
 
 /// Every performance live with `method`, pipelined and (o.unpipelined) not; its files written and
 /// its figures added to report["performances"].
