@@ -8,7 +8,7 @@
 #                   fuzz-corpus replays, the peers (gmsh, meshio, numpy, scipy, torch), install +
 #                   consumer project, compile-fail checks, cuda-compile, the benchmarks (built,
 #                   not run)
-#   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite and the corpus replays under
+#   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite (pipeline's own parts) and the corpus replays under
 #                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, no recovery)
 #   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: every suite that runs exec::omp under TSan, with
 #                   LLVM's libomp and its Archer tool (so OpenMP's synchronisation is understood)
