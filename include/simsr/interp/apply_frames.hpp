@@ -8,6 +8,7 @@
 ///     auto [hr, seconds_per_frame] = interp::apply_frames(exec::omp, method, lr_rest, hr_rest, lr);
 
 #include <chrono>
+#include <cstdint>
 #include <string>
 
 #include "../core/error.hpp"
@@ -15,6 +16,20 @@
 #include "concepts.hpp"
 
 namespace simsr::interp {
+
+/// One frame in positions: hr = hr_rest + method(lr − lr_rest), through the method's own scalar
+/// in the caller's buffers (nothing allocated once they are sized). NumericalError naming `where`
+/// and the frame id for a non-finite prediction (the message is built only then). apply_frames and
+/// the live pipeline (pipeline/live.hpp) run it.
+template <exec::HostPolicy Policy, Interpolator I, class LR, class HR>
+void upsample_positions(Policy policy, const I& method, const Points<Scalar>& lr_rest, const Points<Scalar>& hr_rest, const LR& lr,
+                        Points<typename I::scalar_type>& lr_disp, Points<typename I::scalar_type>& hr_disp, HR&& hr, const char* where,
+                        std::int64_t frame) {
+  lr_disp = (lr - lr_rest).template cast<typename I::scalar_type>();
+  method.apply(policy, lr_disp, hr_disp);
+  hr = hr_rest + hr_disp.template cast<Scalar>();
+  if (!hr.allFinite()) throw NumericalError(where, "the prediction of frame " + std::to_string(frame), -1, hr.sum());
+}
 
 /// What apply_frames produced.
 struct AppliedFrames {
@@ -39,13 +54,11 @@ AppliedFrames apply_frames(Policy policy, const I& method, const Points<Scalar>&
   Points<typename I::scalar_type> lr_disp(n, 3), hr_disp(m, 3);
   double seconds = 0;
   for (Index i = 0; i < f; ++i) {
-    lr_disp = (lowres.frame(i) - lr_rest).template cast<typename I::scalar_type>();
     const auto t0 = std::chrono::steady_clock::now();
-    method.apply(policy, lr_disp, hr_disp);
+    upsample_positions(policy, method, lr_rest, hr_rest, lowres.frame(i), lr_disp, hr_disp,
+                       Eigen::Map<Points<Scalar>>(out.highres.positions.row(i).data(), m, 3), "interp::apply_frames",
+                       lowres.ids[std::size_t(i)]);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    Eigen::Map<Points<Scalar>> dst(out.highres.positions.row(i).data(), m, 3);
-    dst = hr_rest + hr_disp.template cast<Scalar>();
-    if (!dst.allFinite()) throw NumericalError("interp::apply_frames", "the prediction of frame " + std::to_string(lowres.ids[std::size_t(i)]), -1, dst.sum());
   }
   out.seconds_per_frame = f > 0 ? seconds / double(f) : 0.0;
   return out;

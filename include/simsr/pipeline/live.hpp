@@ -26,12 +26,14 @@
 #include <exception>
 #include <mutex>
 #include <thread>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
 #include "../core/types.hpp"
+#include "../interp/apply_frames.hpp"
 #include "../interp/concepts.hpp"
 
 namespace simsr::pipeline {
@@ -92,17 +94,6 @@ namespace detail {
 
 inline double seconds_since(std::chrono::steady_clock::time_point t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); }
 
-/// One frame through the method: hr = hr_rest + method(lr − lr_rest), with the method's own
-/// scalar in between; buffers are the caller's (nothing allocated once warm).
-template <exec::HostPolicy P, interp::Interpolator I>
-void upsample_frame(P policy, const I& method, const Points<Scalar>& lr_rest, const Points<Scalar>& hr_rest, const Points<Scalar>& lr,
-                    Points<typename I::scalar_type>& lr_disp, Points<typename I::scalar_type>& hr_disp, Points<Scalar>& hr, Index frame) {
-  lr_disp = (lr - lr_rest).template cast<typename I::scalar_type>();
-  method.apply(policy, lr_disp, hr_disp);
-  hr = hr_rest + hr_disp.template cast<Scalar>();
-  if (!hr.allFinite()) throw NumericalError("pipeline::run_live", "the HR prediction of frame " + std::to_string(frame), -1, hr.sum());
-}
-
 }  // namespace detail
 
 /// Runs `source` frame after frame through `method` (fitted on lr_rest / hr_rest) and hands every
@@ -119,24 +110,33 @@ LiveReport run_live(P policy, S& source, const I& method, const Points<Scalar>& 
   using T = typename I::scalar_type;
   Points<T> lr_disp(n, 3), hr_disp(m, 3);
   Points<Scalar> hr(m, 3);
+  auto upsample = [&](const Points<Scalar>& lr, Index f) {
+    interp::upsample_positions(policy, method, lr_rest, hr_rest, lr, lr_disp, hr_disp, hr, "pipeline::run_live", f);
+  };
   LiveReport r;
   r.pipelined = o.pipelined;
   r.frames = frames;
   const auto start = std::chrono::steady_clock::now();
+  // One frame on the calling thread, source then method, each timed: the unpipelined run, and the
+  // pipelined run's first frame when it decides the split. Returns the two times.
+  auto alone = [&](Points<Scalar>& lr, Index f) {
+    auto t = std::chrono::steady_clock::now();
+    source.next(policy, lr);
+    const double ts = detail::seconds_since(t);
+    t = std::chrono::steady_clock::now();
+    upsample(lr, f);
+    const double tm = detail::seconds_since(t);
+    r.source_seconds += ts;
+    r.method_seconds += tm;
+    sink(f, std::as_const(lr), std::as_const(hr));
+    if (f == 0) r.first_frame_seconds = detail::seconds_since(start);
+    return std::pair{ts, tm};
+  };
 
   if (!o.pipelined) {
     r.source_threads = r.method_threads = exec::omp_max_threads();
     Points<Scalar> lr(n, 3);
-    for (Index f = 0; f < frames; ++f) {
-      auto t = std::chrono::steady_clock::now();
-      source.next(policy, lr);
-      r.source_seconds += detail::seconds_since(t);
-      t = std::chrono::steady_clock::now();
-      detail::upsample_frame(policy, method, lr_rest, hr_rest, lr, lr_disp, hr_disp, hr, f);
-      r.method_seconds += detail::seconds_since(t);
-      sink(f, std::as_const(lr), std::as_const(hr));
-      if (f == 0) r.first_frame_seconds = detail::seconds_since(start);
-    }
+    for (Index f = 0; f < frames; ++f) alone(lr, f);
     r.wall_seconds = detail::seconds_since(start);
     return r;
   }
@@ -149,17 +149,8 @@ LiveReport run_live(P policy, S& source, const I& method, const Points<Scalar>& 
   r.source_threads = o.source_threads;
   r.method_threads = o.method_threads;
   if (o.source_threads <= 0 && o.method_threads <= 0 && frames > 0) {
-    // the split from the first frame, run unpipelined: the slower stage gets every core
-    auto t = std::chrono::steady_clock::now();
-    source.next(policy, slot[0]);
-    const double ts = detail::seconds_since(t);
-    t = std::chrono::steady_clock::now();
-    detail::upsample_frame(policy, method, lr_rest, hr_rest, slot[0], lr_disp, hr_disp, hr, 0);
-    const double tm = detail::seconds_since(t);
-    r.source_seconds += ts;
-    r.method_seconds += tm;
-    sink(Index(0), std::as_const(slot[0]), std::as_const(hr));
-    r.first_frame_seconds = detail::seconds_since(start);
+    // the split from the first frame, run alone: the slower stage gets every core
+    const auto [ts, tm] = alone(slot[0], 0);
     r.source_threads = ts > tm ? cores : 1;
     r.method_threads = ts > tm ? 1 : cores;
     first = 1;
@@ -208,7 +199,7 @@ LiveReport run_live(P policy, S& source, const I& method, const Points<Scalar>& 
           if (produced <= f) break;  // the source failed
         }
         const auto t = std::chrono::steady_clock::now();
-        detail::upsample_frame(policy, method, lr_rest, hr_rest, slot[f % 2], lr_disp, hr_disp, hr, f);
+        upsample(slot[f % 2], f);
         r.method_seconds += detail::seconds_since(t);
         sink(f, std::as_const(slot[f % 2]), std::as_const(hr));
         if (f == 0) r.first_frame_seconds = detail::seconds_since(start);
