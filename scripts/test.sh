@@ -6,8 +6,9 @@
 #
 #   1. build/       g++ Release: every area's doctest suite, test_threads, the tool and examples, the
 #                   fuzz-corpus replays, the peers (gmsh, meshio, numpy, scipy, torch), install +
-#                   consumer project, compile-fail checks, cuda-compile, the benchmarks (built,
-#                   not run)
+#                   consumer project, compile-fail checks, cuda-compile, and each benchmark
+#                   compiled (syntax only, a ctest each: none is built or run here;
+#                   -DSIMSR_BUILD_BENCHMARKS=ON builds them)
 #   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite (pipeline's own parts) and the corpus replays under
 #                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, no recovery)
 #   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: every suite that runs exec::omp under TSan, with
@@ -69,7 +70,7 @@ run_ctest() {
 }
 
 # 1. the normal build
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON
 cmake --build "$build" -j "$jobs"
 step "build ($build)"
 run_ctest "$build"

@@ -5,7 +5,9 @@
 // (statistics.csv, frame_errors.csv/.svg, heatmaps.pvd), DIR/report/index.html (the page to open:
 // Table 1, the plot, a 3D viewer), DIR/predictions/, DIR/network/.
 // A rerun reuses the finished stages; a killed run continues (the network from its checkpoint).
+// `simsr ablate` (same options): the §5.4 ablations on the same data (pipeline/ablations.hpp).
 // Its own translation unit: the pipeline pulls in every area of the library.
+#include <simsr/pipeline/ablations.hpp>
 #include <simsr/pipeline/demo.hpp>
 
 #include <CLI/CLI.hpp>
@@ -36,25 +38,24 @@ int demo_cmd(DemoArgs& a) {
   const auto report = pipeline::run_demo(exec::omp, a.o, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
   std::cout << "Table 1 on the " << (a.o.dataset == "face" ? "test performances" : "held-out frames") << " (" << report.at("test_frames").get<Index>()
             << " frames; error = distance of each HR vertex to the truth, mesh units; bbox diagonal " << report.at("bbox_diagonal").get<double>() << ")\n\n"
-            << pipeline::table1_text(report) << "report: " << (a.o.out / "report.json").string() << "; files people open: " << (a.o.out / "results").string()
+            << pipeline::table1_text(report) << pipeline::lip_intersections_text(report) << "report: " << (a.o.out / "report.json").string()
+            << "; files people open: " << (a.o.out / "results").string()
             << "/frame_errors.svg (browser), " << (a.o.out / "results").string() << "/heatmaps.pvd (ParaView), "
             << (a.o.out / "report" / "index.html").string() << " (browser)\n";
   return 0;
 }
 }  // namespace
 
-void add_demo(CLI::App& app, std::function<int()>& action) {
-  auto* cmd = app.add_subcommand("demo", "The paper's evaluation end to end: data, neighbourhoods, baselines, the network, Table 1 and the files to open");
-  auto a = std::make_shared<DemoArgs>();
+namespace {
+/// The options demo and ablate share: the data, the split, the neighbourhoods and the recipe.
+void add_demo_options(CLI::App* cmd, DemoArgs& args) {
+  auto* a = &args;
   auto& o = a->o;
-  o.vendor_dir = SIMSR_VENDOR_DIR;
   cmd->add_option("--dataset", o.dataset, "face (simulated from the ICT kit) or bunny (the authors' frames)")
       ->check(CLI::IsMember({"face", "bunny"}))
       ->capture_default_str();
   cmd->add_option("--data", o.data, "the shared data folder (ict_face/, bunny/)")->capture_default_str();
   cmd->add_option("--out", o.out, "output folder (a rerun reuses its finished stages)")->capture_default_str();
-  cmd->add_option("--vendor-dir", o.vendor_dir, "node_modules holding three@0.147.0 for the report page (default: the build's)")->capture_default_str();
-  cmd->add_option("--viewer-frames", o.viewer_frames, "frames of each test sequence the report page's viewer plays")->capture_default_str()->check(CLI::Range(1, 1000));
   cmd->add_option("--preset", a->preset, "face mesh sizes: default, paper-ratio, paper-lr")->capture_default_str();
   cmd->add_option("--frames", o.face.frames, "face: frames per performance")->capture_default_str()->check(CLI::Range(14, 100000));
   cmd->add_option("--train-sequences", o.train_sequences, "face: performances trained on")->delimiter(',')->capture_default_str();
@@ -65,7 +66,6 @@ void add_demo(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--rbf-distance", o.method_parameters.rbf_distance, "rbf: euclidean, geodesic or lr-mesh")->capture_default_str();
   cmd->add_option("--rbf-regularization", o.method_parameters.rbf_regularization, "rbf: lambda added to the kernel's diagonal")->capture_default_str();
   cmd->add_option("--vae-epochs", o.method_parameters.vae_epochs, "beta_vae: training epochs")->capture_default_str();
-  cmd->add_flag("--no-network", a->no_network, "evaluate the baselines only");
   auto& r = o.recipe;
   cmd->add_option("--epochs", r.epochs, "network: epochs")->capture_default_str();
   cmd->add_option("--batch-size", r.batch_size, "network: frames per batch")->capture_default_str();
@@ -80,10 +80,53 @@ void add_demo(CLI::App& app, std::function<int()>& action) {
   cmd->add_flag("--without-cu", r.without_cu, "network ablation w/o CU (§5.4)");
   cmd->add_option("--knn", r.knn, "network: EdgeConv k (default 5)");
   cmd->add_option("--upk", r.up_k, "network: interpolation neighbours (default 10; at most --k)");
+  cmd->add_option("--w-contact", r.w_contact, "network: weight of the lip-contact term (0: off; face only)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--contact-radius", r.contact_radius, "network: lip pairs closer than this at rest take part, and how far behind a triangle a vertex still counts (m)")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--contact-margin", r.contact_margin, "network: the clearance the contact term asks for (m; at most half a pair's rest distance)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--network-name", o.network_name,
                   "network: its name in the tables and its folder (an ablation under another name leaves the default network's stage alone)")
       ->capture_default_str();
+}
+
+int ablate_cmd(DemoArgs& a, const pipeline::AblationOptions& ab) {
+  a.o.face.model = scenario::face_model_preset(a.preset);
+  const auto r = pipeline::run_ablations(exec::omp, a.o, ab, [](const std::string& line) { std::fprintf(stderr, "ablate: %s\n", line.c_str()); });
+  if (r.contains("table2")) std::cout << r.at("table2").get<std::string>() << "\n";
+  std::cout << "variant      mean/diagonal   ms per frame\n";
+  for (const auto& [name, v] : r.at("variants").items())
+    std::printf("%-12s %13.4e %14.1f\n", name.c_str(), v.at("relative_mean_error").get<double>(), v.at("apply_ms_per_frame").get<double>());
+  std::fflush(stdout);
+  std::cout << "Embedded     " << r.at("embedded").at("relative_mean_error").get<double>() << "\nfiles: " << (a.o.out / "results").string()
+            << "/ablations.csv, table2.txt, fig9_upk.svg, fig9_knn.svg (browser)\n";
+  return 0;
+}
+}  // namespace
+
+void add_demo(CLI::App& app, std::function<int()>& action) {
+  auto* cmd = app.add_subcommand("demo", "The paper's evaluation end to end: data, neighbourhoods, baselines, the network, Table 1 and the files to open");
+  auto a = std::make_shared<DemoArgs>();
+  a->o.vendor_dir = SIMSR_VENDOR_DIR;
+  add_demo_options(cmd, *a);
+  auto& o = a->o;
+  cmd->add_option("--vendor-dir", o.vendor_dir, "node_modules holding three@0.147.0 for the report page (default: the build's)")->capture_default_str();
+  cmd->add_option("--viewer-frames", o.viewer_frames, "frames of each test sequence the report page's viewer plays")->capture_default_str()->check(CLI::Range(1, 1000));
+  cmd->add_flag("--no-network", a->no_network, "evaluate the baselines only");
   cmd->callback([&action, a] { action = [a] { return demo_cmd(*a); }; });
+}
+
+void add_ablate(CLI::App& app, std::function<int()>& action) {
+  auto* cmd = app.add_subcommand("ablate",
+                                 "The §5.4 ablations on the demo's data: w/o FE, w/o CU, interpolation neighbours, EdgeConv k (Table 2, Fig. 9)");
+  auto a = std::make_shared<DemoArgs>();
+  auto ab = std::make_shared<pipeline::AblationOptions>();
+  add_demo_options(cmd, *a);
+  cmd->add_option("--ablation-epochs", ab->epochs, "epochs of every variant")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--upk-values", ab->up_k, "interpolation neighbours swept (ascending; empty: none)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--knn-values", ab->knn, "EdgeConv k swept (ascending; empty: none)")->delimiter(',')->capture_default_str();
+  cmd->add_flag("--table2,!--no-table2", ab->table2, "train full, w/o FE and w/o CU (Table 2)");
+  cmd->callback([&action, a, ab] { action = [a, ab] { return ablate_cmd(*a, *ab); }; });
 }
 
 }  // namespace simsr::cli

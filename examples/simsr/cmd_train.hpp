@@ -26,7 +26,7 @@
 namespace simsr::cli {
 
 struct TrainArgs {
-  std::string lr, hr, frames, out, neighbors, official_neighbors, checkpoint, resume, out_dir;
+  std::string lr, hr, frames, out, neighbors, official_neighbors, checkpoint, resume, out_dir, contact;
   Index holdout = 4;
   interp::NetworkRecipe recipe;  ///< the tool's defaults (batch 8, Adam 1e-3, residual): see network_recipe.hpp
   bool quiet = false;
@@ -71,6 +71,12 @@ inline int train_cmd(const TrainArgs& a) {
   if (test.num_frames() > 0) o.holdout = &held;
   o.checkpoint = a.checkpoint;
   o.resume = a.resume;
+  if (!a.contact.empty()) {
+    if (!(cfg.w_contact > 0)) throw ArgumentError("--contact " + a.contact + " needs --w-contact > 0 (patches without a weight would be ignored)");
+    o.contact = data::read_contact_patches(a.contact, problem.num_hr());
+  } else if (cfg.w_contact > 0) {
+    throw ArgumentError("--w-contact needs --contact FILE (the patches, e.g. the hr_lips.npz of simsr datagen --scenario face)");
+  }
   net.train(exec::omp, train_displacements, o);
   const auto t_train = clock::now();
   net.save(a.out);
@@ -121,6 +127,10 @@ inline void add_train(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--lr-decay-epochs", r.lr_decay_epochs, "halve the learning rate every that many epochs (default 10; 0: never)");
   cmd->add_option("--displacement-scale", r.displacement_scale,
                   "multiply normalized displacements by this (1: official; 0: from the training frames, HR RMS 1)");
+  cmd->add_option("--contact", a->contact, "contact patches of the HR surface (.npz with a, b: e.g. hr_lips.npz of simsr datagen --scenario face)");
+  cmd->add_option("--w-contact", r.w_contact, "weight of the contact term (default 0: off)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--contact-radius", r.contact_radius, "pairs closer than this at rest take part, and how far behind a triangle a vertex still counts (mesh units; default 0.005)")->check(CLI::PositiveNumber);
+  cmd->add_option("--contact-margin", r.contact_margin, "clearance asked for (mesh units; default 2e-4)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--knn", r.knn, "EdgeConv k (default 5)");
   cmd->add_option("--upk", r.up_k, "upsampling neighbours (default: 10 official, 20 paper)");
   cmd->add_option("--holdout-every", a->holdout, "frames f with f % n == 0 are held out and evaluated (default 4; 0: none)");

@@ -9,5 +9,6 @@
 
 namespace simsr::cli {
 void add_demo(CLI::App& app, std::function<int()>& action);
+void add_ablate(CLI::App& app, std::function<int()>& action);
 void add_animate(CLI::App& app, std::function<int()>& action);
 }  // namespace simsr::cli

@@ -10,6 +10,7 @@
 //   simsr infer ...            run a trained network on LR frames
 //   simsr datagen ...          simulate paired LR/HR data (the face)
 //   simsr demo ...             the paper's evaluation end to end (cmd_demo.cpp)
+//   simsr ablate ...           the §5.4 ablations: Table 2 and Fig. 9 (cmd_demo.cpp)
 //   simsr animate ...          the face simulated and super-resolved live, frame rates (cmd_animate.cpp)
 // Errors: a message on stderr naming the file, and an exit code in 1..125 (errors.hpp).
 #include "cmd_baselines.hpp"
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
   simsr::cli::add_infer(app, action);
   simsr::cli::add_datagen(app, action);
   simsr::cli::add_demo(app, action);
+  simsr::cli::add_ablate(app, action);
   simsr::cli::add_animate(app, action);
   try {
     app.parse(argc, argv);

@@ -7,6 +7,8 @@
 #include <simsr/mesh/generators.hpp>
 #include <simsr/pipeline/demo.hpp>
 
+#include "small_dataset.hpp"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -19,31 +21,7 @@ using namespace simsr;
 
 namespace pipeline_demo {
 
-/// DIR/bunny/{lrestshape.obj, hrestshape.obj, train_frames.npz}: absolute positions of F frames.
-std::filesystem::path small_dataset(const std::string& name, Index frames) {
-  const auto dir = std::filesystem::path(SIMSR_TEST_TMP_DIR) / "pipeline_demo" / name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir / "bunny");
-  const auto lr = box_tet_mesh<double>(3, 3, 3, Vec3<>(-0.1, -0.1, -0.1), Vec3<>(0.1, 0.1, 0.1));
-  const auto hr = icosphere<double>(2, 0.08);
-  io::write_obj_tets(dir / "bunny" / "lrestshape.obj", lr);
-  io::write_obj(dir / "bunny" / "hrestshape.obj", hr);
-  const Index n = lr.V.rows(), m = hr.V.rows();
-  std::mt19937 rng(11);
-  std::normal_distribution<double> g(0.0, 0.01);
-  data::PairedFrames<> p;
-  p.lowres.resize(frames, 3 * n);
-  p.highres.resize(frames, 3 * m);
-  p.controls.resize(frames, 0);
-  for (Index f = 0; f < frames; ++f) {
-    const Eigen::RowVector3d a(g(rng), g(rng), g(rng)), b(g(rng), g(rng), g(rng));
-    for (Index v = 0; v < n; ++v) p.lr(f).row(v) = lr.V.row(v) + a + b * (lr.V(v, 0) * 10) * (lr.V(v, 1) * 10);
-    for (Index v = 0; v < m; ++v) p.hr(f).row(v) = hr.V.row(v) + a + b * (hr.V(v, 0) * 10) * (hr.V(v, 1) * 10);
-    p.ids.push_back(100 + f);
-  }
-  data::write_paired_frames(dir / "bunny" / "train_frames.npz", p);
-  return dir;
-}
+std::filesystem::path small_dataset(const std::string& name, Index frames) { return test::small_bunny_layout("pipeline_demo", name, frames); }
 
 pipeline::DemoOptions small_options(const std::filesystem::path& dir) {
   pipeline::DemoOptions o;

@@ -7,6 +7,8 @@
 #include <simsr/discretize/embedding.hpp>
 #include <simsr/mesh/topology.hpp>
 #include <simsr/mesh/volume.hpp>
+#include <simsr/eval/intersections.hpp>
+#include <simsr/nn/contact_loss.hpp>
 #include <simsr/scenario/scenario.hpp>
 
 #include "face_fixture.hpp"
@@ -190,4 +192,42 @@ TEST_CASE("face model presets: the LR cell of each (the HR mesh the same), a bad
     CHECK(o->skull_lattice == d.skull_lattice);
   }
   CHECK_THROWS_WITH_AS(scenario::face_model_preset("paper"), doctest::Contains("got 'paper'"), ArgumentError);
+}
+
+TEST_CASE("face_lip_patches: the skin's lip triangles, upper in a and lower in b, facing each other: still at rest, crossing when the upper lip drops") {
+  const auto& face = test::coarse_face();
+  const ContactPatches lips = scenario::face_lip_patches(face);
+  REQUIRE(lips.a.rows() > 10);
+  REQUIRE(lips.b.rows() > 10);
+  std::set<std::array<VIndex, 3>> surface_rows;
+  for (Index t = 0; t < face.surface.F.rows(); ++t) surface_rows.insert({face.surface.F(t, 0), face.surface.F(t, 1), face.surface.F(t, 2)});
+  const std::set<VIndex> upper(face.lip_upper_vertices.data(), face.lip_upper_vertices.data() + face.lip_upper_vertices.size());
+  const std::set<VIndex> lower(face.lip_lower_vertices.data(), face.lip_lower_vertices.data() + face.lip_lower_vertices.size());
+  for (int s = 0; s < 2; ++s) {
+    const Tris& T = s ? lips.b : lips.a;
+    for (Index t = 0; t < T.rows(); ++t) {
+      CHECK(surface_rows.count({T(t, 0), T(t, 1), T(t, 2)}) == 1);  // a skin triangle, its orientation kept
+      for (Index k = 0; k < 3; ++k) CHECK((s ? lower : upper).count(face.surface_hr_vertex[T(t, k)]) == 1);
+    }
+  }
+  // The contact term at the face's scale: pairs within 1.5 cm, nothing pushes at rest.
+  nn::ContactLoss<double> loss(face.surface.V, lips, 0.015, 2e-4);
+  REQUIRE(loss.pairs().size() > 50);
+  const nn::Matrix<double> rest = nn::Matrix<double>::Zero(face.surface.num_vertices(), 3);
+  CHECK(loss.value_and_gradient(exec::seq, rest) == 0.0);
+  // The upper lip dropped 6 mm (−y, the kit's up is +y) passes through the lower one: the term and
+  // the exact test see it (the patches face each other: outward normals of the skin).
+  nn::Matrix<double> drop = rest;
+  for (Index t = 0; t < lips.a.rows(); ++t)
+    for (Index k = 0; k < 3; ++k) drop(lips.a(t, k), 1) = -6e-3;
+  CHECK(loss.value_and_gradient(exec::seq, drop) > 0);
+  CHECK(loss.penetrating() > 0);
+  data::FrameMatrix<> frames(2, 3 * face.surface.num_vertices());
+  for (Index v = 0; v < face.surface.num_vertices(); ++v)
+    for (Index k = 0; k < 3; ++k) {
+      frames(0, 3 * v + k) = face.surface.V(v, k);
+      frames(1, 3 * v + k) = face.surface.V(v, k) + drop(v, k);
+    }
+  const auto counts = eval::intersecting_pairs_per_frame(exec::omp, frames, lips);
+  CHECK(counts[1] > counts[0]);
 }

@@ -6,6 +6,7 @@
 /// network's neighbourhoods from the authors' files, simsr's own, or computed.
 
 #include "concatenate.hpp"
+#include "contact_patches_file.hpp"
 #include "frame_set.hpp"
 #include "network_neighborhoods.hpp"
 #include "paired_frames.hpp"

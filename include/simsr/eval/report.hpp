@@ -40,6 +40,17 @@ inline std::string xml_text(const std::string& s) {
   for (char c : s) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
   return o;
 }
+/// The opening of a plot's SVG: a white page, the title and the two axes (every plot's).
+inline void svg_frame(std::ostringstream& o, double W, double H, double left, double right, double top, double bottom, const std::string& title) {
+  o.imbue(std::locale::classic());
+  o << std::setprecision(6);
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" << xml_text(title) << "</text>\n"
+    << "<line x1=\"" << left << "\" y1=\"" << H - bottom << "\" x2=\"" << W - right << "\" y2=\"" << H - bottom << "\" stroke=\"black\"/>\n"
+    << "<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left << "\" y2=\"" << H - bottom << "\" stroke=\"black\"/>\n";
+}
+inline constexpr const char* plot_colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"};
 }  // namespace detail
 
 /// CSV with a `frame` column and one column per series (all series the same length).
@@ -108,15 +119,8 @@ inline void write_svg_plot(const std::filesystem::path& path, const std::vector<
     return H - bottom - std::clamp(t, 0.0, 1.0) * (H - top - bottom);
   };
   const double xs = (W - left - right) / double(std::max<std::size_t>(n - (n > 0), 1));
-  static const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"};
   std::ostringstream o;
-  o.imbue(std::locale::classic());
-  o << std::setprecision(6);
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" << detail::xml_text(title) << "</text>\n"
-    << "<line x1=\"" << left << "\" y1=\"" << H - bottom << "\" x2=\"" << W - right << "\" y2=\"" << H - bottom << "\" stroke=\"black\"/>\n"
-    << "<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left << "\" y2=\"" << H - bottom << "\" stroke=\"black\"/>\n";
+  detail::svg_frame(o, W, H, left, right, top, bottom, title);
   const int yticks = log_y ? int(hi - lo) : 4;
   for (int t = 0; t <= yticks; ++t) {  // y ticks
     const double v = log_y ? std::pow(10.0, lo + t) : hi * t / 4, y = ypos(v);
@@ -132,11 +136,56 @@ inline void write_svg_plot(const std::filesystem::path& path, const std::vector<
     << "<text x=\"16\" y=\"" << (top + H - bottom) / 2 << "\" transform=\"rotate(-90 16 " << (top + H - bottom) / 2
     << ")\" text-anchor=\"middle\">" << detail::xml_text(y_label) << "</text>\n";
   for (std::size_t i = 0; i < series.size(); ++i) {
-    const char* c = colors[i % 8];
+    const char* c = detail::plot_colors[i % 8];
     o << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\" points=\"";
     for (std::size_t f = 0; f < series[i].values.size(); ++f)
       o << left + double(f) * xs << ',' << ypos(series[i].values[f]) << ' ';
     o << "\"/>\n<rect x=\"" << W - right + 15 << "\" y=\"" << top + 20.0 * double(i) << "\" width=\"12\" height=\"12\" fill=\"" << c
+      << "\"/><text x=\"" << W - right + 32 << "\" y=\"" << top + 20.0 * double(i) + 11 << "\">" << detail::xml_text(series[i].name) << "</text>\n";
+  }
+  o << "</svg>\n";
+  detail::write_file(path, o.str());
+}
+
+/// A plot of the series against the values `x` (every series as long as x; ascending x), lines
+/// with a marker at each point, as a standalone SVG: a sweep of one parameter (Fig. 9).
+inline void write_svg_xy_plot(const std::filesystem::path& path, const std::vector<double>& x, const std::vector<Series>& series,
+                              const std::string& title, const std::string& y_label, const std::string& x_label) {
+  if (series.empty() || x.empty()) throw ArgumentError("write_svg_xy_plot: no series or no x values");
+  for (const auto& s : series)
+    if (s.values.size() != x.size())
+      throw ArgumentError("write_svg_xy_plot: series '" + s.name + "' has " + std::to_string(s.values.size()) + " values for " + std::to_string(x.size()) + " x values");
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (!std::isfinite(x[i]) || (i > 0 && !(x[i] > x[i - 1]))) throw ArgumentError("write_svg_xy_plot: x values must be finite and ascending");
+  const double W = 900, H = 480, left = 90, right = 220, top = 40, bottom = 50;
+  double ymax = 0;
+  for (const auto& s : series)
+    for (double v : s.values)
+      if (std::isfinite(v)) ymax = std::max(ymax, v);
+  if (ymax <= 0) ymax = 1;
+  const double x0 = x.front(), x1 = x.size() > 1 ? x.back() : x.front() + 1;
+  auto xpos = [&](double v) { return left + (v - x0) / (x1 - x0) * (W - left - right); };
+  auto ypos = [&](double v) { return H - bottom - std::clamp(v / ymax, 0.0, 1.0) * (H - top - bottom); };
+  std::ostringstream o;
+  detail::svg_frame(o, W, H, left, right, top, bottom, title);
+  for (int t = 0; t <= 4; ++t) {
+    const double v = ymax * t / 4, y = ypos(v);
+    o << std::setprecision(3) << "<line x1=\"" << left - 4 << "\" y1=\"" << y << "\" x2=\"" << W - right << "\" y2=\"" << y << "\" stroke=\"#ddd\"/>"
+      << "<text x=\"" << left - 6 << "\" y=\"" << y + 4 << "\" text-anchor=\"end\">" << v << "</text>\n";
+  }
+  for (double v : x)
+    o << std::setprecision(6) << "<text x=\"" << xpos(v) << "\" y=\"" << H - bottom + 18 << "\" text-anchor=\"middle\">" << v << "</text>\n";
+  o << "<text x=\"" << (left + W - right) / 2 << "\" y=\"" << H - 10 << "\" text-anchor=\"middle\">" << detail::xml_text(x_label) << "</text>\n"
+    << "<text x=\"16\" y=\"" << (top + H - bottom) / 2 << "\" transform=\"rotate(-90 16 " << (top + H - bottom) / 2 << ")\" text-anchor=\"middle\">"
+    << detail::xml_text(y_label) << "</text>\n";
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    const char* c = detail::plot_colors[i % 8];
+    o << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\" points=\"";
+    for (std::size_t k = 0; k < x.size(); ++k) o << xpos(x[k]) << ',' << ypos(series[i].values[k]) << ' ';
+    o << "\"/>\n";
+    for (std::size_t k = 0; k < x.size(); ++k)
+      o << "<circle cx=\"" << xpos(x[k]) << "\" cy=\"" << ypos(series[i].values[k]) << "\" r=\"3\" fill=\"" << c << "\"/>";
+    o << "\n<rect x=\"" << W - right + 15 << "\" y=\"" << top + 20.0 * double(i) << "\" width=\"12\" height=\"12\" fill=\"" << c
       << "\"/><text x=\"" << W - right + 32 << "\" y=\"" << top + 20.0 * double(i) + 11 << "\">" << detail::xml_text(series[i].name) << "</text>\n";
   }
   o << "</svg>\n";

@@ -28,10 +28,10 @@ inline void write_training_history(const std::filesystem::path& dir, const std::
   std::ostringstream csv;
   csv.imbue(std::locale::classic());
   csv << std::setprecision(10);
-  csv << "epoch,steps,loss,recon,z_reg,face_normals,lr,seconds,holdout_mean_error,holdout_relative_error,baseline_relative_error\n";
+  csv << "epoch,steps,loss,recon,z_reg,face_normals,contact,penetrating_pairs,lr,seconds,holdout_mean_error,holdout_relative_error,baseline_relative_error\n";
   Series loss{"training loss", {}}, err{"network, held-out mean error / bbox diagonal", {}}, base{baseline_name + " on the same frames", {}};
   for (const auto& r : history) {
-    csv << r.epoch << ',' << r.steps << ',' << r.loss << ',' << r.recon << ',' << r.z_reg << ',' << r.face_normals << ',' << r.lr << ','
+    csv << r.epoch << ',' << r.steps << ',' << r.loss << ',' << r.recon << ',' << r.z_reg << ',' << r.face_normals << ',' << r.contact << ',' << r.penetrating << ',' << r.lr << ','
         << r.seconds << ',';
     if (r.holdout_mean_error >= 0) csv << r.holdout_mean_error << ',' << r.holdout_mean_error / diagonal;
     else csv << ',';

@@ -54,6 +54,9 @@ struct NetworkTrainOptions {
   /// Continue from this checkpoint when not empty: it must come from the same config, options and
   /// data (nn::Trainer::load_checkpoint names what differs).
   std::filesystem::path resume;
+  /// The contact term's patches (rows of the HR surface), for a config with w_contact > 0 (the
+  /// face's lips: scenario::face_lip_patches, DIR/hr_lips.npz of simsr datagen).
+  ContactPatches contact;
 };
 
 /// The network `Net` (nn::SuperResolutionNet<float> by default; <double> for checks) as an
@@ -127,6 +130,7 @@ class Learned {
     if (!net_) throw ArgumentError("Learned::train before fit");
     nn::Trainer<network_scalar, typename Net::search_type> trainer(*net_, model_.hr_faces, training_frames(frames, "training frames"), options.trainer);
     if (options.holdout) trainer.set_holdout(training_frames(*options.holdout, "held-out frames"));
+    if (!options.contact.empty()) trainer.set_contact(options.contact);
     if (!options.resume.empty())
       trainer.load_checkpoint(options.resume);  // refuses another run's checkpoint, naming what differs
     else if (!options.checkpoint.empty())

@@ -39,6 +39,11 @@ struct NetworkRecipe {
   /// nn::NetworkConfig::displacement_scale: > 0 as given; 0: from the training frames (the RMS of
   /// their normalized HR displacement becomes 1; config(frames)).
   double displacement_scale = 1.0;
+  /// The lip-contact term (nn/contact_loss.hpp; issue #12 item 7): weight (0: off), the candidate
+  /// pairs' rest distance (also how far behind a triangle a vertex still counts as through it) and the
+  /// clearance, in mesh units (the face's defaults: 5 mm, 0.2 mm; see the README on the radius).
+  double w_contact = 0.0;
+  double contact_radius = 0.005, contact_margin = 2e-4;
 
   /// Epochs when `epochs` < 0: about 15 minutes of the bunny example on 2 cores.
   static Index default_epochs(const std::string& profile) { return profile == "paper" ? 10 : 14; }
@@ -60,6 +65,12 @@ struct NetworkRecipe {
     if (w_zreg >= 0) cfg.w_zreg = w_zreg;
     if (w_fn >= 0) cfg.w_fn = w_fn;
     if (lr_decay_epochs < 0) throw ArgumentError("network recipe: lr decay epochs must be >= 0 (got " + std::to_string(lr_decay_epochs) + ")");
+    if (!(w_contact >= 0) || !std::isfinite(w_contact)) throw ArgumentError("network recipe: the contact weight must be >= 0 (got " + std::to_string(w_contact) + ")");
+    if (w_contact > 0) {
+      cfg.w_contact = w_contact;
+      cfg.contact_radius = contact_radius;
+      cfg.contact_margin = contact_margin;
+    }
     if (displacement_scale > 0) cfg.displacement_scale = displacement_scale;
     else if (displacement_scale < 0 || !std::isfinite(displacement_scale)) throw ArgumentError("network recipe: displacement scale must be >= 0 (0: from the data)");
     cfg.validate();
@@ -79,11 +90,14 @@ struct NetworkRecipe {
     return cfg;
   }
 
-  /// Every field, for reports and the fingerprints of pipeline stages.
+  /// Every field, for reports and the fingerprints of pipeline stages (the contact fields only
+  /// when the term is on: stages finished before it existed keep their fingerprints).
   nlohmann::ordered_json to_json() const {
-    return {{"profile", profile}, {"epochs", resolved_epochs()}, {"batch_size", batch_size}, {"lr", lr},          {"lr_decay_epochs", lr_decay_epochs},
+    nlohmann::ordered_json j = {{"profile", profile}, {"epochs", resolved_epochs()}, {"batch_size", batch_size}, {"lr", lr},          {"lr_decay_epochs", lr_decay_epochs},
             {"w_recon", w_recon}, {"w_zreg", w_zreg},            {"w_fn", w_fn},             {"residual", residual}, {"knn", knn},
             {"up_k", up_k},       {"without_fe", without_fe},    {"without_cu", without_cu}, {"seed", seed}, {"displacement_scale", displacement_scale}};
+    if (w_contact > 0) j["w_contact"] = w_contact, j["contact_radius"] = contact_radius, j["contact_margin"] = contact_margin;
+    return j;
   }
 };
 

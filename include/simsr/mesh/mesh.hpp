@@ -4,6 +4,7 @@
 
 #include "../core/core.hpp"
 #include "closest_point.hpp"
+#include "contact_patches.hpp"
 #include "cotangent_laplacian.hpp"
 #include "harmonic_field.hpp"
 #include "normals.hpp"

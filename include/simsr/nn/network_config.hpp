@@ -87,6 +87,12 @@ struct NetworkConfig {
   double w_zreg = 2.0;                     ///< official weight; ramped_norm uses zreg_start→zreg_end
   double zreg_start = 0.001, zreg_end = 20.0;
   Index zreg_ramp_steps = 0;               ///< 0: ramp over the whole run
+  /// simsr, beyond the paper (§6.1's future work; nn/contact_loss.hpp): the weight of the contact
+  /// term that keeps two patches of the HR surface (the lips) from passing through each other
+  /// (0: off, the official loss). Its patches come with the training data (Trainer::set_contact).
+  double w_contact = 0.0;
+  double contact_radius = 0.0;             ///< mesh units: candidate pairs closer than this at rest (> 0 when w_contact > 0)
+  double contact_margin = 0.0;             ///< mesh units: the clearance asked for (at most half a pair's rest distance)
 
   /// The public PyTorch implementation's network (706,871 parameters at these defaults).
   static NetworkConfig official() { return NetworkConfig{}; }
@@ -165,7 +171,7 @@ struct NetworkConfig {
     at_most("n_epochs", epochs, Index(1) << 24);
     at_most("zreg_ramp_steps", zreg_ramp_steps, Index(1) << 40);
     for (double v : {w0_initial, w0, up_w0_initial, up_w0, leaky_relu_slope, batchnorm_eps, batchnorm_momentum, lr, w_recon, w_fn, w_zreg,
-                     zreg_start, zreg_end, norm_mean, norm_std, dropout, displacement_scale})
+                     zreg_start, zreg_end, norm_mean, norm_std, dropout, displacement_scale, w_contact, contact_radius, contact_margin})
       if (!std::isfinite(v)) fail("every real-valued field must be finite");
     if (!(batchnorm_eps > 0) || !(batchnorm_momentum >= 0 && batchnorm_momentum <= 1)) fail("batchnorm eps must be > 0 and momentum in [0, 1]");
     if (pos_feat_dim < 2 || pos_feat_dim % 2) fail("pos_feat_dim must be even and >= 2");
@@ -191,6 +197,8 @@ struct NetworkConfig {
     if (epochs < 0) fail("epochs must be >= 0");
     if (!(w_recon >= 0) || !(w_fn >= 0) || !(w_zreg >= 0) || !(zreg_start >= 0) || !(zreg_end >= 0)) fail("loss weights must be >= 0");
     if (zreg_ramp_steps < 0) fail("zreg_ramp_steps must be >= 0");
+    if (!(w_contact >= 0) || !(contact_radius >= 0) || !(contact_margin >= 0)) fail("w_contact, contact_radius and contact_margin must be >= 0");
+    if (w_contact > 0 && !(contact_radius > 0)) fail("w_contact > 0 needs contact_radius > 0 (the candidate pairs' distance at rest)");
   }
 
   /// Calls f(key, field) for every field stored under one JSON key (config.py's names where it
@@ -236,6 +244,9 @@ struct NetworkConfig {
     f("zreg_start", c.zreg_start);
     f("zreg_end", c.zreg_end);
     f("zreg_ramp_steps", c.zreg_ramp_steps);
+    f("w_contact", c.w_contact);
+    f("contact_radius", c.contact_radius);
+    f("contact_margin", c.contact_margin);
   }
 
   nlohmann::json to_json() const {

@@ -9,6 +9,7 @@
 #include "batch_norm.hpp"
 #include "beta_vae.hpp"
 #include "concat.hpp"
+#include "contact_loss.hpp"
 #include "coordinate_upsampling.hpp"
 #include "dropout.hpp"
 #include "edge_conv.hpp"

@@ -5,13 +5,18 @@
 ///   paper:    Σ|Δx̂ − Δx| + 0.001·Σ(1 − cos) + β(step)·Σ_s Σ_i ‖h^s_i‖₂, sums per item averaged
 ///             over the batch, β ramped 0.001 → 20.
 /// Face normals are those of rest + displacement in normalized units (as the official code).
+/// simsr adds an optional contact term (config w_contact > 0, patches by set_contact):
+///   + w_contact·(1/B)·Σ (m − s)² over the penetrating or too-close lip pairs (contact_loss.hpp),
+/// with distances in network units (mesh units / NetworkConfig::displacement_unit()).
 ///
 ///     nn::SuperResolutionLoss<float> loss(cfg, net.hr_rest_normalized(), hr_faces);
 ///     auto t = loss.evaluate(exec::omp, pred, target, net.code(), step, &d_pred, &d_code);
 ///     net.backward(exec::omp, d_pred, &d_code);
 
+#include <optional>
 #include <string>
 
+#include "contact_loss.hpp"
 #include "face_normal_loss.hpp"
 #include "latent_norm_loss.hpp"
 #include "losses.hpp"
@@ -24,7 +29,8 @@ class SuperResolutionLoss {
  public:
   /// The weighted terms (each already multiplied by its weight) and their sum.
   struct Terms {
-    double total = 0, recon = 0, z_reg = 0, face_normals = 0;
+    double total = 0, recon = 0, z_reg = 0, face_normals = 0, contact = 0;
+    Index penetrating = 0;  ///< contact pairs with the vertex behind the other patch (0 without the term)
     double beta = 0;  ///< the latent weight used (w_zreg, or the ramp's value)
   };
 
@@ -32,7 +38,8 @@ class SuperResolutionLoss {
   template <class DR, class DF>
   SuperResolutionLoss(const NetworkConfig& cfg, const Eigen::MatrixBase<DR>& hr_rest_normalized, const Eigen::MatrixBase<DF>& faces,
                       long total_steps = 1)
-      : cfg_(cfg), fn_(hr_rest_normalized, faces, cfg.sum_reductions ? Reduction::sum : Reduction::mean) {
+      : cfg_(cfg), fn_(hr_rest_normalized, faces, cfg.sum_reductions ? Reduction::sum : Reduction::mean),
+        rest_network_(hr_rest_normalized.template cast<double>() * cfg.displacement_scale) {
     if (cfg.zreg == LatentRegularizer::ramped_norm) {
       ramp_.start = cfg.zreg_start;
       ramp_.end = cfg.zreg_end;
@@ -46,6 +53,16 @@ class SuperResolutionLoss {
       off += cfg.emb_feat_dims[s];
     }
   }
+
+  /// The contact term's patches (rows of the HR surface): ArgumentError unless the config's
+  /// w_contact > 0 (patches without a weight would be silently ignored).
+  void set_contact(const ContactPatches& patches) {
+    if (!(cfg_.w_contact > 0)) throw ArgumentError("nn::SuperResolutionLoss: contact patches given but the config's w_contact is 0");
+    const double unit = cfg_.displacement_unit();
+    contact_.emplace(rest_network_, patches, cfg_.contact_radius / unit, cfg_.contact_margin / unit);
+  }
+  bool has_contact() const { return contact_.has_value(); }
+  const ContactLoss<S>* contact() const { return contact_ ? &*contact_ : nullptr; }
 
   /// Loss of `pred` ((B·M)×3) against `target` with code z ((B·N)×latent) at optimizer step
   /// `step`; with d_pred / d_z, writes the gradients of the total (overwritten).
@@ -95,7 +112,12 @@ class SuperResolutionLoss {
         break;
       }
     }
-    t.total = t.recon + t.z_reg + t.face_normals;
+    if (cfg_.w_contact > 0) {
+      if (!contact_) throw ArgumentError("nn::SuperResolutionLoss: w_contact > 0 but no contact patches (set_contact)");
+      t.contact = cfg_.w_contact * contact_->value_and_gradient(policy, pred, d_pred, cfg_.w_contact);
+      t.penetrating = contact_->penetrating();
+    }
+    t.total = t.recon + t.z_reg + t.face_normals + t.contact;
     return t;
   }
 
@@ -104,6 +126,8 @@ class SuperResolutionLoss {
   FaceNormalLoss<S> fn_;
   RampedWeight ramp_;
   std::vector<std::pair<Index, Index>> blocks_;
+  Matrix<double> rest_network_;  ///< HR rest positions in network units (normalized × displacement_scale)
+  std::optional<ContactLoss<S>> contact_;
   Matrix<S> d_fn_, d_block_;
 };
 

@@ -91,7 +91,8 @@ TrainingFrames<S> training_frames(const NetworkConfig& cfg, const Eigen::MatrixB
 struct EpochReport {
   Index epoch = 0;                 ///< 1-based
   Index steps = 0;                 ///< optimizer steps so far
-  double loss = 0, recon = 0, z_reg = 0, face_normals = 0;  ///< means over the epoch's batches
+  double loss = 0, recon = 0, z_reg = 0, face_normals = 0, contact = 0;  ///< means over the epoch's batches
+  Index penetrating = 0;           ///< contact pairs found penetrating, summed over the epoch's batches (w_contact > 0)
   double seconds = 0;
   double lr = 0;
   double holdout_mean_error = -1;  ///< mean HR vertex error (raw units) on the held-out frames, or −1
@@ -130,6 +131,13 @@ class Trainer {
   std::int64_t steps() const { return adam_.steps(); }
   const std::vector<EpochReport>& history() const { return history_; }
   Adam<S>& optimizer() { return adam_; }
+
+  /// The contact term's patches (rows of the HR surface; the config's w_contact must be > 0).
+  /// Part of the checkpoint's data: a checkpoint trained with other patches is refused.
+  void set_contact(const ContactPatches& patches) {
+    loss_.set_contact(patches);
+    contact_fingerprint_ = patches.fingerprint();
+  }
 
   /// Frames evaluated after each epoch (never trained on).
   void set_holdout(TrainingFrames<S> frames) {
@@ -171,6 +179,8 @@ class Trainer {
       rep.recon += t.recon / double(nb);
       rep.z_reg += t.z_reg / double(nb);
       rep.face_normals += t.face_normals / double(nb);
+      rep.contact += t.contact / double(nb);
+      rep.penetrating += t.penetrating;
       if (opt_.progress) progress(rep, b + 1, nb, t, std::chrono::steady_clock::now() - t0);
     }
     net_->parameters_changed();
@@ -182,6 +192,7 @@ class Trainer {
     if (opt_.progress) {
       std::fprintf(stderr, "\repoch %lld/%lld  loss %.5f (recon %.5f  z %.5f  normals %.6f)  %.1f s", (long long)rep.epoch, (long long)epochs(),
                    rep.loss, rep.recon, rep.z_reg, rep.face_normals, rep.seconds);
+      if (loss_.has_contact()) std::fprintf(stderr, "  contact %.5f (%lld penetrating pairs)", rep.contact, (long long)rep.penetrating);
       if (rep.holdout_mean_error >= 0) std::fprintf(stderr, "  held-out mean error %.3e", rep.holdout_mean_error);
       std::fprintf(stderr, "\n");
     }
@@ -250,12 +261,12 @@ class Trainer {
             {"lr_decay_epochs", opt_.lr_decay_epochs}, {"lr_decay_gamma", opt_.lr_decay_gamma}};
   }
   /// The data a resumed run must share: frame counts and fingerprints of the normalized training and
-  /// held-out frames (ids included), of the rest shapes and of the HR faces.
+  /// held-out frames (ids included), of the rest shapes, of the HR faces and of the contact patches.
   nlohmann::json data_json() const {
     auto frames = [](const TrainingFrames<S>& t) {
       return Fingerprint().add(t.ldx).add(t.hdx).add(t.ids).hex();
     };
-    return {{"training_frames", data_.frames},
+    nlohmann::json j = {{"training_frames", data_.frames},
             {"training_fingerprint", frames(data_)},
             {"holdout_frames", holdout_.frames},
             {"holdout_fingerprint", frames(holdout_)},
@@ -263,6 +274,8 @@ class Trainer {
             {"hr_vertices", data_.m},
             {"rest_fingerprint", Fingerprint().add(net_->lr_rest_normalized()).add(net_->hr_rest_normalized()).hex()},
             {"faces_fingerprint", Fingerprint().add(hr_faces_).hex()}};
+    if (!contact_fingerprint_.empty()) j["contact_fingerprint"] = contact_fingerprint_;  // only then: older checkpoints still load
+    return j;
   }
 
   /// Restores weights, buffers, optimizer, RNG and counters from save_checkpoint's file: run(policy)
@@ -278,6 +291,12 @@ class Trainer {
     // the config's training fields are compared as the effective options below (a config's
     // n_epochs may differ where the run's length may)
     nlohmann::json saved_config = json_text(a, file, "config"), run_config = net_->config().to_json();
+    // Read as a config, so that a field the checkpoint's version did not have yet compares as the
+    // default it had then (an unreadable config is compared as it is: every key differs).
+    try {
+      saved_config = NetworkConfig::from_json(saved_config).to_json();
+    } catch (const Error&) {
+    }
     for (const char* key : {"n_epochs", "batch_size", "lr"})
       if (saved_config.is_object()) saved_config.erase(key), run_config.erase(key);
     compare_json(differences, "config", saved_config, run_config);
@@ -383,8 +402,10 @@ class Trainer {
     std::string bar(std::size_t(filled), '#');
     bar.resize(std::size_t(width), '.');
     const double s = std::chrono::duration<double>(elapsed).count();
-    std::fprintf(stderr, "\repoch %lld/%lld [%s] %lld/%lld  loss %.5f (recon %.5f  z %.5f  normals %.6f)  %.2f s/step ", (long long)rep.epoch,
-                 (long long)epochs(), bar.c_str(), (long long)b, (long long)nb, t.total, t.recon, t.z_reg, t.face_normals, s / double(b));
+    std::fprintf(stderr, "\repoch %lld/%lld [%s] %lld/%lld  loss %.5f (recon %.5f  z %.5f  normals %.6f", (long long)rep.epoch, (long long)epochs(),
+                 bar.c_str(), (long long)b, (long long)nb, t.total, t.recon, t.z_reg, t.face_normals);
+    if (loss_.has_contact()) std::fprintf(stderr, "  contact %.5f", t.contact);
+    std::fprintf(stderr, ")  %.2f s/step ", s / double(b));
     std::fflush(stderr);
   }
 
@@ -395,6 +416,7 @@ class Trainer {
   Adam<S> adam_;
   SuperResolutionLoss<S> loss_;
   Tris hr_faces_;
+  std::string contact_fingerprint_;
   Index epoch_ = 0;
   std::vector<EpochReport> history_;
   std::vector<Index> order_;

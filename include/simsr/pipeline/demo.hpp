@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <span>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -32,11 +33,13 @@
 #include "../data/data.hpp"
 #include "../eval/comparison.hpp"
 #include "../eval/evaluate.hpp"
+#include "../eval/intersections.hpp"
 #include "../eval/training_history.hpp"
 #include "../interp/by_name.hpp"
 #include "../interp/embedded.hpp"
 #include "../interp/learned.hpp"
 #include "../interp/network_recipe.hpp"
+#include "../data/contact_patches_file.hpp"
 #include "../scenario/face/face_dataset.hpp"
 #include "report_page.hpp"
 #include "stages.hpp"
@@ -91,6 +94,7 @@ struct DemoData {
   data::PairedFrames<> train, test;
   std::string fingerprint;  ///< of the data's options (the files themselves are checked by their producers)
   std::vector<std::string> test_names;  ///< per test frame: its sequence (face) or "holdout"
+  ContactPatches lips;      ///< face: the lips as contact patches of the HR surface (data/hr_lips.npz); bunny: none
   nlohmann::ordered_json summary;
 
   /// The distinct test sequences, in the order their frames come.
@@ -140,6 +144,15 @@ DemoData face_data(P policy, Stages& stages, const DemoOptions& o) {
   d.train = read_sequences(dir, o.train_sequences, d.problem.num_lr(), d.problem.num_hr());
   d.test = read_sequences(dir, o.test_sequences, d.problem.num_lr(), d.problem.num_hr());
   for (Index f = 0; f < d.test.num_frames(); ++f) d.test_names.push_back(d.test.sequence_name(f));
+  const auto lips_file = dir / "hr_lips.npz";
+  if (!std::filesystem::exists(lips_file)) {  // data written before datagen wrote the lips: the model has them
+    stages.say("data: no " + lips_file.string() + " (data of an earlier version): building the face model for its lips");
+    const auto face = scenario::build_face_model(policy, scenario::read_ict_kit(fo.kit), fo.model, dir / "mesh");
+    if (face.surface.num_vertices() != d.problem.num_hr() || (face.surface.V - d.problem.hr.V).cwiseAbs().maxCoeff() > 1e-6)
+      throw ArgumentError(dir.string() + ": hr_rest.obj is not the surface of the face model these options build: regenerate the data");
+    data::write_contact_patches(lips_file, scenario::face_lip_patches(face), face.surface.num_vertices());
+  }
+  d.lips = data::read_contact_patches(lips_file, d.problem.num_hr());
   return d;
 }
 
@@ -175,6 +188,38 @@ double predict_test(P policy, const Method& method, const DemoData& d, const std
   std::filesystem::create_directories(file.parent_path());
   data::write_frame_set(file, "highres", pred);
   return r.seconds_per_frame;
+}
+
+/// Per test frame, the intersecting lip triangle pairs of the truth and of every method's
+/// prediction (exact test), written as CSV (frame, sequence, truth, methods…); returns the summary
+/// per column.
+template <exec::HostPolicy P>
+nlohmann::ordered_json write_lip_intersections(P policy, const std::filesystem::path& csv, const DemoData& d, const std::vector<std::string>& names,
+                                               const std::vector<data::FrameSet>& predictions) {
+  std::vector<std::vector<std::int64_t>> counts{eval::intersecting_pairs_per_frame(policy, d.test.highres, d.lips)};
+  for (const auto& p : predictions) counts.push_back(eval::intersecting_pairs_per_frame(policy, p.positions, d.lips));
+  std::ostringstream text;
+  text.imbue(std::locale::classic());
+  text << "frame,sequence,truth";
+  for (const auto& n : names) text << ',' << n;
+  text << '\n';
+  for (Index f = 0; f < d.test.num_frames(); ++f) {
+    text << d.test.ids[std::size_t(f)] << ',' << d.test_names[std::size_t(f)];
+    for (const auto& c : counts) text << ',' << c[std::size_t(f)];
+    text << '\n';
+  }
+  std::filesystem::create_directories(csv.parent_path());
+  io::write_file_atomic(csv, text.str());
+  nlohmann::ordered_json j;
+  j["upper_triangles"] = d.lips.a.rows();
+  j["lower_triangles"] = d.lips.b.rows();
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    const auto s = eval::summarize_intersections(counts[k]);
+    j["methods"][k == 0 ? std::string("truth") : names[k - 1]] = {
+        {"frames", s.frames}, {"frames_with_intersections", s.frames_with_intersections}, {"pairs_total", s.pairs_total}, {"pairs_max", s.pairs_max}};
+  }
+  j["csv"] = csv.string();
+  return j;
 }
 
 }  // namespace detail
@@ -216,31 +261,111 @@ inline std::vector<std::string> write_comparison_views(const std::filesystem::pa
   return written;
 }
 
-/// Runs (or reuses) every stage and writes the results; returns the report (also DIR/report.json).
-template <exec::HostPolicy P>
-nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log = {}) {
-  if (o.dataset != "face" && o.dataset != "bunny") throw ArgumentError("demo: --dataset must be face or bunny (got '" + o.dataset + "')");
-  if (o.methods.empty() && !o.network) throw ArgumentError("demo: no method and no network: nothing to evaluate");
-  const bool plain_name = !o.network_name.empty() && std::all_of(o.network_name.begin(), o.network_name.end(), [](char c) {
+namespace detail {
+
+/// ArgumentError unless `name` can name a network's stage, folder and prediction file.
+inline void check_network_name(const std::string& name, const std::vector<std::string>& methods) {
+  const bool plain_name = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
   });
-  if (!plain_name || std::find(o.methods.begin(), o.methods.end(), o.network_name) != o.methods.end() || o.network_name == "data" ||
-      o.network_name == "results" || o.network_name == "predictions" || o.network_name == "stages" || o.network_name == "report")
-    throw ArgumentError("demo: network name '" + o.network_name + "' must be letters, digits, _ or - and not a method's or a folder's name");
-  const auto t0 = std::chrono::steady_clock::now();
-  Stages stages(o.out, log);
-  DemoData d = o.dataset == "face" ? detail::face_data(policy, stages, o) : detail::bunny_data(o);
-  const auto& mp = o.method_parameters;
+  if (!plain_name || std::find(methods.begin(), methods.end(), name) != methods.end() || name == "data" || name == "results" || name == "predictions" ||
+      name == "stages" || name == "report" || name == "ablations")
+    throw ArgumentError("demo: network name '" + name + "' must be letters, digits, _ or - and not a method's or a folder's name");
+}
 
+/// The data set (stage "data" on the face) and the §3.2 neighbourhoods (stage "neighbors"), used
+/// by the problem; `nb_fingerprint` and `nb_result` receive that stage's fingerprint and result.
+template <exec::HostPolicy P>
+DemoData prepared_data(P policy, Stages& stages, const DemoOptions& o, std::string& nb_fingerprint, nlohmann::json& nb_result) {
+  if (o.dataset != "face" && o.dataset != "bunny") throw ArgumentError("demo: --dataset must be face or bunny (got '" + o.dataset + "')");
+  DemoData d = o.dataset == "face" ? face_data(policy, stages, o) : bunny_data(o);
+  const auto& mp = o.method_parameters;
   // §3.2 neighbourhoods and the LR graph, shared by IDW, MLS, RBF and the network.
   const auto nb_file = o.out / "neighbors.npz";
-  const std::string nb_fp = fingerprint_of({{"data", d.fingerprint}, {"k", mp.k}});
-  const auto nb_result = stages.run("neighbors", nb_fp, [&] {
+  nb_fingerprint = fingerprint_of({{"data", d.fingerprint}, {"k", mp.k}});
+  nb_result = stages.run("neighbors", nb_fingerprint, [&] {
     const auto nb = data::compute_network_neighborhoods(policy, d.problem.lr, d.problem.hr, mp.k, mp.k);
     data::save_network_neighborhoods(nb_file, nb);
     return nlohmann::json{{"k", mp.k}, {"assignment_cost", nb.upsampling.assignment_cost}, {"assignment_globally_optimal", nb.upsampling.assignment_globally_optimal}};
   });
   d.problem.use(data::read_network_neighborhoods(nb_file, d.problem.num_lr(), d.problem.num_hr()));
+  return d;
+}
+
+/// Stage "network-<name>": the network of `recipe` trained on the training frames (resumed from
+/// DIR/<name>/checkpoint.npz when a run of this very stage was killed), saved as
+/// DIR/<name>/model.npz with its training history, and run on the test frames
+/// (DIR/predictions/<name>.npz). Returns the stage's result.
+template <exec::HostPolicy P>
+nlohmann::json network_stage(P policy, Stages& stages, const DemoOptions& o, const DemoData& d, const std::string& nb_fp,
+                             const interp::NetworkRecipe& recipe, const std::string& name) {
+  check_network_name(name, o.methods);
+  const auto& mp = o.method_parameters;
+  const auto train_displacements = data::displacements(d.train, d.problem.lr.V, d.problem.hr.V);
+  const auto cfg = recipe.config(train_displacements);
+  const auto net_dir = o.out / name;
+  const std::string fp = fingerprint_of({{"neighbors", nb_fp}, {"recipe", recipe.to_json()}});
+  return stages.run("network-" + name, fp, [&] {
+    std::filesystem::create_directories(net_dir);
+    interp::Learned<> net(cfg, recipe.seed);
+    auto problem = d.problem;
+    interp::prepare(policy, net, problem, mp.k);
+    interp::NetworkTrainOptions to;
+    to.trainer.seed = recipe.seed;
+    to.trainer.progress = o.progress;
+    to.trainer.lr_decay_epochs = recipe.lr_decay_epochs;
+    to.checkpoint = net_dir / "checkpoint.npz";
+    if (cfg.w_contact > 0) {
+      if (d.lips.empty()) throw ArgumentError("demo: the contact term (--w-contact) needs contact patches: the face's lips (the " + o.dataset + " data has none)");
+      to.contact = d.lips;
+    }
+    // A checkpoint of this very stage (same fingerprint; its marker is missing: the run was
+    // killed) is resumed; one written under other options is not: training starts over and
+    // replaces it. (The trainer itself refuses a checkpoint of other data or options.)
+    const auto fp_file = net_dir / "checkpoint.fingerprint";
+    if (std::filesystem::exists(to.checkpoint) && std::filesystem::exists(fp_file)) {
+      std::ifstream in(fp_file);
+      std::string old;
+      in >> old;
+      if (old == fp) {
+        to.resume = to.checkpoint;
+        stages.say(name + ": resuming from " + to.checkpoint.string());
+      }
+    }
+    io::write_file_atomic(fp_file, fp + "\n");
+    const auto t = std::chrono::steady_clock::now();
+    net.train(policy, train_displacements, to);
+    const double train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+    net.save(net_dir / "model.npz");
+    const double diag = eval::bbox_diagonal(d.problem.hr.V);
+    eval::write_training_history(net_dir, net.history(), diag, -1);
+    nlohmann::json r;
+    r["model"] = (net_dir / "model.npz").string();
+    r["parameters"] = net.network().store().num_parameters();
+    r["epochs"] = net.epoch();
+    r["steps"] = net.steps();
+    r["train_seconds"] = train_seconds;
+    r["recipe"] = recipe.to_json();
+    r["displacement_scale"] = cfg.displacement_scale;
+    r["apply_seconds_per_frame"] = predict_test(policy, net, d, prediction_file(stages, name));
+    return r;
+  });
+}
+
+}  // namespace detail
+
+/// Runs (or reuses) every stage and writes the results; returns the report (also DIR/report.json).
+template <exec::HostPolicy P>
+nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log = {}) {
+  if (o.dataset != "face" && o.dataset != "bunny") throw ArgumentError("demo: --dataset must be face or bunny (got '" + o.dataset + "')");
+  if (o.methods.empty() && !o.network) throw ArgumentError("demo: no method and no network: nothing to evaluate");
+  if (o.network) detail::check_network_name(o.network_name, o.methods);
+  const auto t0 = std::chrono::steady_clock::now();
+  Stages stages(o.out, log);
+  std::string nb_fp;
+  nlohmann::json nb_result;
+  DemoData d = detail::prepared_data(policy, stages, o, nb_fp, nb_result);
+  const auto& mp = o.method_parameters;
 
   nlohmann::ordered_json methods_json;
   std::vector<std::string> names;
@@ -274,50 +399,7 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
 
   nlohmann::ordered_json network_json;
   if (o.network) {
-    const auto train_displacements = data::displacements(d.train, d.problem.lr.V, d.problem.hr.V);
-    const auto cfg = o.recipe.config(train_displacements);
-    const auto net_dir = o.out / o.network_name;
-    const std::string fp = fingerprint_of({{"neighbors", nb_fp}, {"recipe", o.recipe.to_json()}});
-    network_json = stages.run("network-" + o.network_name, fp, [&] {
-      std::filesystem::create_directories(net_dir);
-      interp::Learned<> net(cfg, o.recipe.seed);
-      interp::prepare(policy, net, d.problem, mp.k);
-      interp::NetworkTrainOptions to;
-      to.trainer.seed = o.recipe.seed;
-      to.trainer.progress = o.progress;
-      to.trainer.lr_decay_epochs = o.recipe.lr_decay_epochs;
-      to.checkpoint = net_dir / "checkpoint.npz";
-      // A checkpoint of this very stage (same fingerprint; its marker is missing: the run was
-      // killed) is resumed; one written under other options is not: training starts over and
-      // replaces it. (The trainer itself refuses a checkpoint of other data or options.)
-      const auto fp_file = net_dir / "checkpoint.fingerprint";
-      if (std::filesystem::exists(to.checkpoint) && std::filesystem::exists(fp_file)) {
-        std::ifstream in(fp_file);
-        std::string old;
-        in >> old;
-        if (old == fp) {
-          to.resume = to.checkpoint;
-          stages.say("network: resuming from " + to.checkpoint.string());
-        }
-      }
-      io::write_file_atomic(fp_file, fp + "\n");
-      const auto t = std::chrono::steady_clock::now();
-      net.train(policy, train_displacements, to);
-      const double train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-      net.save(net_dir / "model.npz");
-      const double diag = eval::bbox_diagonal(d.problem.hr.V);
-      eval::write_training_history(net_dir, net.history(), diag, -1);
-      nlohmann::json r;
-      r["model"] = (net_dir / "model.npz").string();
-      r["parameters"] = net.network().store().num_parameters();
-      r["epochs"] = net.epoch();
-      r["steps"] = net.steps();
-      r["train_seconds"] = train_seconds;
-      r["recipe"] = o.recipe.to_json();
-      r["displacement_scale"] = cfg.displacement_scale;
-      r["apply_seconds_per_frame"] = detail::predict_test(policy, net, d, detail::prediction_file(stages, o.network_name));
-      return r;
-    });
+    network_json = detail::network_stage(policy, stages, o, d, nb_fp, o.recipe, o.network_name);
     methods_json[o.network_name] = network_json;
     names.push_back(o.network_name);
   }
@@ -365,6 +447,10 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
     m["details"] = methods_json[names[i]];
   }
   report["comparison_views"] = views;
+  if (!d.lips.empty()) {  // issue #12 item 7: do the predicted lips pass through each other?
+    stages.say("results: intersecting lip triangle pairs per frame (truth and every method)");
+    report["lip_intersections"] = detail::write_lip_intersections(policy, o.out / "results" / "lip_intersections.csv", d, names, predictions);
+  }
   // Fig. 7 (§5.3): the LR-only unseen-force frames through Embedded and the network
   const auto unseen_dir = o.out / "data" / "unseen";
   if (o.dataset == "face" && o.network && std::filesystem::is_directory(unseen_dir)) {
@@ -409,6 +495,21 @@ nlohmann::ordered_json run_demo(P policy, const DemoOptions& o, const Log& log =
   report["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   io::write_file_atomic(o.out / "report.json", report.dump(2) + "\n");
   return report;
+}
+
+/// The lip-intersection summary of the report (empty when it has none): one line per column.
+inline std::string lip_intersections_text(const nlohmann::ordered_json& report) {
+  if (!report.contains("lip_intersections")) return "";
+  std::string out = "Intersecting lip triangle pairs (exact test, every test frame):\n";
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%-12s %10s %12s %10s\n", "", "frames", "pairs total", "max/frame");
+  out += buf;
+  for (const auto& [name, m] : report.at("lip_intersections").at("methods").items()) {
+    std::snprintf(buf, sizeof buf, "%-12s %4lld/%-5lld %12lld %10lld\n", name.c_str(), (long long)m.at("frames_with_intersections").get<std::int64_t>(),
+                  (long long)m.at("frames").get<std::int64_t>(), (long long)m.at("pairs_total").get<std::int64_t>(), (long long)m.at("pairs_max").get<std::int64_t>());
+    out += buf;
+  }
+  return out + "\n";
 }
 
 /// Table 1 as aligned text (mean, median, std, max, min): raw, relative to the bounding-box

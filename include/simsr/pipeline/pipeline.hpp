@@ -5,6 +5,7 @@
 /// an interpolator run live, pipelined (live.hpp), and the face animated that way (animate.hpp,
 /// `simsr animate`).
 
+#include "ablations.hpp"
 #include "animate.hpp"
 #include "demo.hpp"
 #include "live.hpp"

@@ -6,6 +6,9 @@
 ///     DIR/lr_rest.msh            the LR rest mesh (split lattice, m)
 ///     DIR/hr_rest.obj            the HR rest surface: the face skin, with triangles (m)
 ///     DIR/hr_volume.msh          the HR conforming tet mesh (for looking at it)
+///     DIR/hr_lips.npz            the lips as contact patches of hr_rest.obj (a: upper, b: lower;
+///                                data/contact_patches_file.hpp): the contact loss and the
+///                                evaluation's intersection count read them
 ///     DIR/<performance>.npz      lowres F×N×3, highres F×M×3, controls F×C, frame F, sequence
 ///     DIR/<performance>_controls.npz   the controls alone (names, weights): a controls file
 ///     DIR/face_data.json         sizes, options, per-performance timings and Newton iterations
@@ -41,6 +44,7 @@
 #include "../../core/error.hpp"
 #include "../../core/fingerprint.hpp"
 #include "../../core/parallel.hpp"
+#include "../../data/contact_patches_file.hpp"
 #include "../../data/paired_frames.hpp"
 #include "../../io/atomic_file.hpp"
 #include "../../io/mesh_io.hpp"
@@ -102,6 +106,33 @@ void measure_discrepancy(P policy, const FaceModel& face, const data::PairedFram
 /// (a 2^-36 m grid, ±4 m).
 inline std::vector<std::pair<Index, Index>> intersecting_lip_pairs(const FaceModel& face, const Points<>& X) {
   return intersecting_triangle_pairs(X, face.lip_upper_triangles, face.lip_lower_triangles, 0x1p-36);
+}
+
+/// The lips as contact patches of the HR surface (face.surface): its triangles whose three corners
+/// are upper-lip (patch a) or lower-lip (patch b) vertices of the model, in the surface's own
+/// order and orientation (outward). The HR simulation's contact sets also hold the mouth socket's
+/// inner lip triangles, which the surface (the skin super-resolution predicts) does not have.
+inline ContactPatches face_lip_patches(const FaceModel& face) {
+  const Index M = face.surface.num_vertices();
+  std::vector<char> side(std::size_t(face.hr.num_vertices()), 0);
+  for (Index i = 0; i < face.lip_upper_vertices.size(); ++i) side[std::size_t(face.lip_upper_vertices[i])] = 1;
+  for (Index i = 0; i < face.lip_lower_vertices.size(); ++i) side[std::size_t(face.lip_lower_vertices[i])] = 2;
+  std::vector<Index> rows[2];
+  for (Index t = 0; t < face.surface.F.rows(); ++t) {
+    const char s0 = side[std::size_t(face.surface_hr_vertex[face.surface.F(t, 0)])];
+    if (s0 == 0) continue;
+    bool same = true;
+    for (Index k = 1; k < 3; ++k) same = same && side[std::size_t(face.surface_hr_vertex[face.surface.F(t, k)])] == s0;
+    if (same) rows[s0 - 1].push_back(t);
+  }
+  ContactPatches p;
+  Tris* out[2] = {&p.a, &p.b};
+  for (int s = 0; s < 2; ++s) {
+    out[s]->resize(Index(rows[s].size()), 3);
+    for (std::size_t i = 0; i < rows[s].size(); ++i) out[s]->row(Index(i)) = face.surface.F.row(rows[s][i]);
+  }
+  p.check(M, "face_lip_patches");
+  return p;
 }
 
 namespace detail {
@@ -188,6 +219,7 @@ inline void write_face_rest_shapes(const FaceModel& face, const std::filesystem:
   io::write_mesh(dir / "lr_rest.msh", lr);
   io::write_mesh(dir / "hr_volume.msh", hrv);
   io::write_mesh(dir / "hr_rest.obj", hrs);
+  data::write_contact_patches(dir / "hr_lips.npz", face_lip_patches(face), face.surface.num_vertices());
 }
 
 /// Simulates `performances` on `face` into `dir` (see the file comment). Returns the figures of
