@@ -52,6 +52,11 @@ inline std::vector<AblationVariant> ablation_variants(const interp::NetworkRecip
   if (a.epochs < 1) throw ArgumentError("ablations: epochs must be >= 1 (got " + std::to_string(a.epochs) + ")");
   interp::NetworkRecipe r = base;
   r.epochs = a.epochs;
+  {  // the preset's k and upK spelled out, so that the variants equal to the full network are seen to be
+    const auto c = r.config();
+    r.knn = c.knn;
+    r.up_k = c.up_k;
+  }
   std::vector<AblationVariant> v;
   if (a.table2) {
     v.push_back({"full", "table2", 0, r});
