@@ -97,9 +97,9 @@ int ablate_cmd(DemoArgs& a, const pipeline::AblationOptions& ab) {
   std::cout << "variant      mean/diagonal   ms per frame\n";
   for (const auto& [name, v] : r.at("variants").items())
     std::printf("%-12s %13.4e %14.1f\n", name.c_str(), v.at("relative_mean_error").get<double>(), v.at("apply_ms_per_frame").get<double>());
+  std::printf("%-12s %13.4e\nfiles: %s/ablations.csv, table2.txt, fig9_upk.svg, fig9_knn.svg (browser)\n", "Embedded",
+              r.at("embedded").at("relative_mean").get<double>(), (a.o.out / "results").string().c_str());
   std::fflush(stdout);
-  std::cout << "Embedded     " << r.at("embedded").at("relative_mean_error").get<double>() << "\nfiles: " << (a.o.out / "results").string()
-            << "/ablations.csv, table2.txt, fig9_upk.svg, fig9_knn.svg (browser)\n";
   return 0;
 }
 }  // namespace

@@ -133,4 +133,21 @@ else:
         check(not REQUIRE, "SIMSR_REQUIRE_PEERS: the report page's browser test must run: " + page.stdout.strip())
     else:
         check(page.returncode == 0, f"report page in headless chromium: exit {page.returncode}: {page.stdout[-1500:]} {page.stderr[-1500:]}")
+
+# simsr ablate on the same folder: one variant trained (k = 5 is the upK = 10 network), its row
+# printed with Embedded's beside it, the files written; a sweep beyond the neighbourhoods' k refused.
+abl = subprocess.run([SIMSR, "ablate", "--dataset", "bunny", "--data", DATA, "--out", out, "--no-table2", "--upk-values", "10", "--knn-values", "5",
+                      "--ablation-epochs", "1", "--batch-size", "32"], capture_output=True, text=True)
+check(abl.returncode == 0, f"simsr ablate: exit {abl.returncode}: {abl.stderr[-2000:]}")
+if abl.returncode == 0:
+    summary = json.load(open(os.path.join(out, "results", "ablations.json")))
+    check(set(summary["variants"]) == {"upk10", "knn5"} and summary["variants"]["knn5"]["network"] == "abl_upk10", "ablate: knn5 is the upK = 10 network")
+    check(abl.stderr.count("stage network-abl_upk10: running") == 1, "ablate: one training")
+    printed = [l.split() for l in abl.stdout.splitlines() if l.startswith("upk10") or l.startswith("Embedded")]
+    check(len(printed) == 2 and abs(float(printed[0][1]) - summary["variants"]["upk10"]["relative_mean_error"]) <= 1e-4 * summary["variants"]["upk10"]["relative_mean_error"]
+          and abs(float(printed[1][1]) - summary["embedded"]["relative_mean"]) <= 1e-4 * summary["embedded"]["relative_mean"], f"ablate prints the JSON's errors: {abl.stdout}")
+    for f in ("ablations.csv", "fig9_upk.svg", "fig9_knn.svg"):
+        check(os.path.exists(os.path.join(out, "results", f)), f"ablate wrote results/{f}")
+bad = subprocess.run([SIMSR, "ablate", "--dataset", "bunny", "--data", DATA, "--out", out, "--upk-values", "30"], capture_output=True, text=True)
+check(bad.returncode == 5 and "interpolation neighbours 30" in bad.stderr, f"ablate --upk-values 30: argument error 5 naming it, got {bad.returncode}: {bad.stderr.strip()}")
 finish()
