@@ -233,7 +233,7 @@ TEST_CASE("nn::SuperResolutionLoss: the contact term works in mesh units whateve
   const Tris faces = f.patches.a;  // any faces for the face-normal term (off)
   const Matrix<double> rest_n = nn::normalize_positions<double>(f.rest, cfg.norm_mean, cfg.norm_std);
   nn::SuperResolutionLoss<double> with(cfg, rest_n, faces);
-  with.set_contact(f.patches);
+  with.set_contact(rest_n, f.patches);
   nn::NetworkConfig off = cfg;
   off.w_contact = 0;
   nn::SuperResolutionLoss<double> without(off, rest_n, faces);
@@ -250,7 +250,7 @@ TEST_CASE("nn::SuperResolutionLoss: the contact term works in mesh units whateve
   CHECK(to.contact == 0);
   // the term pushes the upper grid up (+z in network units) where it penetrates
   CHECK((d_with - d_without).bottomRows(f.n * f.n).col(2).sum() < 0);
-  CHECK_THROWS_WITH_AS(without.set_contact(f.patches), doctest::Contains("w_contact is 0"), ArgumentError);
+  CHECK_THROWS_WITH_AS(without.set_contact(rest_n, f.patches), doctest::Contains("w_contact is 0"), ArgumentError);
   nn::SuperResolutionLoss<double> unset(cfg, rest_n, faces);
   CHECK_THROWS_WITH_AS(unset.evaluate(exec::seq, pred, target, z, 0, &d_with, &d_z), doctest::Contains("no contact patches"), ArgumentError);
   nn::NetworkConfig no_radius = cfg;

@@ -2,6 +2,7 @@
 // The pipeline suites' data set in the bunny's layout (an LR box, an HR sphere inside it, frames
 // of a 6-parameter smooth motion): DIR/bunny/{lrestshape.obj, hrestshape.obj, train_frames.npz}.
 #include <simsr/data/paired_frames.hpp>
+#include <simsr/pipeline/demo.hpp>
 #include <simsr/io/obj.hpp>
 #include <simsr/mesh/generators.hpp>
 
@@ -35,6 +36,20 @@ inline std::filesystem::path small_bunny_layout(const std::string& folder, const
   }
   data::write_paired_frames(dir / "bunny" / "train_frames.npz", p);
   return dir;
+}
+
+/// Demo options over such a folder: the bunny layout, DIR/out, k = 10, batches of 4, no progress
+/// lines, network seed `seed`; each suite adds its methods and epochs.
+inline pipeline::DemoOptions small_demo_options(const std::filesystem::path& dir, std::uint64_t seed) {
+  pipeline::DemoOptions o;
+  o.dataset = "bunny";
+  o.data = dir;
+  o.out = dir / "out";
+  o.method_parameters.k = 10;
+  o.recipe.batch_size = 4;
+  o.recipe.seed = seed;
+  o.progress = false;
+  return o;
 }
 
 }  // namespace simsr::test

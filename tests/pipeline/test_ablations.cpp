@@ -25,17 +25,7 @@ namespace pipeline_ablations {
 
 std::filesystem::path small_dataset(const std::string& name, Index frames) { return test::small_bunny_layout("pipeline_ablations", name, frames); }
 
-pipeline::DemoOptions small_options(const std::filesystem::path& dir) {
-  pipeline::DemoOptions o;
-  o.dataset = "bunny";
-  o.data = dir;
-  o.out = dir / "out";
-  o.method_parameters.k = 10;
-  o.recipe.batch_size = 4;
-  o.recipe.seed = 2;
-  o.progress = false;
-  return o;
-}
+pipeline::DemoOptions small_options(const std::filesystem::path& dir) { return test::small_demo_options(dir, 2); }
 
 std::string read_text(const std::filesystem::path& p) {
   std::ifstream in(p);

@@ -24,16 +24,9 @@ namespace pipeline_demo {
 std::filesystem::path small_dataset(const std::string& name, Index frames) { return test::small_bunny_layout("pipeline_demo", name, frames); }
 
 pipeline::DemoOptions small_options(const std::filesystem::path& dir) {
-  pipeline::DemoOptions o;
-  o.dataset = "bunny";
-  o.data = dir;
-  o.out = dir / "out";
+  auto o = test::small_demo_options(dir, 5);
   o.methods = {"embedded", "idw", "ridge"};
-  o.method_parameters.k = 10;
   o.recipe.epochs = 1;
-  o.recipe.batch_size = 4;
-  o.recipe.seed = 5;
-  o.progress = false;
   return o;
 }
 

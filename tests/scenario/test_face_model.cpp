@@ -195,6 +195,7 @@ TEST_CASE("face model presets: the LR cell of each (the HR mesh the same), a bad
 }
 
 TEST_CASE("face_lip_patches: the skin's lip triangles, upper in a and lower in b, facing each other: still at rest, crossing when the upper lip drops") {
+  SIMSR_REQUIRE_FACE_INPUTS();
   const auto& face = test::coarse_face();
   const ContactPatches lips = scenario::face_lip_patches(face);
   REQUIRE(lips.a.rows() > 10);

@@ -65,9 +65,8 @@ struct NetworkRecipe {
     if (w_zreg >= 0) cfg.w_zreg = w_zreg;
     if (w_fn >= 0) cfg.w_fn = w_fn;
     if (lr_decay_epochs < 0) throw ArgumentError("network recipe: lr decay epochs must be >= 0 (got " + std::to_string(lr_decay_epochs) + ")");
-    if (!(w_contact >= 0) || !std::isfinite(w_contact)) throw ArgumentError("network recipe: the contact weight must be >= 0 (got " + std::to_string(w_contact) + ")");
-    if (w_contact > 0) {
-      cfg.w_contact = w_contact;
+    cfg.w_contact = w_contact;  // validate() below refuses a negative or non-finite one
+    if (w_contact > 0) {  // off, the geometry stays out of the config (and of older model files' comparisons)
       cfg.contact_radius = contact_radius;
       cfg.contact_margin = contact_margin;
     }
@@ -96,7 +95,11 @@ struct NetworkRecipe {
     nlohmann::ordered_json j = {{"profile", profile}, {"epochs", resolved_epochs()}, {"batch_size", batch_size}, {"lr", lr},          {"lr_decay_epochs", lr_decay_epochs},
             {"w_recon", w_recon}, {"w_zreg", w_zreg},            {"w_fn", w_fn},             {"residual", residual}, {"knn", knn},
             {"up_k", up_k},       {"without_fe", without_fe},    {"without_cu", without_cu}, {"seed", seed}, {"displacement_scale", displacement_scale}};
-    if (w_contact > 0) j["w_contact"] = w_contact, j["contact_radius"] = contact_radius, j["contact_margin"] = contact_margin;
+    if (w_contact != 0) {
+      j["w_contact"] = w_contact;
+      j["contact_radius"] = contact_radius;
+      j["contact_margin"] = contact_margin;
+    }
     return j;
   }
 };

@@ -26,8 +26,9 @@ struct ContactPatches {
   std::string fingerprint() const { return Fingerprint().add(a).add(b).hex(); }
 
   /// ArgumentError, naming `what`, the patch and the row, unless both patches have triangles, every
-  /// index lies in [0, num_vertices) and no vertex belongs to both.
-  void check(Index num_vertices, const std::string& what) const {
+  /// index lies in [0, num_vertices) and no vertex belongs to both. Returns each vertex's patch:
+  /// 1 (a), 2 (b) or 0 (neither).
+  std::vector<char> check(Index num_vertices, const std::string& what) const {
     if (empty()) throw ArgumentError(what + ": both contact patches need at least one triangle (a: " + std::to_string(a.rows()) + ", b: " +
                                      std::to_string(b.rows()) + ")");
     std::vector<char> side(std::size_t(num_vertices), 0);
@@ -43,6 +44,7 @@ struct ContactPatches {
           if (mark && mark != s + 1) throw ArgumentError(what + ": vertex " + std::to_string(v) + " belongs to both contact patches");
           mark = char(s + 1);
         }
+    return side;
   }
 };
 

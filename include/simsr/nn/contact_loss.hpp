@@ -73,14 +73,10 @@ class ContactLoss {
     if (!(radius > 0) || !std::isfinite(radius)) throw ArgumentError("nn::ContactLoss: radius = " + std::to_string(radius) + " must be positive");
     if (!(margin >= 0) || !std::isfinite(margin)) throw ArgumentError("nn::ContactLoss: margin = " + std::to_string(margin) + " must be >= 0");
     m_ = rest.rows();
-    patches.check(m_, "nn::ContactLoss");
+    const std::vector<char> side = patches.check(m_, "nn::ContactLoss");  // 1: patch a, 2: patch b
     const Matrix<double> X = rest.template cast<double>();
     if (!X.allFinite()) throw ArgumentError("nn::ContactLoss: the rest positions are not finite");
-    std::vector<char> side(std::size_t(m_), 0);  // 1: patch a, 2: patch b
     const Tris* sets[2] = {&patches.a, &patches.b};
-    for (int s = 0; s < 2; ++s)
-      for (Index t = 0; t < sets[s]->rows(); ++t)
-        for (Index k = 0; k < 3; ++k) side[std::size_t((*sets[s])(t, k))] = char(s + 1);
     // Every vertex of one patch against every triangle of the other (once, at rest).
     for (int s = 0; s < 2; ++s) {
       const Tris& other = *sets[1 - s];

@@ -38,8 +38,7 @@ class SuperResolutionLoss {
   template <class DR, class DF>
   SuperResolutionLoss(const NetworkConfig& cfg, const Eigen::MatrixBase<DR>& hr_rest_normalized, const Eigen::MatrixBase<DF>& faces,
                       long total_steps = 1)
-      : cfg_(cfg), fn_(hr_rest_normalized, faces, cfg.sum_reductions ? Reduction::sum : Reduction::mean),
-        rest_network_(hr_rest_normalized.template cast<double>() * cfg.displacement_scale) {
+      : cfg_(cfg), fn_(hr_rest_normalized, faces, cfg.sum_reductions ? Reduction::sum : Reduction::mean) {
     if (cfg.zreg == LatentRegularizer::ramped_norm) {
       ramp_.start = cfg.zreg_start;
       ramp_.end = cfg.zreg_end;
@@ -54,12 +53,17 @@ class SuperResolutionLoss {
     }
   }
 
-  /// The contact term's patches (rows of the HR surface): ArgumentError unless the config's
-  /// w_contact > 0 (patches without a weight would be silently ignored).
-  void set_contact(const ContactPatches& patches) {
+  /// The contact term's patches (rows of the HR surface, whose normalized rest shape the
+  /// constructor took): ArgumentError unless the config's w_contact > 0 (patches without a weight
+  /// would be silently ignored).
+  template <class DR>
+  void set_contact(const Eigen::MatrixBase<DR>& hr_rest_normalized, const ContactPatches& patches) {
     if (!(cfg_.w_contact > 0)) throw ArgumentError("nn::SuperResolutionLoss: contact patches given but the config's w_contact is 0");
-    const double unit = cfg_.displacement_unit();
-    contact_.emplace(rest_network_, patches, cfg_.contact_radius / unit, cfg_.contact_margin / unit);
+    if (hr_rest_normalized.rows() != fn_.vertices())
+      throw ShapeError("nn::SuperResolutionLoss::set_contact: HR rest shape", {fn_.vertices(), 3}, {hr_rest_normalized.rows(), hr_rest_normalized.cols()});
+    const double unit = cfg_.displacement_unit();  // distances in network units: normalized positions × displacement_scale
+    contact_.emplace(hr_rest_normalized.template cast<double>() * cfg_.displacement_scale, patches, cfg_.contact_radius / unit,
+                     cfg_.contact_margin / unit);
   }
   bool has_contact() const { return contact_.has_value(); }
   const ContactLoss<S>* contact() const { return contact_ ? &*contact_ : nullptr; }
@@ -126,7 +130,6 @@ class SuperResolutionLoss {
   FaceNormalLoss<S> fn_;
   RampedWeight ramp_;
   std::vector<std::pair<Index, Index>> blocks_;
-  Matrix<double> rest_network_;  ///< HR rest positions in network units (normalized × displacement_scale)
   std::optional<ContactLoss<S>> contact_;
   Matrix<S> d_fn_, d_block_;
 };

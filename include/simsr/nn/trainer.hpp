@@ -135,7 +135,7 @@ class Trainer {
   /// The contact term's patches (rows of the HR surface; the config's w_contact must be > 0).
   /// Part of the checkpoint's data: a checkpoint trained with other patches is refused.
   void set_contact(const ContactPatches& patches) {
-    loss_.set_contact(patches);
+    loss_.set_contact(net_->hr_rest_normalized(), patches);
     contact_fingerprint_ = patches.fingerprint();
   }
 

@@ -95,7 +95,7 @@ nlohmann::ordered_json run_ablations(P policy, const DemoOptions& o, const Ablat
   Stages stages(o.out, log);
   std::string nb_fp;
   nlohmann::json nb_result;
-  const DemoData d = detail::prepared_data(policy, stages, o, nb_fp, nb_result);
+  DemoData d = detail::prepared_data(policy, stages, o, nb_fp, nb_result);
   const auto variants = ablation_variants(o.recipe, a, o.method_parameters.k);
   const double diag = eval::bbox_diagonal(d.problem.hr.V);
   data::FrameSet truth;
@@ -107,8 +107,7 @@ nlohmann::ordered_json run_ablations(P policy, const DemoOptions& o, const Ablat
   double embedded_mean = 0;
   {
     interp::Embedded<> embedded;
-    auto problem = d.problem;
-    embedded.fit(policy, problem);
+    embedded.fit(policy, d.problem);
     embedded_mean = eval::evaluate(policy, embedded, d.problem.lr.V, d.problem.hr.V, d.test).errors.statistics().mean;
   }
 

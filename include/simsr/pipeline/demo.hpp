@@ -295,9 +295,10 @@ DemoData prepared_data(P policy, Stages& stages, const DemoOptions& o, std::stri
 /// Stage "network-<name>": the network of `recipe` trained on the training frames (resumed from
 /// DIR/<name>/checkpoint.npz when a run of this very stage was killed), saved as
 /// DIR/<name>/model.npz with its training history, and run on the test frames
-/// (DIR/predictions/<name>.npz). Returns the stage's result.
+/// (DIR/predictions/<name>.npz). Returns the stage's result. `d` is not const because fitting reads
+/// (and may complete) the problem's LR graph.
 template <exec::HostPolicy P>
-nlohmann::json network_stage(P policy, Stages& stages, const DemoOptions& o, const DemoData& d, const std::string& nb_fp,
+nlohmann::json network_stage(P policy, Stages& stages, const DemoOptions& o, DemoData& d, const std::string& nb_fp,
                              const interp::NetworkRecipe& recipe, const std::string& name) {
   check_network_name(name, o.methods);
   const auto& mp = o.method_parameters;
@@ -308,8 +309,7 @@ nlohmann::json network_stage(P policy, Stages& stages, const DemoOptions& o, con
   return stages.run("network-" + name, fp, [&] {
     std::filesystem::create_directories(net_dir);
     interp::Learned<> net(cfg, recipe.seed);
-    auto problem = d.problem;
-    interp::prepare(policy, net, problem, mp.k);
+    interp::prepare(policy, net, d.problem, mp.k);
     interp::NetworkTrainOptions to;
     to.trainer.seed = recipe.seed;
     to.trainer.progress = o.progress;
