@@ -80,6 +80,8 @@ int main(int argc, char** argv) {
         run("rbf", rbf, d);
         interp::Ridge<> ridge;
         run("ridge", ridge, d);
+        interp::LocalLinear<> local_linear;
+        run("local_linear", local_linear, d);
         interp::BetaVaeBaseline<> vae;
         run("beta_vae", vae, d, interp::BetaVaeTrainOptions{.epochs = vae_epochs, .on_epoch = {}});
         // The official network composed with Embedded (residual), trained with the tool's defaults

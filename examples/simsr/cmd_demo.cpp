@@ -61,7 +61,7 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
   cmd->add_option("--train-sequences", o.train_sequences, "face: performances trained on")->delimiter(',')->capture_default_str();
   cmd->add_option("--test-sequences", o.test_sequences, "face: performances evaluated")->delimiter(',')->capture_default_str();
   cmd->add_option("--holdout-every", o.bunny_holdout_every, "bunny: frames f with f % n == 0 are the test frames")->capture_default_str();
-  cmd->add_option("--methods", o.methods, "baselines (embedded idw rbf mls ridge beta_vae)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--methods", o.methods, "baselines (embedded idw rbf mls ridge local_linear beta_vae)")->delimiter(',')->capture_default_str();
   cmd->add_option("--k", o.method_parameters.k, "neighbours of the §3.2 neighbourhoods, IDW and MLS")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--rbf-distance", o.method_parameters.rbf_distance, "rbf: euclidean, geodesic or lr-mesh")->capture_default_str();
   cmd->add_option("--rbf-regularization", o.method_parameters.rbf_regularization, "rbf: lambda added to the kernel's diagonal")->capture_default_str();
@@ -75,6 +75,9 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
   cmd->add_option("--displacement-scale", r.displacement_scale, "network: multiply normalized displacements by this (1: official; 0: from the training frames)")
       ->capture_default_str();
   cmd->add_flag("--residual,!--no-residual", r.residual, "network: learn the correction of Embedded (default) or the displacement itself");
+  cmd->add_option("--residual-base", r.residual_base, "network: what the residual adds to: local_linear (fitted on the training frames) or embedded")
+      ->check(CLI::IsMember({"embedded", "local_linear"}))
+      ->capture_default_str();
   cmd->add_option("--seed", r.seed, "network: seed of the initial weights and the shuffling")->capture_default_str();
   cmd->add_flag("--without-fe", r.without_fe, "network ablation w/o FE (§5.4)");
   cmd->add_flag("--without-cu", r.without_cu, "network ablation w/o CU (§5.4)");

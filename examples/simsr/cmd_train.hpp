@@ -57,7 +57,8 @@ inline int train_cmd(const TrainArgs& a) {
   j["displacement_scale"] = cfg.displacement_scale;
 
   interp::Learned<> net(cfg, a.recipe.seed);
-  interp::prepare(exec::omp, net, problem, cfg.up_k);  // geometry only: training follows
+  const bool local_base = cfg.residual && cfg.residual_base == nn::ResidualBase::local_linear;
+  interp::prepare(exec::omp, net, problem, local_base ? std::max(cfg.up_k, cfg.residual_base_k) : cfg.up_k);  // geometry only: training follows
   double embedded_error = -1;
   if (test.num_frames() > 0) {  // the baseline to beat, on the same held-out frames
     interp::Embedded<> embedded;
@@ -92,6 +93,7 @@ inline int train_cmd(const TrainArgs& a) {
   j["epochs"] = net.epoch();
   j["steps"] = net.steps();
   j["batch_size"] = net.batch_size();
+  if (const auto* b = net.base_info()) j["residual_base"] = {{"kind", "local_linear"}, {"k", cfg.residual_base_k}, {"lambda_relative", b->lambda_relative}};
   j["geometry_seconds"] = sec(t_geo - t_start);
   j["training_seconds"] = sec(t_train - t_geo);
   if (!h.empty()) {
@@ -136,6 +138,9 @@ inline void add_train(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--holdout-every", a->holdout, "frames f with f % n == 0 are held out and evaluated (default 4; 0: none)");
   cmd->add_flag("--residual,!--no-residual", r.residual,
                 "learn the correction of the Embedded interpolation, Δx = Embedded + network (default); --no-residual: the network alone");
+  cmd->add_option("--residual-base", r.residual_base,
+                  "what the residual adds to: embedded (default) or local_linear (fitted on the training frames)")
+      ->check(CLI::IsMember({"embedded", "local_linear"}));
   cmd->add_flag("--without-fe", r.without_fe, "ablation w/o FE: h⁰ goes straight to the upsampling");
   cmd->add_flag("--without-cu", r.without_cu, "ablation w/o CU: fixed Euclidean neighbours with free learned weights");
   cmd->add_option("--checkpoint", a->checkpoint, "write a resumable checkpoint here after every epoch");

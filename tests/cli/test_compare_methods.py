@@ -25,10 +25,10 @@ p = subprocess.run([EXE, "--data-dir", bunny, "--train-frames", "16", "--test-fr
 check(p.returncode == 0, f"compare_methods exits 0 (got {p.returncode}: {p.stderr.strip()[-2000:]})")
 rows = [json.loads(l) for l in p.stdout.strip().splitlines() if l.startswith("{")]
 names = [r.get("method") for r in rows]
-check(names == ["embedded", "idw", "mls", "rbf", "ridge", "beta_vae", "network"], f"every method, in order: {names}")
+check(names == ["embedded", "idw", "mls", "rbf", "ridge", "local_linear", "beta_vae", "network"], f"every method, in order: {names}")
 flags = {r["method"]: (r["trainable"], r["needs_neighborhoods"]) for r in rows}
 expect = {"embedded": (False, False), "idw": (False, True), "mls": (False, True), "rbf": (False, True),
-          "ridge": (True, False), "beta_vae": (True, False), "network": (True, True)}
+          "ridge": (True, False), "local_linear": (True, True), "beta_vae": (True, False), "network": (True, True)}
 for name, want in expect.items():
     check(flags.get(name) == want, f"{name}: (trainable, needs_neighborhoods) = {flags.get(name)}, expected {want}")
 err = {r["method"]: r["relative_error"]["mean"] for r in rows}

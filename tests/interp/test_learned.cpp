@@ -7,6 +7,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -209,4 +210,72 @@ TEST_CASE("Learned: bad inputs are errors naming the vertex; the w/o CU ablation
   table.fit(exec::omp, s.problem);
   table.apply(exec::omp, in, out);
   CHECK(out.allFinite());
+}
+
+TEST_CASE("Learned over the local-linear base: untrained it is interp::LocalLinear; trained, saved and loaded it predicts the same") {
+  auto s = net_scene(12, 4);
+  const auto train = s.frames.select(std::vector<Index>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
+  nn::NetworkConfig cfg = residual_config();
+  cfg.residual_base = nn::ResidualBase::local_linear;
+  cfg.residual_base_k = 6;
+  interp::Learned<> untrained(cfg, 1);
+  untrained.fit(exec::omp, s.problem);
+  Points<> a(s.problem.num_hr(), 3), b(s.problem.num_hr(), 3), c(s.problem.num_hr(), 3);
+  const Points<> in = s.frames.lr(11);
+  CHECK_THROWS_WITH_AS(untrained.apply(exec::omp, in, a), doctest::Contains("not fitted yet"), ArgumentError);
+  CHECK_THROWS_AS(untrained.network().set_residual_map(Eigen::SparseMatrix<double, Eigen::RowMajor>(3, 3)), ShapeError);
+  interp::Learned<> over_embedded(residual_config(), 1);
+  over_embedded.fit(exec::omp, s.problem);
+  CHECK_THROWS_WITH_AS(over_embedded.network().set_residual_map(Eigen::SparseMatrix<double, Eigen::RowMajor>(3 * s.problem.num_hr(), 3 * s.problem.num_lr())),
+                       doctest::Contains("local_linear only"), ArgumentError);
+  untrained.train(exec::omp, train, quick(0));  // fits the base, no step
+  interp::LocalLinear<> ll(interp::LocalLinearOptions{.k = 6});
+  ll.fit(exec::omp, s.problem);
+  ll.train(exec::omp, train, {});
+  REQUIRE(untrained.base_info() != nullptr);
+  CHECK(untrained.base_info()->lambda_relative == ll.info().lambda_relative);
+  untrained.apply(exec::omp, in, a);
+  ll.apply(exec::omp, in, b);
+  CHECK((a - b).cwiseAbs().maxCoeff() <= 1e-5 * (1.0 + b.cwiseAbs().maxCoeff()));  // float32 network units
+
+  interp::Learned<> net(cfg, 1);
+  net.fit(exec::omp, s.problem);
+  net.train(exec::omp, train, quick(2));
+  net.apply(exec::omp, in, a);
+  CHECK((a - b).cwiseAbs().maxCoeff() > 0);  // it trained
+  const auto file = tmp("model_local_linear.npz");
+  net.save(file);
+  auto loaded = interp::Learned<>::from_model_file(file);
+  CHECK(loaded.base_info() == nullptr);
+  loaded.fit(exec::omp, s.problem);
+  loaded.apply(exec::omp, in, c);
+  CHECK(a == c);
+  // the map travels in the model file; without it the file is refused, naming the arrays
+  const auto arrays = nn::read_model_arrays(file);
+  auto without = [&](const std::vector<std::string>& names) {
+    io::NpzArrays out;
+    for (const auto& [k, v] : arrays)
+      if (std::find(names.begin(), names.end(), k) == names.end()) out.insert_or_assign(k, v);
+    return out;
+  };
+  CHECK_THROWS_WITH_AS(nn::model_data(without({"residual_map_data"}), "m.npz"), doctest::Contains("residual_map_data"), ArgumentError);
+  CHECK_THROWS_WITH_AS(nn::model_data(without({"residual_map_indptr", "residual_map_indices", "residual_map_data"}), "m.npz"),
+                       doctest::Contains("local-linear base"), ArgumentError);
+  auto bad = without({});
+  auto values = arrays.at("residual_map_data").to_vector<double>();
+  values[7] = std::nan("");
+  bad.insert_or_assign("residual_map_data", io::make_npy<double>({std::int64_t(values.size())}, values.data()));
+  CHECK_THROWS_WITH_AS(nn::model_data(bad, "m.npz"), doctest::Contains("not finite"), ArgumentError);
+}
+
+TEST_CASE("NetworkRecipe: the residual base by name; only a non-Embedded base enters the fingerprint JSON") {
+  interp::NetworkRecipe r;
+  CHECK(r.config().residual_base == nn::ResidualBase::embedded);
+  CHECK_FALSE(r.to_json().contains("residual_base"));
+  r.residual_base = "local_linear";
+  CHECK(r.config().residual_base == nn::ResidualBase::local_linear);
+  CHECK(r.to_json().at("residual_base") == "local_linear");
+  CHECK(nn::NetworkConfig::from_json(r.config().to_json()).residual_base == nn::ResidualBase::local_linear);
+  r.residual_base = "ridge";
+  CHECK_THROWS_AS(r.config(), ArgumentError);
 }

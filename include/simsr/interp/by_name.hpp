@@ -18,6 +18,7 @@
 #include "beta_vae.hpp"
 #include "embedded.hpp"
 #include "idw.hpp"
+#include "local_linear.hpp"
 #include "mls.hpp"
 #include "rbf.hpp"
 #include "ridge.hpp"
@@ -26,7 +27,7 @@ namespace simsr::interp {
 
 /// Every parameter a baseline takes by name (defaults: the paper's).
 struct MethodParameters {
-  Index k = 20;                           ///< idw, mls: neighbours per HR vertex (paper 20)
+  Index k = 20;                           ///< idw, mls, local_linear: neighbours per HR vertex (paper 20)
   double power = 2;                       ///< idw: p of 1/d^p
   double sigma = 0;                       ///< rbf, mls: Gaussian width (0: from the data)
   int degree = -1;                        ///< rbf: polynomial tail degree (-1 none, 0, 1)
@@ -40,7 +41,7 @@ struct MethodParameters {
 
 /// The names `with_method` knows, the cheap ones first (beta_vae trains for minutes).
 inline const std::vector<std::string>& method_names() {
-  static const std::vector<std::string> names{"embedded", "idw", "rbf", "mls", "ridge", "beta_vae"};
+  static const std::vector<std::string> names{"embedded", "idw", "rbf", "mls", "ridge", "local_linear", "beta_vae"};
   return names;
 }
 
@@ -80,6 +81,9 @@ void with_method(const std::string& name, const MethodParameters& a, Visit&& vis
   } else if (name == "ridge") {
     Ridge<> m;
     visit(m, RidgeTrainOptions{});
+  } else if (name == "local_linear") {
+    LocalLinear<> m(LocalLinearOptions{.k = a.k});
+    visit(m, LocalLinearTrainOptions{});
   } else if (name == "beta_vae") {
     if (a.vae_epochs < 0) throw ArgumentError("beta_vae epochs must be >= 0 (got " + std::to_string(a.vae_epochs) + ")");
     BetaVaeBaseline<> m;

@@ -20,6 +20,7 @@
 #include "fit_and_train.hpp"
 #include "idw.hpp"
 #include "learned.hpp"
+#include "local_linear.hpp"
 #include "network_recipe.hpp"
 #include "mls.hpp"
 #include "problem.hpp"

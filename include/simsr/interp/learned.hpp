@@ -12,7 +12,8 @@
 /// It owns what a network user must otherwise get right by hand: the network's geometry from the
 /// fitted problem (the problem's upsampling neighbourhoods and LR graph — from the authors'
 /// files via `problem.use(...)`, or computed; Euclidean neighbours for the w/o CU ablation; the
-/// Embedded matrix for the residual composition), the official normalization of inputs and
+/// Embedded matrix for the residual composition, or the local-linear base fitted on the training
+/// frames: NetworkConfig::residual_base), the official normalization of inputs and
 /// targets (positions (x − μ)/σ in float32 minus the normalized rest shape; predictions back to
 /// mesh units by σ; displacements scaled by the config's displacement_scale), training with held-out evaluation and resumable checkpoints, and inference
 /// through the precomputed upsampling weights.
@@ -38,6 +39,7 @@
 #include "../nn/super_resolution_net.hpp"
 #include "../nn/trainer.hpp"
 #include "concepts.hpp"
+#include "local_linear.hpp"
 #include "problem.hpp"
 
 namespace simsr::interp {
@@ -54,6 +56,8 @@ struct NetworkTrainOptions {
   /// Continue from this checkpoint when not empty: it must come from the same config, options and
   /// data (nn::Trainer::load_checkpoint names what differs).
   std::filesystem::path resume;
+  /// How the local-linear residual base is fitted (NetworkConfig::residual_base = local_linear).
+  LocalLinearTrainOptions base;
   /// The contact term's patches (rows of the HR surface), for a config with w_contact > 0 (the
   /// face's lips: scenario::face_lip_patches, DIR/hr_lips.npz of simsr datagen).
   ContactPatches contact;
@@ -115,8 +119,13 @@ class Learned {
       g.up_distances = nb.distances.leftCols(cfg.up_k);
     }
     if (cfg.feature_embedding) g.lr_graph = problem.ensure_lr_graph(policy, cfg.knn).leftCols(cfg.knn);
-    if (cfg.residual)
+    base_.reset();
+    if (cfg.residual && cfg.residual_base == nn::ResidualBase::embedded)
       g.embedding = embedding_matrix(embed(policy, problem.lr, problem.hr.V), problem.lr.T, problem.num_lr()).template cast<double>();
+    if (cfg.residual && cfg.residual_base == nn::ResidualBase::local_linear) {  // fitted on the frames by train()
+      base_ = std::make_unique<LocalLinear<Scalar>>(LocalLinearOptions{.k = cfg.residual_base_k});
+      base_->fit(policy, problem);
+    }
     model_ = nn::ModelData{cfg, std::move(g), problem.lr.T, problem.hr.F};
     nn::Rng rng(seed_);
     net_ = std::make_unique<Net>(cfg, model_.geometry, rng);
@@ -128,6 +137,11 @@ class Learned {
   template <exec::HostPolicy Policy>
   void train(Policy policy, const data::PairedFrames<Scalar>& frames, const NetworkTrainOptions& options) {
     if (!net_) throw ArgumentError("Learned::train before fit");
+    if (base_) {  // the local-linear base, on the frames the network then trains on (deterministic: a resumed run refits the same)
+      base_->train(policy, frames, options.base);
+      model_.geometry.residual_map = base_->linear_map();
+      net_->set_residual_map(model_.geometry.residual_map);
+    }
     nn::Trainer<network_scalar, typename Net::search_type> trainer(*net_, model_.hr_faces, training_frames(frames, "training frames"), options.trainer);
     if (options.holdout) trainer.set_holdout(training_frames(*options.holdout, "held-out frames"));
     if (!options.contact.empty()) trainer.set_contact(options.contact);
@@ -178,6 +192,8 @@ class Learned {
   const Net& network() const { return *net_; }
   /// The model data (config, geometry, meshes) fitted or loaded.
   const nn::ModelData& model() const { return model_; }
+  /// The local-linear residual base's training report (after train; nullptr for another base or a loaded model).
+  const LocalLinearTrainInfo* base_info() const { return base_ ? &base_->info() : nullptr; }
   /// One report per trained epoch (loss terms, seconds, held-out mean error in mesh units).
   const std::vector<nn::EpochReport>& history() const { return history_; }
   /// Epochs trained in all (a resumed run counts the checkpoint's), optimizer steps, batch size.
@@ -248,6 +264,7 @@ class Learned {
   nn::NetworkConfig config_;
   std::uint64_t seed_ = 0;
   std::unique_ptr<Net> net_;
+  std::unique_ptr<LocalLinear<Scalar>> base_;  ///< the local-linear residual base, until trained
   nn::ModelData model_;
   std::string loaded_from_;
   std::vector<nn::EpochReport> history_;

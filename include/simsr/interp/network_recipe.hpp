@@ -32,7 +32,10 @@ struct NetworkRecipe {
   double lr = 1e-3;                  ///< Adam
   Index lr_decay_epochs = 10;        ///< halve the learning rate every that many epochs (0: never)
   double w_recon = -1, w_zreg = -1, w_fn = -1;  ///< −1: the preset's
-  bool residual = true;              ///< Δx = Embedded + network
+  bool residual = true;              ///< Δx = base + network
+  /// The residual's base: "embedded" (the official geometry's barycentric interpolation) or
+  /// "local_linear" (interp::LocalLinear fitted on the training frames; README, "The network on the face").
+  std::string residual_base = "embedded";
   Index knn = -1, up_k = -1;         ///< EdgeConv k, interpolation neighbours (−1: the preset's)
   bool without_fe = false, without_cu = false;  ///< §5.4 ablations
   std::uint64_t seed = 0;            ///< initial weights and shuffling
@@ -55,6 +58,10 @@ struct NetworkRecipe {
     if (knn > 0) cfg.knn = knn;
     if (up_k > 0) cfg.up_k = up_k;
     cfg.residual = residual;
+    if (residual_base == "local_linear")
+      cfg.residual_base = nn::ResidualBase::local_linear;
+    else if (residual_base != "embedded")
+      throw ArgumentError("network recipe: residual base must be embedded or local_linear (got '" + residual_base + "')");
     if (without_fe) cfg.disable_feature_embedding();
     if (without_cu) cfg.upsampling = nn::UpsamplingKind::table;
     cfg.epochs = resolved_epochs();
@@ -89,12 +96,14 @@ struct NetworkRecipe {
     return cfg;
   }
 
-  /// Every field, for reports and the fingerprints of pipeline stages (the contact fields only
-  /// when the term is on: stages finished before it existed keep their fingerprints).
+  /// Every field, for reports and the fingerprints of pipeline stages (the residual base when not
+  /// Embedded and the contact fields when the term is on: stages finished before they existed keep
+  /// their fingerprints).
   nlohmann::ordered_json to_json() const {
     nlohmann::ordered_json j = {{"profile", profile}, {"epochs", resolved_epochs()}, {"batch_size", batch_size}, {"lr", lr},          {"lr_decay_epochs", lr_decay_epochs},
             {"w_recon", w_recon}, {"w_zreg", w_zreg},            {"w_fn", w_fn},             {"residual", residual}, {"knn", knn},
             {"up_k", up_k},       {"without_fe", without_fe},    {"without_cu", without_cu}, {"seed", seed}, {"displacement_scale", displacement_scale}};
+    if (residual_base != "embedded") j["residual_base"] = residual_base;  // absent: the stages of earlier versions keep their fingerprints
     if (w_contact != 0) {
       j["w_contact"] = w_contact;
       j["contact_radius"] = contact_radius;

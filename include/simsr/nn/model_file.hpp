@@ -3,7 +3,8 @@
 /// A trained network as one self-contained `.npz` (SPEC §7 "Weights are saved as .npz"): every
 /// tensor under its PyTorch state-dict name and shape (float32; `num_batches_tracked` int64 0-d),
 /// the config as 0-d unicode JSON, and everything inference needs — rest shapes, LR tets, HR
-/// faces, neighbourhoods, normalization (and the embedding for the residual option). The layout is
+/// faces, neighbourhoods, normalization (and the residual base: the Embedded matrix `embedding_*`, or
+/// the local-linear map `residual_map_*`, both as scipy CSR arrays). The layout is
 /// the one scripts/torch_to_simsr.py writes from an official PyTorch checkpoint, so either loads.
 ///
 ///     nn::ModelData data = nn::read_model_data("model.npz");         // config + geometry
@@ -11,6 +12,7 @@
 ///     nn::load_state(net.store(), nn::read_model_arrays("model.npz"));  // strict, as PyTorch's
 ///     nn::save_model("copy.npz", net, data);
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -99,6 +101,42 @@ Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> model_matrix(c
   return x.to_matrix<T>();
 }
 
+/// A rows×cols sparse matrix stored as `<name>_indptr`, `<name>_indices`, `<name>_data` (scipy's
+/// CSR), checked: consistent lengths, indptr never decreasing, indices within [0, cols), finite values.
+inline Eigen::SparseMatrix<double, Eigen::RowMajor> read_csr(const io::NpzArrays& a, const std::string& file, const std::string& name, Index rows,
+                                                            Index cols) {
+  for (const char* part : {"_indptr", "_indices", "_data"})
+    if (!a.contains(name + part)) throw ArgumentError(file + ": '" + name + part + "' is missing (the " + name + " CSR arrays come together)");
+  const auto ptr = a.at(name + "_indptr").to_vector<std::int64_t>();
+  const auto idx = a.at(name + "_indices").to_vector<std::int64_t>();
+  const auto val = a.at(name + "_data").to_vector<double>();
+  if (Index(ptr.size()) != rows + 1 || ptr.front() != 0 || std::size_t(ptr.back()) != idx.size() || idx.size() != val.size())
+    throw ArgumentError(file + ": the " + name + " CSR arrays are inconsistent (" + std::to_string(rows) + " rows expected)");
+  // all of indptr before any row is read: a row past a later decrease would index beyond idx
+  for (Index r = 0; r < rows; ++r)
+    if (ptr[std::size_t(r + 1)] < ptr[std::size_t(r)]) throw ArgumentError(file + ": " + name + "_indptr decreases at row " + std::to_string(r));
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(idx.size());
+  for (Index r = 0; r < rows; ++r) {
+    for (auto k = ptr[std::size_t(r)]; k < ptr[std::size_t(r + 1)]; ++k) {
+      if (idx[std::size_t(k)] < 0 || idx[std::size_t(k)] >= cols) throw ArgumentError(file + ": " + name + " index out of range in row " + std::to_string(r));
+      if (!std::isfinite(val[std::size_t(k)])) throw ArgumentError(file + ": " + name + " entry in row " + std::to_string(r) + " is not finite");
+      t.emplace_back(r, idx[std::size_t(k)], val[std::size_t(k)]);
+    }
+  }
+  Eigen::SparseMatrix<double, Eigen::RowMajor> m(rows, cols);
+  m.setFromTriplets(t.begin(), t.end());
+  return m;
+}
+
+inline void write_csr(io::NpzArrays& out, const std::string& name, Eigen::SparseMatrix<double, Eigen::RowMajor> m) {
+  m.makeCompressed();
+  std::vector<std::int64_t> ptr(m.outerIndexPtr(), m.outerIndexPtr() + m.rows() + 1), idx(m.innerIndexPtr(), m.innerIndexPtr() + m.nonZeros());
+  out[name + "_indptr"] = io::make_npy<std::int64_t>({std::int64_t(ptr.size())}, ptr.data());
+  out[name + "_indices"] = io::make_npy<std::int64_t>({std::int64_t(idx.size())}, idx.data());
+  out[name + "_data"] = io::make_npy<double>({std::int64_t(m.nonZeros())}, m.valuePtr());
+}
+
 }  // namespace detail
 
 /// ArgumentError unless `arrays` hold exactly the state tensors that `cfg` implies for M HR
@@ -165,25 +203,14 @@ inline ModelData model_data(const io::NpzArrays& a, const std::string& file = "<
   check_range(d.lr_tets, N, "lr_tets");
   check_range(d.hr_faces, M, "hr_faces");
   if (a.contains("embedding_indptr")) {
-    const auto ptr = a.at("embedding_indptr").to_vector<std::int64_t>();
-    const auto idx = a.at("embedding_indices").to_vector<std::int64_t>();
-    const auto val = a.at("embedding_data").to_vector<double>();
-    if (Index(ptr.size()) != M + 1 || ptr.front() != 0 || std::size_t(ptr.back()) != idx.size() || idx.size() != val.size())
-      throw ArgumentError(file + ": the embedding CSR arrays are inconsistent");
-    // all of indptr before any row is read: a row past a later decrease would index beyond idx
-    for (Index r = 0; r < M; ++r)
-      if (ptr[std::size_t(r + 1)] < ptr[std::size_t(r)]) throw ArgumentError(file + ": embedding_indptr decreases at row " + std::to_string(r));
-    std::vector<Eigen::Triplet<double>> t;
-    for (Index r = 0; r < M; ++r) {
-      for (auto k = ptr[std::size_t(r)]; k < ptr[std::size_t(r + 1)]; ++k) {
-        if (idx[std::size_t(k)] < 0 || idx[std::size_t(k)] >= N) throw ArgumentError(file + ": embedding index out of range in row " + std::to_string(r));
-        t.emplace_back(r, idx[std::size_t(k)], val[std::size_t(k)]);
-      }
-    }
-    g.embedding.resize(M, N);
-    g.embedding.setFromTriplets(t.begin(), t.end());
-  } else if (d.config.residual) {
+    g.embedding = detail::read_csr(a, file, "embedding", M, N);
+  } else if (d.config.residual && d.config.residual_base == ResidualBase::embedded) {
     throw ArgumentError(file + ": a residual model needs the embedding arrays (embedding_indptr, embedding_indices, embedding_data)");
+  }
+  if (a.contains("residual_map_indptr")) {
+    g.residual_map = detail::read_csr(a, file, "residual_map", 3 * M, 3 * N);
+  } else if (d.config.residual && d.config.residual_base == ResidualBase::local_linear) {
+    throw ArgumentError(file + ": a model over the local-linear base needs its arrays (residual_map_indptr, residual_map_indices, residual_map_data)");
   }
   return d;
 }
@@ -213,14 +240,8 @@ io::NpzArrays model_arrays(const SuperResolutionNet<S, Search>& net, const Model
   const double mean = net.config().norm_mean, sd = net.config().norm_std;
   out["norm_mean"] = io::make_npy<double>({}, &mean);
   out["norm_std"] = io::make_npy<double>({}, &sd);
-  if (g.embedding.nonZeros() > 0) {
-    Eigen::SparseMatrix<double, Eigen::RowMajor> E = g.embedding;
-    E.makeCompressed();
-    std::vector<std::int64_t> ptr(E.outerIndexPtr(), E.outerIndexPtr() + E.rows() + 1), idx(E.innerIndexPtr(), E.innerIndexPtr() + E.nonZeros());
-    out["embedding_indptr"] = io::make_npy<std::int64_t>({std::int64_t(ptr.size())}, ptr.data());
-    out["embedding_indices"] = io::make_npy<std::int64_t>({std::int64_t(idx.size())}, idx.data());
-    out["embedding_data"] = io::make_npy<double>({std::int64_t(E.nonZeros())}, E.valuePtr());
-  }
+  if (g.embedding.nonZeros() > 0) detail::write_csr(out, "embedding", g.embedding);
+  if (g.residual_map.nonZeros() > 0) detail::write_csr(out, "residual_map", g.residual_map);
   return out;
 }
 

@@ -30,6 +30,13 @@ enum class UpsamplingKind {
   table  ///< w/o CU: one free logit per (HR vertex, neighbour), not a function of coordinates
 };
 
+/// What the residual composition (NetworkConfig::residual) adds the network's output to.
+enum class ResidualBase {
+  embedded,     ///< the Embedded (barycentric) interpolation of the LR displacements, fixed by the rest shapes
+  local_linear  ///< simsr: interp::LocalLinear fitted on the training frames (each HR vertex a 3×3-block
+                ///< linear map of its upsampling neighbours' displacements); the network learns what it misses
+};
+
 /// The latent regularizer of the loss (Eq. 7's β·L_reg).
 enum class LatentRegularizer {
   mean_abs,     ///< official model.py: w_zreg·mean|z| over z = [h⁰, h¹, h²]
@@ -61,8 +68,12 @@ struct NetworkConfig {
   double w0_initial = 30.0, w0 = 1.0;
   double leaky_relu_slope = 0.2;
   double batchnorm_eps = 1e-5, batchnorm_momentum = 0.1;
-  /// Δx^H = Embedded(Δx^L) + network output: the network learns what the embedding misses.
+  /// Δx^H = base(Δx^L) + network output: the network learns what the base misses.
   bool residual = false;
+  /// The base of the residual composition. local_linear is fitted by interp::Learned::train on the
+  /// training frames before the first step, and travels in the model file as a 3M×3N matrix.
+  ResidualBase residual_base = ResidualBase::embedded;
+  Index residual_base_k = 20;              ///< local_linear: upsampling neighbours per HR vertex
   // --- data normalization (official dataset.py) ---------------------------------------------------
   double norm_mean = 0.5 * (0.04998 - 0.05092);
   double norm_std = 0.5 * (0.04998 + 0.05092);
@@ -197,6 +208,7 @@ struct NetworkConfig {
     if (epochs < 0) fail("epochs must be >= 0");
     if (!(w_recon >= 0) || !(w_fn >= 0) || !(w_zreg >= 0) || !(zreg_start >= 0) || !(zreg_end >= 0)) fail("loss weights must be >= 0");
     if (zreg_ramp_steps < 0) fail("zreg_ramp_steps must be >= 0");
+    if (residual_base_k < 1 || residual_base_k > max_neighbors) fail("residual_base_k must be in [1, " + std::to_string(max_neighbors) + "]");
     if (!(w_contact >= 0) || !(contact_radius >= 0) || !(contact_margin >= 0)) fail("w_contact, contact_radius and contact_margin must be >= 0");
     if (w_contact > 0 && !(contact_radius > 0)) fail("w_contact > 0 needs contact_radius > 0 (the candidate pairs' distance at rest)");
   }
@@ -229,6 +241,8 @@ struct NetworkConfig {
     f("batchnorm_eps", c.batchnorm_eps);
     f("batchnorm_momentum", c.batchnorm_momentum);
     f("residual", c.residual);
+    f("residual_base", c.residual_base);
+    f("residual_base_k", c.residual_base_k);
     f("norm_mean", c.norm_mean);
     f("norm_std", c.norm_std);
     f("displacement_scale", c.displacement_scale);
@@ -307,10 +321,14 @@ struct NetworkConfig {
   static constexpr std::pair<UpsamplingKind, const char*> upsampling_names[] = {{UpsamplingKind::mlp, "mlp"}, {UpsamplingKind::table, "table"}};
   static constexpr std::pair<LatentRegularizer, const char*> zreg_names[] = {
       {LatentRegularizer::mean_abs, "mean_abs"}, {LatentRegularizer::mean_square, "mean_square"}, {LatentRegularizer::ramped_norm, "ramped_norm"}};
+  static constexpr std::pair<ResidualBase, const char*> residual_base_names[] = {{ResidualBase::embedded, "embedded"},
+                                                                                {ResidualBase::local_linear, "local_linear"}};
   template <class E>
   static constexpr const auto& names_of() {
     if constexpr (std::is_same_v<E, UpsamplingKind>)
       return upsampling_names;
+    else if constexpr (std::is_same_v<E, ResidualBase>)
+      return residual_base_names;
     else
       return zreg_names;
   }

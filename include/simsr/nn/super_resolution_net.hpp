@@ -39,9 +39,13 @@ struct NetworkGeometry {
   GraphIndices lr_graph;       ///< N×(≥ knn) LR geodesic neighbours, self first (EdgeConv graph 1)
   GraphIndices up_indices;     ///< M×(≥ upK) LR neighbours of each HR vertex, nearest first
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> up_distances;  ///< M×(≥ upK), raw units
-  /// M×N embedding (barycentric) matrix: needed only with cfg.residual (the network then starts
-  /// at the Embedded interpolation: its output layer is initialized to zero).
+  /// M×N embedding (barycentric) matrix: needed only with cfg.residual over Embedded (the network
+  /// then starts at the Embedded interpolation: its output layer is initialized to zero).
   Eigen::SparseMatrix<double, Eigen::RowMajor> embedding;
+  /// 3M×3N linear map on displacements flattened by vertex (interp::LocalLinear::linear_map): the
+  /// base of cfg.residual with ResidualBase::local_linear. May be empty at construction (it is
+  /// fitted on the training frames: SuperResolutionNet::set_residual_map before the first forward).
+  Eigen::SparseMatrix<double, Eigen::RowMajor> residual_map;
 };
 
 template <class S = float, class Search = neighbors::BruteForceKnn<S>>
@@ -74,12 +78,31 @@ class SuperResolutionNet {
                                                     upsampling_query<S>(hr_n_, lr_n_, idx, geo.up_distances.leftCols(cfg_.up_k)), idx, N, rng);
     decoder_ = std::make_unique<SirenDecoder<S>>(store_, "net_decoder.decoder", cfg_, rng);
     if (cfg_.residual) {
-      if (geo.embedding.rows() != M || geo.embedding.cols() != N)
-        throw ShapeError("nn::SuperResolutionNet: residual needs the M×N embedding matrix", {M, N}, {geo.embedding.rows(), geo.embedding.cols()});
-      embedding_ = geo.embedding.template cast<S>();
+      if (cfg_.residual_base == ResidualBase::embedded) {
+        if (geo.embedding.rows() != M || geo.embedding.cols() != N)
+          throw ShapeError("nn::SuperResolutionNet: residual needs the M×N embedding matrix", {M, N}, {geo.embedding.rows(), geo.embedding.cols()});
+        embedding_ = geo.embedding.template cast<S>();
+      } else if (geo.residual_map.rows() > 0 || geo.residual_map.cols() > 0) {
+        set_residual_map(geo.residual_map);
+      }
       decoder_->zero_output_layer();
     }
   }
+
+  /// The residual base's 3M×3N map (ResidualBase::local_linear; see NetworkGeometry::residual_map).
+  /// ArgumentError for another base, ShapeError for another size, ArgumentError for a non-finite entry.
+  void set_residual_map(const Eigen::SparseMatrix<double, Eigen::RowMajor>& map) {
+    if (!cfg_.residual || cfg_.residual_base != ResidualBase::local_linear)
+      throw ArgumentError("nn::SuperResolutionNet: a residual map is the base of residual = true with residual_base = local_linear only");
+    if (map.rows() != 3 * m_ || map.cols() != 3 * n_)
+      throw ShapeError("nn::SuperResolutionNet: residual map (3M×3N)", {3 * m_, 3 * n_}, {map.rows(), map.cols()});
+    for (Index k = 0; k < map.outerSize(); ++k)
+      for (typename Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(map, k); it; ++it)
+        if (!std::isfinite(it.value())) throw ArgumentError("nn::SuperResolutionNet: residual map entry in row " + std::to_string(k) + " is not finite");
+    residual_map_ = map.template cast<S>();
+    residual_map_.makeCompressed();
+  }
+  bool has_residual_map() const { return residual_map_.rows() > 0; }
 
   /// The state dict this network registers for `cfg` and M HR vertices, in order (names, shapes,
   /// kinds; no weight allocated): a model file's tensors are checked against it before a network
@@ -178,17 +201,30 @@ class SuperResolutionNet {
   void decode(Policy policy, Mode mode, const ConstView<S>& ldx, Matrix<S>& pred) {
     decoder_->forward(policy, mode, zh_, pred);
     pred_ = &pred;
-    if (cfg_.residual) {
-      // Row by row under the policy: Eigen's sparse × dense product may start its own OpenMP
-      // threads, and exec::seq must start none (tests/threads).
-      const Index B = ldx.rows() / n_;
+    if (!cfg_.residual) return;
+    // Row by row under the policy: Eigen's sparse × dense product may start its own OpenMP
+    // threads, and exec::seq must start none (tests/threads).
+    const Index B = ldx.rows() / n_;
+    if (cfg_.residual_base == ResidualBase::embedded) {
       exec::parallel_for(policy, B * m_, [&](Index r) {
         const Index b = r / m_;
         auto out = pred.row(r);
         for (typename decltype(embedding_)::InnerIterator it(embedding_, r - b * m_); it; ++it)
           out += it.value() * ldx.row(b * n_ + it.index());
       });
+      return;
     }
+    if (!has_residual_map())
+      throw ArgumentError("nn::SuperResolutionNet: the local-linear residual base is not fitted yet (set_residual_map, or interp::Learned::train)");
+    exec::parallel_for(policy, B * m_, [&](Index r) {
+      const Index b = r / m_, v = r - b * m_;
+      for (Index c = 0; c < 3; ++c) {  // column 3j + a: LR vertex j of this item, coordinate a
+        S acc = 0;
+        for (typename decltype(residual_map_)::InnerIterator it(residual_map_, 3 * v + c); it; ++it)
+          acc += it.value() * ldx(b * n_ + it.index() / 3, it.index() % 3);
+        pred(r, c) += acc;
+      }
+    });
   }
   ConstView<S> pred_ref() const {
     if (!pred_) throw ArgumentError("nn::SuperResolutionNet::backward: needs a forward first");
@@ -203,7 +239,7 @@ class SuperResolutionNet {
   std::unique_ptr<FeatureEmbedding<S, Search>> fe_;
   std::unique_ptr<CoordinateUpsampling<S>> up_;
   std::unique_ptr<SirenDecoder<S>> decoder_;
-  Eigen::SparseMatrix<S, Eigen::RowMajor> embedding_;
+  Eigen::SparseMatrix<S, Eigen::RowMajor> embedding_, residual_map_;
   Matrix<S> h0_, z_, zh_, d_zh_, d_z_;
   const Matrix<S>* pred_ = nullptr;
 };
