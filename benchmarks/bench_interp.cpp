@@ -6,9 +6,12 @@
 /// RBF (geodesic: HR-surface paths between mapped positions) needs a real surface: the same LR
 /// lattice with an enclosing ellipsoid of 35,637 vertices, LR vertex i mapped onto HR vertex
 /// ⌊(2i+1)M/2N⌋ (spread over the rings; the assignment itself is not what is timed).
+/// LocalLinear: trained on 240 random frames of the paper-size problem (two "performances" of 120,
+/// so cross-validation leaves one out, as on the face), its fit and its apply.
 #include <benchmark/benchmark.h>
 
 #include <simsr/interp/idw.hpp>
+#include <simsr/interp/local_linear.hpp>
 #include <simsr/interp/mls.hpp>
 #include <simsr/interp/rbf.hpp>
 #include <simsr/mesh/generators.hpp>
@@ -124,6 +127,35 @@ RBF<>& rbf() {
   return *m;
 }
 
+/// 240 frames of random displacements at the paper's sizes, in two sequences of 120 (what the fit
+/// costs does not depend on the values).
+const data::PairedFrames<>& paper_frames() {
+  static const data::PairedFrames<> f = [] {
+    data::PairedFrames<> x;
+    const Index F = 240;
+    std::mt19937 rng(4);
+    std::normal_distribution<double> g;
+    x.lowres.resize(F, 3 * kLr);
+    x.highres.resize(F, 3 * kHr);
+    for (Index i = 0; i < x.lowres.size(); ++i) x.lowres.data()[i] = g(rng);
+    for (Index i = 0; i < x.highres.size(); ++i) x.highres.data()[i] = g(rng);
+    x.controls.resize(F, 0);
+    x.sequence_names = {"a", "b"};
+    for (Index i = 0; i < F; ++i) x.ids.push_back(i), x.sequence.push_back(i < F / 2 ? 0 : 1);
+    return x;
+  }();
+  return f;
+}
+LocalLinear<>& local_linear() {
+  static LocalLinear<> m = [] {
+    LocalLinear<> x;
+    x.fit(exec::omp, paper_problem());
+    x.train(exec::omp, paper_frames(), {.lambda = 1e-5});
+    return x;
+  }();
+  return m;
+}
+
 void BM_IDW_apply_seq(benchmark::State& s) { run_apply(s, idw(), exec::seq, paper_problem()); }
 void BM_IDW_apply_omp(benchmark::State& s) { run_apply(s, idw(), exec::omp, paper_problem()); }
 void BM_MLS_as_written_apply_seq(benchmark::State& s) { run_apply(s, mls(MlsBasis::per_coordinate), exec::seq, paper_problem()); }
@@ -132,6 +164,18 @@ void BM_MLS_linear3d_apply_seq(benchmark::State& s) { run_apply(s, mls(MlsBasis:
 void BM_MLS_linear3d_apply_omp(benchmark::State& s) { run_apply(s, mls(MlsBasis::linear_3d), exec::omp, paper_problem()); }
 void BM_RBF_geodesic_sparse_apply_seq(benchmark::State& s) { run_apply(s, rbf(), exec::seq, rbf_problem()); }
 void BM_RBF_geodesic_sparse_apply_omp(benchmark::State& s) { run_apply(s, rbf(), exec::omp, rbf_problem()); }
+
+void BM_LocalLinear_apply_seq(benchmark::State& s) { run_apply(s, local_linear(), exec::seq, paper_problem()); }
+void BM_LocalLinear_apply_omp(benchmark::State& s) { run_apply(s, local_linear(), exec::omp, paper_problem()); }
+/// The demo's fit at the paper's size: 35,637 vertices × (Gram of 60 × 240, 9 λ × 2 folds + 1 solves).
+void BM_LocalLinear_train_cv_omp(benchmark::State& s) {
+  for (auto _ : s) {
+    LocalLinear<> m;
+    m.fit(exec::omp, paper_problem());
+    m.train(exec::omp, paper_frames(), {});
+    s.counters["lambda"] = m.info().lambda_relative;
+  }
+}
 
 void BM_MLS_as_written_fit_omp(benchmark::State& s) {
   for (auto _ : s) {
@@ -172,6 +216,9 @@ BENCHMARK(BM_MLS_as_written_apply_seq)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MLS_as_written_apply_omp)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MLS_linear3d_apply_seq)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MLS_linear3d_apply_omp)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LocalLinear_apply_seq)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LocalLinear_apply_omp)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LocalLinear_train_cv_omp)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_MLS_as_written_fit_omp)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_RBF_geodesic_sparse_fit_omp)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_RBF_geodesic_sparse_fit_sigma_lr_edge_omp)->Unit(benchmark::kMillisecond)->Iterations(1);
