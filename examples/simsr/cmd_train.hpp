@@ -57,8 +57,7 @@ inline int train_cmd(const TrainArgs& a) {
   j["displacement_scale"] = cfg.displacement_scale;
 
   interp::Learned<> net(cfg, a.recipe.seed);
-  const bool local_base = cfg.residual && cfg.residual_base == nn::ResidualBase::local_linear;
-  interp::prepare(exec::omp, net, problem, local_base ? std::max(cfg.up_k, cfg.residual_base_k) : cfg.up_k);  // geometry only: training follows
+  interp::prepare(exec::omp, net, problem, interp::Learned<>::neighborhoods_needed(cfg));  // geometry only: training follows
   double embedded_error = -1;
   if (test.num_frames() > 0) {  // the baseline to beat, on the same held-out frames
     interp::Embedded<> embedded;
@@ -93,7 +92,7 @@ inline int train_cmd(const TrainArgs& a) {
   j["epochs"] = net.epoch();
   j["steps"] = net.steps();
   j["batch_size"] = net.batch_size();
-  if (const auto* b = net.base_info()) j["residual_base"] = {{"kind", "local_linear"}, {"k", cfg.residual_base_k}, {"lambda_relative", b->lambda_relative}};
+  if (const auto* b = net.base_info()) j["residual_base"] = b->to_json();
   j["geometry_seconds"] = sec(t_geo - t_start);
   j["training_seconds"] = sec(t_train - t_geo);
   if (!h.empty()) {

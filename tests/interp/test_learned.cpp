@@ -276,6 +276,9 @@ TEST_CASE("NetworkRecipe: the residual base by name; only a non-Embedded base en
   CHECK(r.config().residual_base == nn::ResidualBase::local_linear);
   CHECK(r.to_json().at("residual_base") == "local_linear");
   CHECK(nn::NetworkConfig::from_json(r.config().to_json()).residual_base == nn::ResidualBase::local_linear);
+  CHECK(interp::Learned<>::neighborhoods_needed(r.config()) == 20);  // the base's k beyond upK 10
   r.residual_base = "ridge";
   CHECK_THROWS_AS(r.config(), ArgumentError);
+  r.residual_base = "embedded";
+  CHECK(interp::Learned<>::neighborhoods_needed(r.config()) == 10);
 }

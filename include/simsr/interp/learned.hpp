@@ -22,6 +22,7 @@
 /// (ArgumentError naming the vertex), predictions must be finite (NumericalError), and training
 /// stops at a non-finite loss, gradient or weight (nn::Trainer).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -94,6 +95,13 @@ class Learned {
     l.loaded_from_ = file.string();
     l.prepare();
     return l;
+  }
+
+  /// The upsampling neighbours per HR vertex fit() reads for `config`: upK, or the local-linear
+  /// base's k when that is more (what interp::prepare must compute before fitting).
+  static Index neighborhoods_needed(const nn::NetworkConfig& config) {
+    const bool local_base = config.residual && config.residual_base == nn::ResidualBase::local_linear;
+    return local_base ? std::max(config.up_k, config.residual_base_k) : config.up_k;
   }
 
   /// Builds the network's geometry from the problem and draws the initial weights (see the file

@@ -36,6 +36,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+#include <nlohmann/json.hpp>
 
 #include "../core/eigen_threads.hpp"
 #include "../core/error.hpp"
@@ -72,6 +73,11 @@ struct LocalLinearTrainInfo {
   /// Cross-validated root mean squared error per HR coordinate at each grid λ (empty when λ was given).
   std::vector<double> grid_lambda, grid_rmse;
   Index still_vertices = 0;    ///< HR vertices whose neighbours never move in training (W = 0)
+
+  /// For reports (simsr train, the demo's network stage).
+  nlohmann::ordered_json to_json() const {
+    return {{"lambda_relative", lambda_relative}, {"folds", folds}, {"folds_by_sequence", by_sequence}, {"still_vertices", still_vertices}};
+  }
 };
 
 /// The local linear upsampler (S = double or float). Satisfies interp::TrainableInterpolator.

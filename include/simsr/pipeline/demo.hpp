@@ -351,9 +351,7 @@ nlohmann::json network_stage(P policy, Stages& stages, const DemoOptions& o, Dem
     r["train_seconds"] = train_seconds;
     r["recipe"] = recipe.to_json();
     r["displacement_scale"] = cfg.displacement_scale;
-    if (const auto* b = net.base_info())
-      r["residual_base"] = {{"kind", "local_linear"}, {"k", cfg.residual_base_k}, {"lambda_relative", b->lambda_relative}, {"folds", b->folds},
-                            {"folds_by_sequence", b->by_sequence}};
+    if (const auto* b = net.base_info()) r["residual_base"] = b->to_json();
     r["apply_seconds_per_frame"] = predict_test(policy, net, d, prediction_file(stages, name));
     return r;
   });
