@@ -15,6 +15,7 @@
 /// calls at a time). The constructor's one-time setup (rest shapes, O(#T)) is sequential.
 
 #include <algorithm>
+#include <concepts>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -37,6 +38,9 @@ namespace detail {
 /// Materials with element data to validate offer `check(element)` (throws ArgumentError).
 template <class M>
 concept ChecksElements = requires(const M& m, const typename M::Element& e) { m.check(e); };
+/// Materials usable in the local–global solver offer the stiffness of their constant matrix.
+template <class M>
+concept HasProjectiveStiffness = requires(const M& m) { { m.projective_stiffness() } -> std::convertible_to<typename M::scalar_type>; };
 }  // namespace detail
 
 /// Σ_t V_t ψ(F_t) over the tets of a rest mesh (see the file comment).
@@ -154,6 +158,28 @@ class ElasticEnergy {
       }
       H.block(s) += sum;
     });
+  }
+
+  /// The local–global solver's constant matrix (projective dynamics, Bouaziz et al. 2014 eq. 12):
+  /// H += Σ_t V_t k (D_t ⊗ I)(D_t ⊗ I)ᵀ, k = material().projective_stiffness() (per unit volume),
+  /// i.e. the Hessian of Σ_t V_t k/2 ‖F_t − const‖². For materials that offer that stiffness
+  /// (StrainLimit, VolumeTarget). Sequential (once per weight set).
+  template <exec::HostPolicy P>
+    requires detail::HasProjectiveStiffness<M>
+  void add_global_matrix(P, BlockHessian<S>& H) const {
+    if (H.num_vertices() != n_) throw ShapeError("ElasticEnergy::add_global_matrix: matrix vertices", {n_}, {H.num_vertices()});
+    const S k = material_.projective_stiffness();
+    for (Index t = 0; t < T_.rows(); ++t) {
+      const Eigen::Matrix<S, 4, 4> DD = (rest_.volume[t] * k) * D_[std::size_t(t)] * D_[std::size_t(t)].transpose();
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) {
+          const Index s = H.slot(T_(t, a), T_(t, b));
+          if (s >= 0)
+            H.block(s) += DD(a, b) * Mat3<S>::Identity();
+          else
+            H.add(T_(t, a), T_(t, b), DD(a, b) * Mat3<S>::Identity());
+        }
+    }
   }
 
   /// Number of tets with det F ≤ 0 at x.

@@ -28,6 +28,7 @@
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
 #include "../core/types.hpp"
+#include "detail/term_sums.hpp"
 #include "dirichlet_boundary.hpp"
 #include "energy_term.hpp"
 #include "hessian.hpp"
@@ -197,51 +198,15 @@ class QuasistaticSolver {
   /// Σ terms' energies at x (J).
   template <class P, class... Terms>
   double total_energy(P policy, const Points<S>& x, const Terms&... terms) {
-    double sum = 0, mag = 0;
-    const auto one = [&](const auto& t) {
-      const double e = double(t.energy(policy, x));
-      sum += e;
-      mag += std::abs(e);
-    };
-    (one(terms), ...);
-    magnitude_ = mag;
-    return sum;
+    return detail::total_energy(policy, x, magnitude_, terms...);
   }
 
-  /// Sets g_ to ∂E/∂x over the free DOFs (fixed ones zeroed), a 3V vector, vertex-major,
-  /// and returns Σ_k ‖∂E_k/∂x‖ over the terms (free DOFs), the scale of the forces in balance.
+  /// Sets g_ to ∂E/∂x over the free DOFs and returns the forces' scale (detail/term_sums.hpp).
   template <class P, class... Terms>
   double compute_gradient(P policy, const Points<S>& x, const Terms&... terms) {
-    g_.setZero(3 * n_);
-    double balance = 0;
-    const auto one = [&](const auto& term) {
-      term_grad_.setZero(n_, 3);
-      term.add_gradient(policy, x, term_grad_);
-      const Eigen::Map<const VecX<S>> tg(term_grad_.data(), 3 * n_);
-      double sq = 0;
-      for (Index k = 0; k < 3 * n_; ++k)
-        if (!fixed_[std::size_t(k)]) {
-          g_[k] += tg[k];
-          sq += double(tg[k]) * double(tg[k]);
-        }
-      balance += std::sqrt(sq);
-    };
-    (one(terms), ...);
-    return balance;
+    return detail::free_gradient(policy, x, fixed_, term_grad_, g_, terms...);
   }
-  void apply_boundary(Points<S>& x, const DirichletBoundary<S>& b) {
-    if (b.targets.rows() != b.vertices.size() || b.targets.cols() != 3)
-      throw ShapeError("QuasistaticSolver: Dirichlet targets", {b.vertices.size(), 3}, {b.targets.rows(), b.targets.cols()});
-    fixed_.assign(std::size_t(3 * n_), 0);
-    for (Index k = 0; k < b.vertices.size(); ++k) {
-      const VIndex v = b.vertices[k];
-      if (v < 0 || v >= n_) throw MeshError("vertex", v, "Dirichlet vertex out of range [0, " + std::to_string(n_) + ")");
-      if (!b.targets.row(k).allFinite()) throw MeshError("vertex", v, "Dirichlet target is not finite");
-      x.row(v) = b.targets.row(k);
-      for (int c = 0; c < 3; ++c) fixed_[std::size_t(3 * v + c)] = 1;
-    }
-    if (!x.allFinite()) throw ShapeError("QuasistaticSolver: x has non-finite entries", {n_, 3}, {x.rows(), x.cols()});
-  }
+  void apply_boundary(Points<S>& x, const DirichletBoundary<S>& b) { detail::apply_dirichlet("QuasistaticSolver", x, b, fixed_); }
 
   /// Assembles the Hessian (every term with definiteness `d`, in the order given) and solves
   /// H d = rhs_. False when the system turned out not positive definite.

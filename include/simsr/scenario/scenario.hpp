@@ -1,7 +1,8 @@
 #pragma once
 /// \file
-/// The scenario area: simulated data sets built from real input — today the face of the core
-/// paper (§4) from the ICT FaceKit: the kit and its parts, the jaw hinge read from data.
+/// The scenario area: simulated data sets built from real input — the face of the core paper (§4)
+/// from the ICT FaceKit (the kit and its parts, the jaw hinge read from data), and SoftDECA's
+/// layered head, its parameter sampler and its simulation.
 
 #include "face/head_surface.hpp"
 #include "face/ict_kit.hpp"
@@ -17,3 +18,7 @@
 #include "face/performances.hpp"
 #include "face/skull.hpp"
 #include "face/unseen_forces.hpp"
+#include "softdeca/layered_head.hpp"
+#include "softdeca/parameters.hpp"
+#include "softdeca/softdeca_simulator.hpp"
+#include "softdeca/template.hpp"

@@ -1,10 +1,14 @@
 #pragma once
 /// \file
 /// Forces and constraints of the quasistatic soft-tissue solver (SPEC §3): track and point
-/// springs, gravity, bone attachments (Dirichlet constraints), obstacle and self-contact.
+/// springs, gravity, bone attachments (Dirichlet constraints), obstacle and self-contact; and
+/// SoftDECA's surface terms (bending, target and distance attraction) and its dynamics.
 
 #include "bone_attachment.hpp"
 #include "embedded_springs.hpp"
 #include "gravity.hpp"
+#include "implicit_inertia.hpp"
 #include "obstacle_contact.hpp"
 #include "self_contact.hpp"
+#include "surface_bending.hpp"
+#include "vertex_targets.hpp"

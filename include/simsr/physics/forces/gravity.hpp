@@ -79,6 +79,9 @@ class Gravity {
   void add_hessian(P, const Points<S>& x, BlockHessian<S>&, Definiteness) const {
     detail::require_positions("Gravity: x", x, num_vertices());
   }
+  /// Adds nothing to the local–global solver's matrix either (a linear term).
+  template <exec::HostPolicy P>
+  void add_global_matrix(P, BlockHessian<S>&) const {}
 
  private:
   VecX<S> m_;

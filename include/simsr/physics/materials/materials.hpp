@@ -9,4 +9,6 @@
 #include "mooney_rivlin.hpp"
 #include "neo_hookean.hpp"
 #include "signed_svd.hpp"
+#include "strain_limit.hpp"
 #include "teran_muscle.hpp"
+#include "volume_target.hpp"

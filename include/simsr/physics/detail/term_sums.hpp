@@ -1,0 +1,76 @@
+#pragma once
+/// \file
+/// What every solver over a sum of EnergyTerms does the same way (the Newton solver and the
+/// local–global solver): set the Dirichlet vertices, sum the terms' energies, and sum their
+/// gradients over the free DOFs together with the size of the forces in balance.
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "../../core/error.hpp"
+#include "../../core/types.hpp"
+#include "../dirichlet_boundary.hpp"
+
+namespace simsr::physics::detail {
+
+/// Sets x's boundary vertices to their targets and fixed[3v + c] = 1 for them (0 elsewhere).
+/// ShapeError for a target array of the wrong shape, MeshError for a vertex out of range or a
+/// non-finite target, ShapeError when x has a non-finite entry afterwards.
+template <class S>
+void apply_dirichlet(const char* solver, Points<S>& x, const DirichletBoundary<S>& b, std::vector<char>& fixed) {
+  const Index n = x.rows();
+  if (b.targets.rows() != b.vertices.size() || b.targets.cols() != 3)
+    throw ShapeError(std::string(solver) + ": Dirichlet targets", {b.vertices.size(), 3}, {b.targets.rows(), b.targets.cols()});
+  fixed.assign(std::size_t(3 * n), 0);
+  for (Index k = 0; k < b.vertices.size(); ++k) {
+    const VIndex v = b.vertices[k];
+    if (v < 0 || v >= n) throw MeshError("vertex", v, "Dirichlet vertex out of range [0, " + std::to_string(n) + ")");
+    if (!b.targets.row(k).allFinite()) throw MeshError("vertex", v, "Dirichlet target is not finite");
+    x.row(v) = b.targets.row(k);
+    for (int c = 0; c < 3; ++c) fixed[std::size_t(3 * v + c)] = 1;
+  }
+  if (!x.allFinite()) throw ShapeError(std::string(solver) + ": x has non-finite entries", {n, 3}, {x.rows(), x.cols()});
+}
+
+/// Σ terms' energies at x; `magnitude` gets Σ |E_k| (the scale of round-off in the sum).
+template <class S, class P, class... Terms>
+double total_energy(P policy, const Points<S>& x, double& magnitude, const Terms&... terms) {
+  double sum = 0, mag = 0;
+  const auto one = [&](const auto& t) {
+    const double e = double(t.energy(policy, x));
+    sum += e;
+    mag += std::abs(e);
+  };
+  (one(terms), ...);
+  magnitude = mag;
+  return sum;
+}
+
+/// g = ∂E/∂x over the free DOFs (fixed ones 0), a 3V vector, vertex-major; returns Σ_k ‖∂E_k/∂x‖
+/// over the free DOFs, the scale of the forces in balance. `scratch` is a #V×3 buffer.
+template <class S, class P, class... Terms>
+double free_gradient(P policy, const Points<S>& x, const std::vector<char>& fixed, Points<S>& scratch, VecX<S>& g,
+                     const Terms&... terms) {
+  const Index n = x.rows();
+  g.setZero(3 * n);
+  double balance = 0;
+  const auto one = [&](const auto& term) {
+    scratch.setZero(n, 3);
+    term.add_gradient(policy, x, scratch);
+    const Eigen::Map<const VecX<S>> tg(scratch.data(), 3 * n);
+    double sq = 0;
+    for (Index k = 0; k < 3 * n; ++k)
+      if (!fixed[std::size_t(k)]) {
+        g[k] += tg[k];
+        sq += double(tg[k]) * double(tg[k]);
+      }
+    balance += std::sqrt(sq);
+  };
+  (one(terms), ...);
+  return balance;
+}
+
+}  // namespace simsr::physics::detail

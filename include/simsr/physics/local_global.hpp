@@ -1,0 +1,283 @@
+#pragma once
+/// \file
+/// The local–global solver of projective dynamics (Bouaziz et al. 2014), over the same terms as
+/// the Newton solver (quasistatic.hpp), in the quasi-Newton form of Liu, Bouaziz & Kavan 2017:
+///
+///   global matrix  L = Σ_k L_k, each term's constant matrix (add_global_matrix: w AᵀA of a
+///                  projective term, a stated stand-in for the others), Dirichlet DOFs eliminated,
+///                  factored once per weight set (and per boundary vertex set);
+///   local step     every term's gradient at x, which for a projective term is L_k x − w Aᵀp
+///                  with p the projections (strain band, sphere, curvature magnitude), computed per
+///                  element in parallel under the policy;
+///   global step    d = −L⁻¹ g, refined by L-BFGS over the last `history` steps (0: none);
+///   line search    backtracking on the total energy from the unit step.
+///
+/// With history 0 and only projective terms this is Bouaziz et al.'s iteration x ← L⁻¹(Σ w Aᵀp)
+/// exactly: the unit step minimizes the quadratic that majorizes E at x, so it is always accepted.
+/// Non-projective terms (VolumeTarget's (det F − v)²) enter through their exact gradient, so the
+/// fixed point is the minimum of the very energy Newton minimizes; L only has to be a good
+/// preconditioner, never exact, which is also why a weight changed without refactoring still
+/// converges to the right answer (slower): call invalidate() after changing weights.
+///
+///     physics::LocalGlobalSolver<> pd(mesh.num_vertices(), mesh.T);
+///     auto report = pd.solve(exec::omp, x, bc, strain, volume, bending, targets, gravity, dynamics);
+///
+/// Every term must be a ProjectiveTerm: an EnergyTerm with add_global_matrix(policy, BlockHessian&).
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "../core/error.hpp"
+#include "../core/parallel.hpp"
+#include "../core/types.hpp"
+#include "detail/term_sums.hpp"
+#include "dirichlet_boundary.hpp"
+#include "energy_term.hpp"
+#include "hessian.hpp"
+#include "linear_solvers/linear_solvers.hpp"
+
+namespace simsr::physics {
+
+namespace detail {
+template <class T, class S>
+concept HasGlobalMatrix = requires(const T& t, BlockHessian<S>& L) {
+  t.add_global_matrix(exec::seq, L);
+  t.add_global_matrix(exec::omp, L);
+};
+}  // namespace detail
+
+/// An EnergyTerm the local–global solver can use: it also adds its constant matrix.
+template <class T, class S = Scalar>
+concept ProjectiveTerm = EnergyTerm<T, S> && detail::HasGlobalMatrix<T, S>;
+
+/// `static_assert(assert_projective_term<T, S>())`: one sentence when T is not a ProjectiveTerm.
+template <class T, class S = Scalar>
+constexpr bool assert_projective_term() {
+  static_assert(EnergyTerm<T, S>, "this type is not a physics::ProjectiveTerm: it is not a physics::EnergyTerm (energy, add_gradient, add_hessian)");
+  static_assert(!EnergyTerm<T, S> || detail::HasGlobalMatrix<T, S>,
+                "this type is not a physics::ProjectiveTerm: it lacks add_global_matrix(policy, BlockHessian& L) const for exec::seq and "
+                "exec::omp, its constant matrix in the local-global solver (ElasticEnergy has it for materials with projective_stiffness())");
+  return true;
+}
+
+/// One iteration, as reported to the progress callback and kept in the report's history.
+struct LocalGlobalIteration {
+  Index iteration = 0;
+  double energy = 0;         ///< total energy before the step (J)
+  double gradient_norm = 0;  ///< ‖∂E/∂x‖ over free DOFs before the step (N)
+  double step_length = 0;    ///< accepted line-search factor
+  Index backtracks = 0;
+};
+
+/// Options of LocalGlobalSolver. The convergence test is the Newton solver's (NewtonOptions), so
+/// both stop at the same gradient norm on the same problem.
+struct LocalGlobalOptions {
+  double relative_tolerance = 1e-6;
+  double absolute_tolerance = 0;  ///< N
+  double reference_force = 0;     ///< N
+  Index max_iterations = 2000;
+  /// L-BFGS memory (step pairs). 0 is plain projective dynamics (with the line search);
+  /// Liu et al. 2017 use 5.
+  Index history = 5;
+  double armijo = 1e-4;
+  Index max_backtracks = 40;
+  std::function<void(const LocalGlobalIteration&)> progress = {};
+};
+
+/// What a solve did.
+struct LocalGlobalReport {
+  bool converged = false;
+  Index iterations = 0;
+  double energy = 0;
+  double initial_gradient_norm = 0;
+  double gradient_norm = 0;
+  bool factored = false;  ///< this solve factored the global matrix (the first with its weights)
+  std::vector<LocalGlobalIteration> history;
+};
+
+/// Projective dynamics' local–global iteration, quasi-Newton form (see the file comment).
+template <class Linear = SparseCholesky<Scalar>>
+class LocalGlobalSolver {
+  static_assert(assert_linear_solver<Linear>());
+
+ public:
+  using S = typename detail::linear_scalar<Linear>::type;
+
+  /// The matrix's pattern starts from the tets (the elastic terms' blocks) and grows to what the
+  /// other terms add.
+  LocalGlobalSolver(Index num_vertices, const Tets& T, LocalGlobalOptions options = {}, Linear linear = {})
+      : n_(num_vertices), options_(std::move(options)), linear_(std::move(linear)), L_(num_vertices, T) {}
+
+  LocalGlobalOptions& options() { return options_; }
+  /// The weights changed: the next solve factors the global matrix again.
+  void invalidate() { factored_ = false; }
+  bool factored() const { return factored_; }
+  Index factorizations() const { return factorizations_; }
+
+  /// Builds and factors L from the terms (Dirichlet DOFs of `boundary` eliminated). solve() calls
+  /// it when needed; call it directly to time or reuse the factorization.
+  template <exec::HostPolicy P, class... Terms>
+  void factor(P policy, const DirichletBoundary<S>& boundary, const Terms&... terms) {
+    static_assert((assert_projective_term<Terms, S>() && ...));
+    if constexpr ((ProjectiveTerm<Terms, S> && ...)) {
+      fixed_mask(boundary, factor_fixed_);
+      L_.set_zero();
+      (terms.add_global_matrix(policy, L_), ...);
+      const SparseMatrix<S>& A = L_.assemble(policy, factor_fixed_);
+      linear_.compute(policy, A, L_.pattern_version());
+      factored_ = true;
+      ++factorizations_;
+    }
+  }
+
+  /// Minimizes Σ terms over x (#V×3, in/out: the warm start), boundary vertices set first.
+  /// Throws ConvergenceError when the tolerance is not met within max_iterations or the line
+  /// search finds no decrease; ConvergenceError from the linear solver when L is singular (a
+  /// body with neither Dirichlet vertices nor a term that holds it: rigid motions are free).
+  template <exec::HostPolicy P, class... Terms>
+  LocalGlobalReport solve(P policy, Points<S>& x, const DirichletBoundary<S>& boundary, const Terms&... terms) {
+    static_assert(sizeof...(Terms) > 0, "LocalGlobalSolver::solve needs at least one energy term");
+    static_assert((assert_projective_term<Terms, S>() && ...));
+    if constexpr ((ProjectiveTerm<Terms, S> && ...))
+      return iterate(policy, x, boundary, terms...);
+    else
+      return {};
+  }
+
+ private:
+  template <class P, class... Terms>
+  LocalGlobalReport iterate(P policy, Points<S>& x, const DirichletBoundary<S>& boundary, const Terms&... terms) {
+    detail::require_positions("LocalGlobalSolver::solve: x", x, n_);
+    detail::apply_dirichlet("LocalGlobalSolver", x, boundary, fixed_);
+    LocalGlobalReport report;
+    if (!factored_ || fixed_ != factor_fixed_) {
+      factor(policy, boundary, terms...);
+      report.factored = true;
+    }
+    forget();
+    double reference = 0, magnitude = 0;
+    double E = detail::total_energy(policy, x, magnitude, terms...);
+    double balance = detail::free_gradient(policy, x, fixed_, scratch_, g_, terms...);
+    for (Index it = 0;; ++it) {
+      if (!std::isfinite(E)) throw ConvergenceError("local-global solver (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
+      const double gnorm = double(g_.norm());
+      if (it == 0) {
+        report.initial_gradient_norm = gnorm;
+        reference = std::max(options_.reference_force, gnorm);
+      }
+      reference = std::max(reference, balance);
+      report.iterations = it;
+      report.energy = E;
+      report.gradient_norm = gnorm;
+      if (gnorm <= std::max(options_.absolute_tolerance, options_.relative_tolerance * reference)) {
+        report.converged = true;
+        return report;
+      }
+      if (it >= options_.max_iterations) throw ConvergenceError("local-global solver", it, gnorm);
+
+      direction(policy);
+      double slope = double(g_.dot(d_));
+      if (!(slope < 0) || !d_.allFinite()) {  // the L-BFGS update lost descent: the plain global step
+        forget();
+        direction(policy);
+        slope = double(g_.dot(d_));
+      }
+      if (!(slope < 0)) throw ConvergenceError("local-global solver (the global step is no descent direction: L is not positive definite)", it, gnorm);
+
+      const double noise = 64 * std::numeric_limits<double>::epsilon() * magnitude;
+      double alpha = 1, Et = 0;
+      Index backtracks = 0;
+      for (;; ++backtracks) {
+        trial_ = x;
+        Eigen::Map<VecX<S>>(trial_.data(), 3 * n_) += S(alpha) * d_;
+        double mag = 0;
+        Et = detail::total_energy(policy, trial_, mag, terms...);
+        if (std::isfinite(Et) && Et <= E + options_.armijo * alpha * slope + noise) {
+          magnitude = mag;
+          break;
+        }
+        if (backtracks >= options_.max_backtracks)
+          throw ConvergenceError("local-global solver (line search: no decrease at iteration " + std::to_string(it) + ")", it, gnorm);
+        alpha *= 0.5;
+      }
+      x.swap(trial_);
+      g_old_ = g_;
+      balance = detail::free_gradient(policy, x, fixed_, scratch_, g_, terms...);
+      remember(S(alpha) * d_, g_ - g_old_);
+      LocalGlobalIteration record{it, E, gnorm, alpha, backtracks};
+      report.history.push_back(record);
+      if (options_.progress) options_.progress(record);
+      E = Et;
+    }
+  }
+
+  /// d_ = −H̃⁻¹ g_ by L-BFGS's two loops with L⁻¹ as the initial inverse Hessian.
+  template <class P>
+  void direction(P policy) {
+    const std::size_t m = pairs_s_.size();
+    q_ = g_;
+    alphas_.resize(m);
+    for (std::size_t i = m; i-- > 0;) {
+      alphas_[i] = pairs_rho_[i] * pairs_s_[i].dot(q_);
+      q_ -= alphas_[i] * pairs_y_[i];
+    }
+    const LinearSolveInfo info = linear_.solve(policy, q_, d_);
+    if (!info.converged) throw ConvergenceError("local-global solver (global step: the linear solve did not converge)", info.iterations, info.relative_residual);
+    for (std::size_t i = 0; i < m; ++i) {
+      const S beta = pairs_rho_[i] * pairs_y_[i].dot(d_);
+      d_ += (alphas_[i] - beta) * pairs_s_[i];
+    }
+    d_ = -d_;
+  }
+
+  void forget() {
+    pairs_s_.clear();
+    pairs_y_.clear();
+    pairs_rho_.clear();
+  }
+
+  /// Keeps (s, y) when it has positive curvature yᵀs > 0 (the update stays positive definite).
+  void remember(const VecX<S>& s, const VecX<S>& y) {
+    if (options_.history <= 0) return;
+    const S ys = y.dot(s);
+    if (!(ys > S(1e-12) * std::sqrt(double(y.squaredNorm() * s.squaredNorm())))) return;
+    if (Index(pairs_s_.size()) == options_.history) {
+      pairs_s_.erase(pairs_s_.begin());
+      pairs_y_.erase(pairs_y_.begin());
+      pairs_rho_.erase(pairs_rho_.begin());
+    }
+    pairs_s_.push_back(s);
+    pairs_y_.push_back(y);
+    pairs_rho_.push_back(S(1) / ys);
+  }
+
+  void fixed_mask(const DirichletBoundary<S>& b, std::vector<char>& fixed) const {
+    fixed.assign(std::size_t(3 * n_), 0);
+    for (Index k = 0; k < b.vertices.size(); ++k) {
+      const VIndex v = b.vertices[k];
+      if (v < 0 || v >= n_) throw MeshError("vertex", v, "Dirichlet vertex out of range [0, " + std::to_string(n_) + ")");
+      for (int c = 0; c < 3; ++c) fixed[std::size_t(3 * v + c)] = 1;
+    }
+  }
+
+  Index n_;
+  LocalGlobalOptions options_;
+  Linear linear_;
+  BlockHessian<S> L_;
+  bool factored_ = false;
+  Index factorizations_ = 0;
+  std::vector<char> fixed_, factor_fixed_;
+  Points<S> scratch_, trial_;
+  VecX<S> g_, g_old_, d_, q_;
+  std::vector<VecX<S>> pairs_s_, pairs_y_;
+  std::vector<S> pairs_rho_, alphas_;
+};
+
+}  // namespace simsr::physics

@@ -1,0 +1,232 @@
+#pragma once
+/// \file
+/// SoftDECA's forward simulation on the layered template (softdeca supplement §1–2), one sample
+/// of parameters at a time, with either solver over the same energy:
+///
+///   E = E_str(soft tissue; w_st, ε) + E_str(muscle; w_mu, ε) + E_vol(all tets; w_vol, v)
+///     + E_curv(skin; w_curv) + E_tar(skin → the expression; w_tar) + E_dist2(skin; w_dist)
+///     + gravity (1–2 g, any direction) + the implicit step's inertia (α, β, γ)
+///
+/// with the bones (cranium, jaw, the neck cut) as Dirichlet vertices at the sample's skull
+/// scaling. E_dist2 keeps each skin vertex over bone at its template distance d_x from the bone
+/// vertex beneath it (which moves with the skull), SoftDECA's "predicted distances" D(S) being
+/// the template's tissue thickness here. E_tar's and E_dist2's weights are per unit skin area (each
+/// vertex's Voronoi area times the stiffness), so they do not depend on the skin's resolution.
+///
+/// One sample runs in two parts:
+///  1. the individual at rest: quasistatic, no expression (E_tar pulls to the neutral skin), the
+///     skull scaled, gravity on, from the template carried along by its scaled bones;
+///  2. the expression: `steps` implicit steps of length h from that state at rest, the target
+///     blended from the neutral to the expression over the first half of the steps and held,
+///     inertia α, damping β and momentum γ acting (with α = β = 0 every step is quasistatic).
+/// The result is the skin at the last step (and at rest, for reference).
+///
+///     scenario::SoftDecaSimulator sim(tpl);
+///     auto r = sim.simulate(exec::omp, params, expression_weights);          // local–global
+///     auto n = sim.simulate(exec::omp, params, expression_weights, {.solver = SoftDecaSolver::newton});
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../../core/error.hpp"
+#include "../../core/parallel.hpp"
+#include "../../core/types.hpp"
+#include "../../mesh/vertex_areas.hpp"
+#include "../../physics/elastic_energy.hpp"
+#include "../../physics/forces/gravity.hpp"
+#include "../../physics/forces/implicit_inertia.hpp"
+#include "../../physics/forces/surface_bending.hpp"
+#include "../../physics/forces/vertex_targets.hpp"
+#include "../../physics/local_global.hpp"
+#include "../../physics/materials/strain_limit.hpp"
+#include "../../physics/materials/volume_target.hpp"
+#include "../../physics/quasistatic.hpp"
+#include "template.hpp"
+#include "parameters.hpp"
+
+namespace simsr::scenario {
+
+/// Which solver a SoftDECA simulation uses.
+enum class SoftDecaSolver { local_global, newton };
+
+/// How one sample is simulated.
+struct SoftDecaSimulationOptions {
+  SoftDecaSolver solver = SoftDecaSolver::local_global;
+  Index steps = 6;              ///< implicit steps from rest to the expression (≥ 1)
+  double time_step = 1.0 / 30;  ///< h (s)
+  double relative_tolerance = 1e-6;  ///< both solvers' gradient tolerance (NewtonOptions' meaning)
+  Index max_iterations = 5000;  ///< local–global iterations per solve (Newton: 100)
+  Index history = 5;            ///< local–global L-BFGS memory
+};
+
+/// What one sample gave.
+struct SoftDecaResult {
+  Points<> skin;          ///< #skin×3 at the last step (m)
+  Points<> skin_at_rest;  ///< #skin×3 after part 1
+  std::vector<Index> iterations;  ///< per solve (part 1, then each step)
+  Index inverted_tets = 0;        ///< det F ≤ 0 at the last step
+  double seconds = 0;
+  Index total_iterations() const {
+    Index s = 0;
+    for (Index i : iterations) s += i;
+    return s;
+  }
+};
+
+/// The layered template's terms, built once and re-weighted per sample (see the file comment).
+class SoftDecaSimulator {
+ public:
+  using StrainEnergy = physics::ElasticEnergy<physics::StrainLimit<>>;
+  using VolumeEnergy = physics::ElasticEnergy<physics::VolumeTarget<>>;
+
+  explicit SoftDecaSimulator(const SoftDecaTemplate& tpl, SoftDecaStiffness k = {})
+      : tpl_(tpl),
+        k_(k),
+        n_(tpl.head.mesh.num_vertices()),
+        strain_soft_(layer(tpl, TissueLayer::soft_tissue), physics::StrainLimit<>(k.strain_soft_tissue)),
+        strain_muscle_(layer(tpl, TissueLayer::muscle), physics::StrainLimit<>(k.strain_muscle)),
+        volume_(tpl.head.mesh, physics::VolumeTarget<>(k.volume)),
+        bending_(n_, tpl.head.mesh.V, tpl.skin_triangles, k.bending),
+        targets_(physics::VertexTargets<>::attraction(n_, tpl.skin, skin_rest(tpl), VecX<>::Zero(tpl.skin.size()))),
+        distances_(make_distances(tpl)),
+        gravity_(tpl.head.mesh, k.density, Vec3<>(0, -k.gravity, 0)),
+        inertia_(gravity_.masses(), tpl.head.mesh.V, {}),
+        settle_(n_, tpl.head.mesh.T),
+        step_(n_, tpl.head.mesh.T),
+        newton_(n_, tpl.head.mesh.T) {
+    // skin areas (per unit area weights): Voronoi areas of the skin triangles at rest
+    const VecX<> all = voronoi_areas(tpl.head.mesh.V, tpl.skin_triangles);
+    skin_area_.resize(tpl.skin.size());
+    for (Index k2 = 0; k2 < tpl.skin.size(); ++k2) skin_area_[k2] = all[tpl.skin[k2]];
+    distance_area_.resize(distances_.size());
+    for (Index k2 = 0; k2 < distances_.size(); ++k2) distance_area_[k2] = all[distances_.vertices()[k2]];
+  }
+
+  const SoftDecaTemplate& template_() const { return tpl_; }
+  /// Skin vertices kept at a distance from the bone beneath them (E_dist2).
+  Index distance_vertices() const { return distances_.size(); }
+
+  /// One sample (see the file comment). `expression` holds the kit's E expression weights.
+  /// Throws ConvergenceError from the solvers, ShapeError for a wrong number of weights,
+  /// ArgumentError for parameters outside what the energies accept.
+  template <exec::HostPolicy P>
+  SoftDecaResult simulate(P policy, const SoftDecaParameters& p, const VecX<>& expression, const SoftDecaSimulationOptions& o = {}) {
+    if (o.steps < 1) throw ArgumentError("SoftDecaSimulator: steps must be >= 1, got " + std::to_string(o.steps));
+    if (expression.size() != tpl_.expression_deltas.rows())
+      throw ShapeError("SoftDecaSimulator: expression weights", {tpl_.expression_deltas.rows()}, {expression.size()});
+    const auto t0 = std::chrono::steady_clock::now();
+    // the sample's weights
+    strain_soft_.material() = physics::StrainLimit<>(k_.strain_soft_tissue * p.w_strain_soft_tissue, p.max_strain);
+    strain_muscle_.material() = physics::StrainLimit<>(k_.strain_muscle * p.w_strain_muscle, p.max_strain);
+    volume_.material() = physics::VolumeTarget<>(k_.volume * p.w_volume, p.volume_target);
+    bending_.set_stiffness(k_.bending * p.w_bending);
+    targets_.set_weights(k_.target * p.w_target * skin_area_);
+    distances_.set_weights(k_.distance * p.w_distance * distance_area_);
+    gravity_.set_acceleration(k_.gravity * p.gravity * p.gravity_direction.normalized());
+    const physics::DirichletBoundary<> bones = tpl_.head.bone_targets(p.cranium_scale, p.jaw_scale);
+    Points<> anchors(distances_.size(), 3);
+    for (Index k2 = 0; k2 < distances_.size(); ++k2) anchors.row(k2) = bone_target(bones, anchor_vertex_[std::size_t(k2)]);
+    distances_.set_targets(anchors);
+    settle_.invalidate();
+    step_.invalidate();
+
+    SoftDecaResult r;
+    // 1. the individual at rest, from the template carried along by its bones
+    Points<> x = tpl_.head.scaled_rest(p.cranium_scale, p.jaw_scale);
+    targets_.set_targets(tpl_.expression(VecX<>::Zero(expression.size())));
+    inertia_.set_parameters({.h = o.time_step, .alpha = 0, .beta = 0, .gamma = 0});
+    r.iterations.push_back(solve(policy, settle_, x, bones, o));
+    r.skin_at_rest = skin_of(x);
+    // 2. the expression, dynamically
+    inertia_.set_parameters({.h = o.time_step, .alpha = p.alpha, .beta = p.beta, .gamma = p.gamma});
+    inertia_.reset(x);
+    const double ramp_steps = std::max(1.0, double(o.steps) / 2);
+    for (Index s = 1; s <= o.steps; ++s) {
+      targets_.set_targets(tpl_.expression(std::min(1.0, double(s) / ramp_steps) * expression));
+      r.iterations.push_back(solve(policy, step_, x, bones, o));
+      inertia_.advance(x);
+    }
+    r.skin = skin_of(x);
+    r.inverted_tets = volume_.count_inverted(policy, x);
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  }
+
+ private:
+  static TetMesh<> layer(const SoftDecaTemplate& tpl, TissueLayer l) {
+    std::vector<Index> rows;
+    for (Index t = 0; t < tpl.head.mesh.num_tets(); ++t)
+      if (tpl.head.tissue[std::size_t(t)] == l) rows.push_back(t);
+    TetMesh<> m;
+    m.V = tpl.head.mesh.V;
+    m.T.resize(Index(rows.size()), 4);
+    for (std::size_t r = 0; r < rows.size(); ++r) m.T.row(Index(r)) = tpl.head.mesh.T.row(rows[r]);
+    return m;
+  }
+  static Points<> skin_rest(const SoftDecaTemplate& tpl) {
+    Points<> s(tpl.skin.size(), 3);
+    for (Index k = 0; k < tpl.skin.size(); ++k) s.row(k) = tpl.head.mesh.V.row(tpl.skin[k]);
+    return s;
+  }
+  /// Skin vertices (outer wrap, index i) whose inner-wrap vertex 2L·nv + i is cranium or jaw.
+  physics::VertexTargets<> make_distances(const SoftDecaTemplate& tpl) {
+    const LayeredHead& h = tpl.head;
+    const Index inner = 2 * h.layers * h.wrap_vertices;
+    std::vector<VIndex> v;
+    std::vector<double> d;
+    for (Index k = 0; k < tpl.skin.size(); ++k) {
+      const Index i = tpl.skin[k], b = inner + i;
+      const Bone bone = h.bone[std::size_t(b)];
+      if (bone == Bone::cranium || bone == Bone::jaw) {
+        v.push_back(VIndex(i));
+        anchor_vertex_.push_back(VIndex(b));
+        d.push_back((h.mesh.V.row(i) - h.mesh.V.row(b)).norm());
+      }
+    }
+    const Index m = Index(v.size());
+    Points<> s(m, 3);
+    for (Index k = 0; k < m; ++k) s.row(k) = h.mesh.V.row(anchor_vertex_[std::size_t(k)]);
+    return physics::VertexTargets<>(h.mesh.num_vertices(), Eigen::Map<const IndexVector>(v.data(), m), s,
+                                    Eigen::Map<const VecX<>>(d.data(), m), VecX<>::Zero(m));
+  }
+  static Eigen::RowVector3d bone_target(const physics::DirichletBoundary<>& b, VIndex v) {
+    const auto it = std::lower_bound(b.vertices.data(), b.vertices.data() + b.vertices.size(), v);
+    return b.targets.row(Index(it - b.vertices.data()));
+  }
+  Points<> skin_of(const Points<>& x) const {
+    Points<> s(tpl_.skin.size(), 3);
+    for (Index k = 0; k < tpl_.skin.size(); ++k) s.row(k) = x.row(tpl_.skin[k]);
+    return s;
+  }
+  template <class P>
+  Index solve(P policy, physics::LocalGlobalSolver<>& pd, Points<>& x, const physics::DirichletBoundary<>& bones, const SoftDecaSimulationOptions& o) {
+    if (o.solver == SoftDecaSolver::newton) {
+      newton_.options().relative_tolerance = o.relative_tolerance;
+      return newton_.solve(policy, x, bones, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_, inertia_).iterations;
+    }
+    pd.options().relative_tolerance = o.relative_tolerance;
+    pd.options().max_iterations = o.max_iterations;
+    pd.options().history = o.history;
+    return pd.solve(policy, x, bones, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_, inertia_).iterations;
+  }
+
+  const SoftDecaTemplate& tpl_;
+  SoftDecaStiffness k_;
+  Index n_;
+  std::vector<VIndex> anchor_vertex_;  // before distances_ (filled by make_distances)
+  StrainEnergy strain_soft_, strain_muscle_;
+  VolumeEnergy volume_;
+  physics::SurfaceBending<> bending_;
+  physics::VertexTargets<> targets_;
+  physics::VertexTargets<> distances_;
+  physics::Gravity<> gravity_;
+  physics::ImplicitInertia<> inertia_;
+  physics::LocalGlobalSolver<> settle_, step_;
+  physics::QuasistaticSolver<> newton_;
+  VecX<> skin_area_, distance_area_;
+};
+
+}  // namespace simsr::scenario
