@@ -4,13 +4,16 @@
 # runtimes and LLVM's OpenMP with Archer), so it exports SIMSR_REQUIRE_PEERS=1: after that, a peer,
 # the ../shared/data folder or clang that is still missing is a real failure here, never a skip.
 #
-#   1. build/       g++ Release: every area's doctest suite, test_threads, the tool and examples, the
-#                   fuzz-corpus replays, the peers (gmsh, meshio, numpy, scipy, torch), install +
-#                   consumer project, compile-fail checks, cuda-compile, and each benchmark
-#                   compiled (syntax only, a ctest each: none is built or run here;
-#                   -DSIMSR_BUILD_BENCHMARKS=ON builds them)
+#   1. build/       g++, a test build (SIMSR_TEST_BUILD: -O1 everywhere): the interp, nn and pipeline
+#                   suites (the libgomp allocation checks; the demo, animate and ablation runs),
+#                   test_threads, the tool and examples, the fuzz-corpus replays, the peers (gmsh,
+#                   meshio, numpy, scipy, torch), install + consumer project, compile-fail checks,
+#                   cuda-compile, and each benchmark compiled (clang syntax only, a ctest each: none
+#                   is built or run here; -DSIMSR_BUILD_BENCHMARKS=ON builds them)
 #   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite (pipeline's own parts) and the corpus replays under
-#                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, no recovery)
+#                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, no recovery); the
+#                   suites other than interp, nn and pipeline run here and under TSan only
+#                   (tests/CMakeLists.txt says why)
 #   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: every suite that runs exec::omp under TSan, with
 #                   LLVM's libomp and its Archer tool (so OpenMP's synchronisation is understood)
 #   4. scripts/fuzz.sh: every libFuzzer harness (build-asan's replay binaries) for
@@ -70,7 +73,7 @@ run_ctest() {
 }
 
 # 1. the normal build
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON
 cmake --build "$build" -j "$jobs"
 step "build ($build)"
 run_ctest "$build"
