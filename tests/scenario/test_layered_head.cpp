@@ -97,6 +97,33 @@ TEST_CASE("layered_head: a thickness beyond the centre folds the prisms; the rep
                        doctest::Contains("still fold"), MeshError);
 }
 
+TEST_CASE("layered_head: a column no thickness unfolds pinches to the surface; the shell stays conforming and positive") {
+  Ball b = ball();
+  b.inward.row(7) *= -1;  // vertex 7 offsets outward: its prisms fold at any thickness
+  const Index nv = b.outer.V.rows();
+  const LayeredHead h = layered_head(exec::seq, b.outer, b.inward, VecX<>::Constant(nv, 0.2), b.bones, {.layers = 2, .collapse_below = 0.01});
+  // the repair thins every corner of a folded prism, so vertex 7's neighbours pinch with it
+  CHECK(h.collapsed_vertices >= 1);
+  CHECK(h.collapsed_vertices <= 7);
+  CHECK(h.thickness[7] == 0);
+  CHECK(h.mesh.num_vertices() < h.num_wraps() * nv);
+  for (Index w = 0; w < h.num_wraps(); ++w) CHECK(h.vertex(w, 7) == 7);
+  CHECK(h.bone[7] == Bone::none);
+  CHECK(signed_volumes(exec::seq, h.mesh.V, h.mesh.T).minCoeff() > 0);
+  // conforming: the shell's boundary is closed (every boundary edge in two boundary triangles)
+  CHECK(boundary_edges(boundary_faces(h.mesh.T)).rows() == 0);
+  // and every vertex is used by a tet (inner copies left without one are dropped)
+  std::vector<char> used(std::size_t(h.mesh.num_vertices()), 0);
+  for (Index t = 0; t < h.mesh.num_tets(); ++t)
+    for (int c = 0; c < 4; ++c) used[std::size_t(h.mesh.T(t, c))] = 1;
+  // but outer vertices whose triangles all pinched (here vertex 7) are kept, without tets
+  for (Index v = 0; v < h.mesh.num_vertices(); ++v)
+    if (!used[std::size_t(v)]) {
+      CHECK(v < nv);
+      CHECK(h.thickness[v] == 0);
+    }
+}
+
 TEST_CASE("layered_head: the open boundary (the neck) is held in every wrap") {
   const Ball b = ball(-0.6);
   const Index nv = b.outer.V.rows();
@@ -104,7 +131,7 @@ TEST_CASE("layered_head: the open boundary (the neck) is held in every wrap") {
   const Edges open = boundary_edges(b.outer.F);
   REQUIRE(open.rows() > 0);
   for (Index e = 0; e < open.rows(); ++e)
-    for (Index w = 0; w < h.num_wraps(); ++w) CHECK(h.bone[std::size_t(w * nv + open(e, 0))] == Bone::neck);
+    for (Index w = 0; w < h.num_wraps(); ++w) CHECK(h.bone[std::size_t(h.vertex(w, open(e, 0)))] == Bone::neck);
 }
 
 TEST_CASE("layered_head: bone_targets scale the cranium about its centroid and the jaw about the hinge the cranium carries") {

@@ -137,6 +137,15 @@ class LocalGlobalSolver {
     }
   }
 
+  /// d = L⁻¹ q with the factored matrix (one global step without L-BFGS; q and d 3V, vertex-major,
+  /// zero on Dirichlet DOFs). Error before the first factorization.
+  template <exec::HostPolicy P>
+  void apply_inverse(P policy, const VecX<S>& q, VecX<S>& d) {
+    if (!factored_) throw Error("LocalGlobalSolver::apply_inverse before the matrix was factored (factor() or solve())");
+    const LinearSolveInfo info = linear_.solve(policy, q, d);
+    if (!info.converged) throw ConvergenceError("local-global solver (global step: the linear solve did not converge)", info.iterations, info.relative_residual);
+  }
+
   /// Minimizes Σ terms over x (#V×3, in/out: the warm start), boundary vertices set first.
   /// Throws ConvergenceError when the tolerance is not met within max_iterations or the line
   /// search finds no decrease; ConvergenceError from the linear solver when L is singular (a

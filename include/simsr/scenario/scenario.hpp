@@ -18,6 +18,7 @@
 #include "face/performances.hpp"
 #include "face/skull.hpp"
 #include "face/unseen_forces.hpp"
+#include "softdeca/ict_template.hpp"
 #include "softdeca/layered_head.hpp"
 #include "softdeca/parameters.hpp"
 #include "softdeca/softdeca_simulator.hpp"

@@ -9,9 +9,11 @@
 ///     wrap 2L           the inner surface: bone where it lies on the skull, free elsewhere
 ///
 /// L (`layers`) is the resolution parameter: each shell is L prisms deep, 3 tets per prism. A
-/// vertex moves inward along its (smoothed) normal by its thickness; where the prisms of a
+/// vertex moves inward along its given direction by its thickness; where the prisms of a
 /// triangle fold (a concave spot where the offset crosses itself) the thickness at its corners
-/// is reduced until no prism folds, so the shell is always a valid, conforming tet mesh.
+/// is reduced until no prism folds, and a column thinned below `collapse_below` pinches to the
+/// surface (prism_shell.hpp: one vertex in every wrap, its degenerate tets left out; it is then
+/// held by no bone), so the shell is always a valid, conforming tet mesh.
 ///
 /// The inner wrap's bone vertices are Dirichlet vertices: cranium or jaw, each scaled per axis for
 /// an individual skull (supplement §1 "Skull", 0.5–1.5 per axis): the cranium about its bone
@@ -56,12 +58,12 @@ struct LayeredHeadOptions {
   Index layers = 1;               ///< prism layers per shell: the resolution parameter (≥ 1)
   double muscle_fraction = 0.35;  ///< the share of the flesh thickness, next to the bone, that is muscle (0, 1)
   Index max_repairs = 60;         ///< rounds of thinning folded prisms (each: × 0.8 at their corners)
-  double min_thickness = 0;       ///< a thinned vertex never goes below it (model units); 0: no floor
+  double collapse_below = 0;      ///< a column thinned below this pinches to the surface (model units; 0: never)
 };
 
 /// The layered head (see the file comment).
 struct LayeredHead {
-  TetMesh<> mesh;                    ///< every wrap's vertices (wrap w: [w·nv, (w+1)·nv)) and both shells' tets
+  TetMesh<> mesh;                    ///< every wrap's vertices (vertex(w, i); the outer wrap's are 0..nv−1) and both shells' tets
   std::vector<TissueLayer> tissue;   ///< per tet
   std::vector<Bone> bone;            ///< per mesh vertex
   Tris outer_triangles;              ///< the outer wrap's triangles (mesh vertices 0..nv−1)
@@ -69,10 +71,14 @@ struct LayeredHead {
   Index wrap_vertices = 0;           ///< nv
   Index layers = 0;                  ///< L
   Index repaired_vertices = 0;       ///< wrap vertices whose thickness was reduced to unfold prisms
+  Index collapsed_vertices = 0;      ///< of those, the ones pinched to the surface (thickness 0)
+  IndexVector vertex_of;             ///< w·nv + i → the mesh vertex of wrap w's vertex i (prism_shell.hpp)
+  IndexVector column_of;             ///< mesh vertex → its column i
   Vec3<> hinge = Vec3<>::Zero();     ///< the jaw's scaling centre
   Vec3<> cranium_centre = Vec3<>::Zero();
 
   Index num_wraps() const { return 2 * layers + 1; }
+  VIndex vertex(Index w, Index i) const { return vertex_of[w * wrap_vertices + i]; }
   Index count(TissueLayer l) const { return Index(std::count(tissue.begin(), tissue.end(), l)); }
   Index count(Bone b) const { return Index(std::count(bone.begin(), bone.end(), b)); }
 
@@ -123,9 +129,9 @@ struct LayeredHead {
   /// solve of the scaled individual that inverts no tet of a positive scaling.
   Points<> scaled_rest(const Vec3<>& cranium_scale, const Vec3<>& jaw_scale) const {
     Points<> x(mesh.num_vertices(), 3);
-    const Index inner = 2 * layers * wrap_vertices;
     for (Index v = 0; v < mesh.num_vertices(); ++v) {
-      const bool jaw = bone[std::size_t(inner + v % wrap_vertices)] == Bone::jaw;
+      const VIndex inner = vertex(2 * layers, column_of[v]);
+      const bool jaw = inner >= 0 && bone[std::size_t(inner)] == Bone::jaw;
       x.row(v) = scaled(mesh.V.row(v).transpose(), jaw, cranium_scale, jaw_scale).transpose();
     }
     return x;
@@ -165,30 +171,37 @@ LayeredHead layered_head(P policy, const TriMesh<>& outer, const Points<>& inwar
   };
 
   LayeredHead head;
-  std::vector<char> thinned(std::size_t(nv), 0);
+  std::vector<char> thinned(static_cast<std::size_t>(nv), 0), collapsed(static_cast<std::size_t>(nv), 0);
   std::vector<Points<>> wraps = make_wraps();
   for (Index round = 0;; ++round) {
-    const std::vector<char> bad = folded_prisms(policy, outer.F, wraps);
+    const std::vector<char> bad = folded_prisms(policy, outer.F, wraps, collapsed);
     if (std::find(bad.begin(), bad.end(), 1) == bad.end()) break;
     if (round >= opt.max_repairs) {
       const Index f = Index(std::find(bad.begin(), bad.end(), 1) - bad.begin());
       throw MeshError("triangle", f, "its prisms still fold after " + std::to_string(opt.max_repairs) + " rounds of thinning the layered head");
     }
-    std::vector<char> shrink(std::size_t(nv), 0);
+    std::vector<char> shrink(static_cast<std::size_t>(nv), 0);
     for (Index f = 0; f < outer.F.rows(); ++f)
       if (bad[std::size_t(f)])
         for (int c = 0; c < 3; ++c) shrink[std::size_t(outer.F(f, c))] = 1;
     for (Index i = 0; i < nv; ++i)
       if (shrink[std::size_t(i)]) {
-        thickness[i] = std::max(opt.min_thickness, 0.8 * thickness[i]);
+        thickness[i] *= 0.8;
         thinned[std::size_t(i)] = 1;
+        if (thickness[i] < opt.collapse_below) {  // no thickness fits: the shell pinches to the surface here
+          thickness[i] = 0;
+          collapsed[std::size_t(i)] = 1;
+        }
       }
     wraps = make_wraps();
   }
   head.repaired_vertices = Index(std::count(thinned.begin(), thinned.end(), 1));
+  head.collapsed_vertices = Index(std::count(collapsed.begin(), collapsed.end(), 1));
 
-  const PrismShell<> shell = prism_shell(policy, outer.F, wraps);
+  const PrismShell<> shell = prism_shell(policy, outer.F, wraps, collapsed);
   head.mesh = shell.mesh;
+  head.vertex_of = shell.vertex_of;
+  head.column_of = shell.column_of;
   head.wrap_vertices = nv;
   head.layers = L;
   head.thickness = thickness;
@@ -196,12 +209,14 @@ LayeredHead layered_head(P policy, const TriMesh<>& outer, const Points<>& inwar
   head.tissue.resize(std::size_t(head.mesh.num_tets()));
   for (Index t = 0; t < head.mesh.num_tets(); ++t) head.tissue[std::size_t(t)] = shell.tet_layer[t] < L ? TissueLayer::soft_tissue : TissueLayer::muscle;
   head.bone.assign(std::size_t(head.mesh.num_vertices()), Bone::none);
-  for (Index i = 0; i < nv; ++i) head.bone[std::size_t(2 * L * nv + i)] = inner_bone[std::size_t(i)];
+  for (Index i = 0; i < nv; ++i)  // a pinched column is skin, held by nothing; a dropped inner copy holds nothing either
+    if (!collapsed[std::size_t(i)] && head.vertex(2 * L, i) >= 0) head.bone[std::size_t(head.vertex(2 * L, i))] = inner_bone[std::size_t(i)];
   // the open boundary (the neck cut) is held in every wrap
   const Edges open = boundary_edges(outer.F);
   for (Index e = 0; e < open.rows(); ++e)
     for (int c = 0; c < 2; ++c)
-      for (Index w = 0; w < W; ++w) head.bone[std::size_t(w * nv + open(e, c))] = Bone::neck;
+      for (Index w = 0; w < W; ++w)
+        if (head.vertex(w, open(e, c)) >= 0) head.bone[std::size_t(head.vertex(w, open(e, c)))] = Bone::neck;
   // scaling centres
   Vec3<> sum = Vec3<>::Zero();
   Index n = 0;

@@ -25,6 +25,7 @@
 ///     auto r = sim.simulate(exec::omp, params, expression_weights);          // local–global
 ///     auto n = sim.simulate(exec::omp, params, expression_weights, {.solver = SoftDecaSolver::newton});
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -103,22 +104,50 @@ class SoftDecaSimulator {
     for (Index k2 = 0; k2 < tpl.skin.size(); ++k2) skin_area_[k2] = all[tpl.skin[k2]];
     distance_area_.resize(distances_.size());
     for (Index k2 = 0; k2 < distances_.size(); ++k2) distance_area_[k2] = all[distances_.vertices()[k2]];
+    // outer vertices that pinched columns left without a tet (layered_head.hpp): a skin vertex is
+    // held by E_tar; any other (a socket's) is held where its bones carry it, else it would be a
+    // zero row of both solvers' matrices
+    std::vector<char> in_tet(static_cast<std::size_t>(n_), 0), on_skin(static_cast<std::size_t>(n_), 0);
+    for (Index t = 0; t < tpl.head.mesh.num_tets(); ++t)
+      for (int c = 0; c < 4; ++c) in_tet[std::size_t(tpl.head.mesh.T(t, c))] = 1;
+    for (Index k2 = 0; k2 < tpl.skin.size(); ++k2) on_skin[std::size_t(tpl.skin[k2])] = 1;
+    for (Index v = 0; v < n_; ++v)
+      if (!in_tet[std::size_t(v)] && !on_skin[std::size_t(v)] && tpl.head.bone[std::size_t(v)] == Bone::none) loose_.push_back(VIndex(v));
   }
+
+  /// Vertices without a tet and off the skin, held at their place (see the constructor).
+  const std::vector<VIndex>& loose_vertices() const { return loose_; }
 
   const SoftDecaTemplate& template_() const { return tpl_; }
   /// Skin vertices kept at a distance from the bone beneath them (E_dist2).
   Index distance_vertices() const { return distances_.size(); }
 
-  /// One sample (see the file comment). `expression` holds the kit's E expression weights.
+  /// One sample (see the file comment): prepare(), settle(), then `steps` calls of step() with
+  /// the expression blended in over the first half. `expression` holds the E expression weights.
   /// Throws ConvergenceError from the solvers, ShapeError for a wrong number of weights,
   /// ArgumentError for parameters outside what the energies accept.
   template <exec::HostPolicy P>
   SoftDecaResult simulate(P policy, const SoftDecaParameters& p, const VecX<>& expression, const SoftDecaSimulationOptions& o = {}) {
     if (o.steps < 1) throw ArgumentError("SoftDecaSimulator: steps must be >= 1, got " + std::to_string(o.steps));
-    if (expression.size() != tpl_.expression_deltas.rows())
-      throw ShapeError("SoftDecaSimulator: expression weights", {tpl_.expression_deltas.rows()}, {expression.size()});
+    check_expression(expression);
     const auto t0 = std::chrono::steady_clock::now();
-    // the sample's weights
+    prepare(p);
+    SoftDecaResult r;
+    Points<> x;
+    r.iterations.push_back(settle(policy, x, o));
+    r.skin_at_rest = skin_of(x);
+    start_dynamics(x, o);
+    const double ramp_steps = std::max(1.0, double(o.steps) / 2);
+    for (Index s = 1; s <= o.steps; ++s) r.iterations.push_back(step(policy, x, std::min(1.0, double(s) / ramp_steps) * expression, o));
+    r.skin = skin_of(x);
+    r.inverted_tets = volume_.count_inverted(policy, x);
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  }
+
+  /// The sample's weights, gravity and skull on every term (both solvers' matrices refactor).
+  void prepare(const SoftDecaParameters& p) {
+    p_ = p;
     strain_soft_.material() = physics::StrainLimit<>(k_.strain_soft_tissue * p.w_strain_soft_tissue, p.max_strain);
     strain_muscle_.material() = physics::StrainLimit<>(k_.strain_muscle * p.w_strain_muscle, p.max_strain);
     volume_.material() = physics::VolumeTarget<>(k_.volume * p.w_volume, p.volume_target);
@@ -126,33 +155,74 @@ class SoftDecaSimulator {
     targets_.set_weights(k_.target * p.w_target * skin_area_);
     distances_.set_weights(k_.distance * p.w_distance * distance_area_);
     gravity_.set_acceleration(k_.gravity * p.gravity * p.gravity_direction.normalized());
-    const physics::DirichletBoundary<> bones = tpl_.head.bone_targets(p.cranium_scale, p.jaw_scale);
+    bones_ = tpl_.head.bone_targets(p.cranium_scale, p.jaw_scale);
+    if (!loose_.empty()) {  // held with the cranium, merged into the sorted Dirichlet list
+      const Points<> carried = tpl_.head.scaled_rest(p.cranium_scale, p.jaw_scale);
+      std::vector<std::pair<VIndex, Vec3<>>> all;
+      for (Index k2 = 0; k2 < bones_.size(); ++k2) all.emplace_back(bones_.vertices[k2], bones_.targets.row(k2).transpose());
+      for (VIndex v : loose_) all.emplace_back(v, carried.row(v).transpose());
+      std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      bones_.vertices.resize(Index(all.size()));
+      bones_.targets.resize(Index(all.size()), 3);
+      for (std::size_t k2 = 0; k2 < all.size(); ++k2) {
+        bones_.vertices[Index(k2)] = all[k2].first;
+        bones_.targets.row(Index(k2)) = all[k2].second.transpose();
+      }
+    }
     Points<> anchors(distances_.size(), 3);
-    for (Index k2 = 0; k2 < distances_.size(); ++k2) anchors.row(k2) = bone_target(bones, anchor_vertex_[std::size_t(k2)]);
+    for (Index k2 = 0; k2 < distances_.size(); ++k2) anchors.row(k2) = bone_target(bones_, anchor_vertex_[std::size_t(k2)]);
     distances_.set_targets(anchors);
     settle_.invalidate();
     step_.invalidate();
+  }
 
-    SoftDecaResult r;
-    // 1. the individual at rest, from the template carried along by its bones
-    Points<> x = tpl_.head.scaled_rest(p.cranium_scale, p.jaw_scale);
-    targets_.set_targets(tpl_.expression(VecX<>::Zero(expression.size())));
+  /// Part 1: x = the individual at rest (quasistatic, no expression), from the template carried
+  /// along by its bones. Returns the solver's iterations.
+  template <exec::HostPolicy P>
+  Index settle(P policy, Points<>& x, const SoftDecaSimulationOptions& o = {}) {
+    x = tpl_.head.scaled_rest(p_.cranium_scale, p_.jaw_scale);
+    targets_.set_targets(tpl_.expression(VecX<>::Zero(tpl_.expression_deltas.rows())));
     inertia_.set_parameters({.h = o.time_step, .alpha = 0, .beta = 0, .gamma = 0});
-    r.iterations.push_back(solve(policy, settle_, x, bones, o));
-    r.skin_at_rest = skin_of(x);
-    // 2. the expression, dynamically
-    inertia_.set_parameters({.h = o.time_step, .alpha = p.alpha, .beta = p.beta, .gamma = p.gamma});
+    return solve(policy, settle_, x, o);
+  }
+
+  /// Part 2 begins at rest at x: the dynamics' parameters set, the state's history reset.
+  void start_dynamics(const Points<>& x, const SoftDecaSimulationOptions& o = {}) {
+    inertia_.set_parameters({.h = o.time_step, .alpha = p_.alpha, .beta = p_.beta, .gamma = p_.gamma});
     inertia_.reset(x);
-    const double ramp_steps = std::max(1.0, double(o.steps) / 2);
-    for (Index s = 1; s <= o.steps; ++s) {
-      targets_.set_targets(tpl_.expression(std::min(1.0, double(s) / ramp_steps) * expression));
-      r.iterations.push_back(solve(policy, step_, x, bones, o));
-      inertia_.advance(x);
-    }
-    r.skin = skin_of(x);
-    r.inverted_tets = volume_.count_inverted(policy, x);
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
+  }
+
+  /// One implicit step toward the skin at expression weights `w` (x in/out; the state's history
+  /// advances). Returns the solver's iterations.
+  template <exec::HostPolicy P>
+  Index step(P policy, Points<>& x, const VecX<>& w, const SoftDecaSimulationOptions& o = {}) {
+    check_expression(w);
+    targets_.set_targets(tpl_.expression(w));
+    const Index its = solve(policy, step_, x, o);
+    inertia_.advance(x);
+    return its;
+  }
+
+  /// The step solver (local-global), for timing its parts: its factor() and apply_inverse().
+  physics::LocalGlobalSolver<>& step_solver() { return step_; }
+  const physics::DirichletBoundary<>& boundary() const { return bones_; }
+  /// Σ terms' gradients at x into g (#V×3): the local step of one local-global iteration.
+  template <exec::HostPolicy P>
+  void gradient(P policy, const Points<>& x, Points<>& g) const {
+    g.setZero(x.rows(), 3);
+    strain_soft_.add_gradient(policy, x, g);
+    strain_muscle_.add_gradient(policy, x, g);
+    volume_.add_gradient(policy, x, g);
+    bending_.add_gradient(policy, x, g);
+    targets_.add_gradient(policy, x, g);
+    distances_.add_gradient(policy, x, g);
+    gravity_.add_gradient(policy, x, g);
+    inertia_.add_gradient(policy, x, g);
+  }
+  /// Factors the step solver's matrix for the current weights (what step() does once per sample).
+  template <exec::HostPolicy P>
+  void factor_step(P policy) {
+    step_.factor(policy, bones_, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_, inertia_);
   }
 
  private:
@@ -171,14 +241,14 @@ class SoftDecaSimulator {
     for (Index k = 0; k < tpl.skin.size(); ++k) s.row(k) = tpl.head.mesh.V.row(tpl.skin[k]);
     return s;
   }
-  /// Skin vertices (outer wrap, index i) whose inner-wrap vertex 2L·nv + i is cranium or jaw.
+  /// Skin vertices (outer wrap, index i) whose inner-wrap vertex vertex(2L, i) is cranium or jaw.
   physics::VertexTargets<> make_distances(const SoftDecaTemplate& tpl) {
     const LayeredHead& h = tpl.head;
-    const Index inner = 2 * h.layers * h.wrap_vertices;
     std::vector<VIndex> v;
     std::vector<double> d;
     for (Index k = 0; k < tpl.skin.size(); ++k) {
-      const Index i = tpl.skin[k], b = inner + i;
+      const Index i = tpl.skin[k], b = h.vertex(2 * h.layers, i);
+      if (b < 0) continue;
       const Bone bone = h.bone[std::size_t(b)];
       if (bone == Bone::cranium || bone == Bone::jaw) {
         v.push_back(VIndex(i));
@@ -201,8 +271,12 @@ class SoftDecaSimulator {
     for (Index k = 0; k < tpl_.skin.size(); ++k) s.row(k) = x.row(tpl_.skin[k]);
     return s;
   }
+  void check_expression(const VecX<>& w) const {
+    if (w.size() != tpl_.expression_deltas.rows()) throw ShapeError("SoftDecaSimulator: expression weights", {tpl_.expression_deltas.rows()}, {w.size()});
+  }
   template <class P>
-  Index solve(P policy, physics::LocalGlobalSolver<>& pd, Points<>& x, const physics::DirichletBoundary<>& bones, const SoftDecaSimulationOptions& o) {
+  Index solve(P policy, physics::LocalGlobalSolver<>& pd, Points<>& x, const SoftDecaSimulationOptions& o) {
+    const physics::DirichletBoundary<>& bones = bones_;
     if (o.solver == SoftDecaSolver::newton) {
       newton_.options().relative_tolerance = o.relative_tolerance;
       return newton_.solve(policy, x, bones, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_, inertia_).iterations;
@@ -227,6 +301,9 @@ class SoftDecaSimulator {
   physics::LocalGlobalSolver<> settle_, step_;
   physics::QuasistaticSolver<> newton_;
   VecX<> skin_area_, distance_area_;
+  SoftDecaParameters p_;
+  physics::DirichletBoundary<> bones_;
+  std::vector<VIndex> loose_;
 };
 
 }  // namespace simsr::scenario
