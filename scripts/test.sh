@@ -4,15 +4,16 @@
 # runtimes and LLVM's OpenMP with Archer), so it exports SIMSR_REQUIRE_PEERS=1: after that, a peer,
 # the ../shared/data folder or clang that is still missing is a real failure here, never a skip.
 #
-#   1. build/       g++, a test build (SIMSR_TEST_BUILD: -O1 everywhere): the interp, nn and pipeline
-#                   suites (the libgomp allocation checks; the demo, animate and ablation runs),
+#   1. build/       g++, a test build (SIMSR_TEST_BUILD: -O1 everywhere): the interp, nn, pipeline and
+#                   scenario suites (the libgomp allocation checks; the demo, animate and ablation
+#                   runs; the SoftDECA template from the kit),
 #                   test_threads, the tool and examples, the fuzz-corpus replays, the peers (gmsh,
 #                   meshio, numpy, scipy, torch), install + consumer project, compile-fail checks,
 #                   cuda-compile, and each benchmark compiled (clang syntax only, a ctest each: none
 #                   is built or run here; -DSIMSR_BUILD_BENCHMARKS=ON builds them)
 #   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite (pipeline's own parts) and the corpus replays under
 #                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, no recovery); the
-#                   suites other than interp, nn and pipeline run here and under TSan only
+#                   suites other than interp, nn, pipeline and scenario run here and under TSan only
 #                   (tests/CMakeLists.txt says why)
 #   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: every suite that runs exec::omp under TSan, with
 #                   LLVM's libomp and its Archer tool (so OpenMP's synchronisation is understood)
