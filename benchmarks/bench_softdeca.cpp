@@ -6,7 +6,7 @@
 // Scenes (built lazily, shared by the cases):
 //   bouaziz_49k   a layered ball standing in for a head (radius 10 cm, flesh 1.5 cm; icosphere
 //                 level 4: 2,562 vertices per wrap, 3 prism layers per shell, so 7 wraps =
-//                 17,934 vertices = 53.8k DOFs, 107,580 tets), cranium above y = −3 cm, jaw below
+//                 17,934 vertices = 53.8k DOFs, 92,160 tets), cranium above y = −3 cm, jaw below
 //                 −6 cm, skin = the outer wrap with two synthetic expressions
 //   ict_template  the ICT kit's layered head (scenario/softdeca/ict_template.hpp, 1 layer per
 //                 shell; 42,084 vertices, 167,778 tets): built by scene(), its cases not yet
