@@ -4,10 +4,9 @@
 // line search and no L-BFGS).
 //
 // Scenes (built lazily, shared by the cases):
-//   bouaziz_49k   a layered ball standing in for a head (radius 10 cm, flesh 1.5 cm; icosphere
-//                 level 4: 2,562 vertices per wrap, 3 prism layers per shell, so 7 wraps =
-//                 17,934 vertices = 53.8k DOFs, 92,160 tets), cranium above y = −3 cm, jaw below
-//                 −6 cm, skin = the outer wrap with two synthetic expressions
+//   bouaziz_49k   the sphere template (scenario/softdeca/sphere_template.hpp) at icosphere level
+//                 4: 2,562 vertices per wrap, 3 prism layers per shell, so 7 wraps = 17,934
+//                 vertices = 53.8k DOFs, 92,160 tets
 //   ict_template  the ICT kit's layered head (scenario/softdeca/ict_template.hpp, 1 layer per
 //                 shell; 42,084 vertices, 167,778 tets): built by scene(), its cases not yet
 //                 registered (see the end of the file)
@@ -27,9 +26,9 @@
 // Run: build/benchmarks/bench_softdeca [--benchmark_filter=bouaziz]
 #include <benchmark/benchmark.h>
 
-#include <simsr/mesh/generators.hpp>
 #include <simsr/scenario/softdeca/ict_template.hpp>
 #include <simsr/scenario/softdeca/softdeca_simulator.hpp>
+#include <simsr/scenario/softdeca/sphere_template.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -41,28 +40,6 @@ using namespace simsr;
 using namespace simsr::scenario;
 
 namespace {
-
-SoftDecaTemplate ball_template(Index level, Index layers) {
-  const auto s = icosphere<double>(level, 0.1);
-  const Index nv = s.V.rows();
-  const Points<> inward = -s.V.rowwise().normalized();
-  std::vector<Bone> bones(static_cast<std::size_t>(nv));
-  for (Index i = 0; i < nv; ++i) bones[std::size_t(i)] = s.V(i, 1) > -0.03 ? Bone::cranium : s.V(i, 1) < -0.06 ? Bone::jaw : Bone::none;
-  SoftDecaTemplate tpl;
-  tpl.head = layered_head(exec::omp, s, inward, VecX<>::Constant(nv, 0.015), bones, {.layers = layers}, Vec3<>(0, -0.05, -0.02));
-  tpl.skin.resize(nv);
-  for (Index i = 0; i < nv; ++i) tpl.skin[i] = VIndex(i);
-  tpl.skin_triangles = s.F;
-  tpl.kit_vertex.assign(std::size_t(nv), -1);
-  tpl.expression_names = {"bulge", "lift"};
-  tpl.expression_deltas = Eigen::MatrixXd::Zero(2, 3 * nv);
-  for (Index i = 0; i < nv; ++i) {
-    const Vec3<> x = s.V.row(i).transpose() / 0.1;
-    tpl.expression_deltas.row(0).segment<3>(3 * i) = 0.01 * std::max(0.0, x.z()) * x.transpose();
-    tpl.expression_deltas(1, 3 * i + 1) = 0.01 * std::max(0.0, x.y());
-  }
-  return tpl;
-}
 
 struct Scene {
   std::unique_ptr<SoftDecaTemplate> tpl;
@@ -78,7 +55,7 @@ Scene& scene(const std::string& name) {
   if (it != scenes.end()) return it->second;
   Scene s;
   if (name == "bouaziz_49k") {
-    s.tpl = std::make_unique<SoftDecaTemplate>(ball_template(4, 3));
+    s.tpl = std::make_unique<SoftDecaTemplate>(sphere_softdeca_template(exec::omp, 4, 3));
   } else {
     const auto kit = read_ict_kit(std::filesystem::path(SIMSR_DATA_DIR) / "ict_face");
     s.tpl = std::make_unique<SoftDecaTemplate>(softdeca_template(exec::omp, kit));

@@ -1,9 +1,9 @@
 // SoftDECA's simulation on a small layered ball standing in for the head: the local-global and
 // the Newton solver agree on sampled parameters; gravity's direction and the skull's scaling act
 // visibly; the expression is reached.
-#include <simsr/mesh/generators.hpp>
 #include <simsr/scenario/softdeca/layered_head.hpp>
 #include <simsr/scenario/softdeca/softdeca_simulator.hpp>
+#include <simsr/scenario/softdeca/sphere_template.hpp>
 
 #include <doctest/doctest.h>
 
@@ -14,29 +14,8 @@ namespace scenario_test_softdeca_simulator {
 using namespace simsr;
 using namespace simsr::scenario;
 
-/// A ball of radius 10 cm, flesh 1.5 cm deep, cranium bone above y = −3 cm, jaw below −6 cm; two
-/// "expressions": a 1 cm bulge of the front (+z) and a 1 cm lift of the top.
-SoftDecaTemplate ball_template() {
-  const auto s = icosphere<double>(2, 0.1);
-  const Index nv = s.V.rows();
-  const Points<> inward = -s.V.rowwise().normalized();
-  std::vector<Bone> bones(static_cast<std::size_t>(nv));
-  for (Index i = 0; i < nv; ++i) bones[std::size_t(i)] = s.V(i, 1) > -0.03 ? Bone::cranium : s.V(i, 1) < -0.06 ? Bone::jaw : Bone::none;
-  SoftDecaTemplate tpl;
-  tpl.head = layered_head(exec::seq, s, inward, VecX<>::Constant(nv, 0.015), bones, {.layers = 1}, Vec3<>(0, -0.05, -0.02));
-  tpl.skin.resize(nv);
-  for (Index i = 0; i < nv; ++i) tpl.skin[i] = VIndex(i);
-  tpl.skin_triangles = s.F;
-  tpl.kit_vertex.assign(std::size_t(nv), 0);
-  tpl.expression_names = {"bulge", "lift"};
-  tpl.expression_deltas = Eigen::MatrixXd::Zero(2, 3 * nv);
-  for (Index i = 0; i < nv; ++i) {
-    const Vec3<> x = s.V.row(i).transpose() / 0.1;
-    tpl.expression_deltas.row(0).segment<3>(3 * i) = 0.01 * std::max(0.0, x.z()) * x.transpose();
-    tpl.expression_deltas(1, 3 * i + 1) = 0.01 * std::max(0.0, x.y());
-  }
-  return tpl;
-}
+/// The sphere template (sphere_template.hpp) at icosphere level 2, one layer per shell.
+SoftDecaTemplate ball_template() { return sphere_softdeca_template(exec::seq, 2, 1); }
 
 SoftDecaParameters calm() {
   SoftDecaParameters p;  // every weight 1, v = 1, ε = 1, 1 g down, skull as is, quasistatic

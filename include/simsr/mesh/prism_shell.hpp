@@ -140,9 +140,9 @@ PrismShell<S> prism_shell(P policy, const Tris& F, const std::vector<Points<S>>&
   for (Index w = 0; w < W; ++w)
     for (Index i = 0; i < nv; ++i)
       if (w == 0 || collapsed.empty() || !collapsed[std::size_t(i)]) r.mesh.V.row(r.vertex_of[w * nv + i]) = wraps[std::size_t(w)].row(i);
-  // tets, prism by prism (sequential: a prism gives 1 to 3 tets)
+  // tets, prism by prism (sequential: a prism gives 1 to 3 tets), then their volumes checked
   std::vector<std::array<VIndex, 4>> tets;
-  std::vector<VIndex> layer;
+  std::vector<VIndex> layer, triangle;
   tets.reserve(std::size_t(3 * F.rows() * layers));
   for (Index w = 0; w < layers; ++w)
     for (Index f = 0; f < F.rows(); ++f)
@@ -150,13 +150,17 @@ PrismShell<S> prism_shell(P policy, const Tris& F, const std::vector<Points<S>>&
         if (detail::collapsed_tet(t, nv, collapsed)) continue;
         std::array<VIndex, 4> m{};
         for (int c = 0; c < 4; ++c) m[std::size_t(c)] = r.vertex_of[t[std::size_t(c)]];
-        const auto p = [&](int c) { return Vec3<S>(r.mesh.V.row(m[std::size_t(c)]).transpose()); };
-        if (!(detail::tet_volume6(p(0), p(1), p(2), p(3)) > S(0)))
-          throw MeshError("triangle", f, "its prism between wraps " + std::to_string(w) + " and " + std::to_string(w + 1) +
-                                             " is folded (a tet of non-positive volume): the wraps cross there");
         tets.push_back(m);
         layer.push_back(VIndex(w));
+        triangle.push_back(VIndex(f));
       }
+  exec::parallel_for(policy, Index(tets.size()), [&](Index k) {
+    const auto p = [&](int c) { return Vec3<S>(r.mesh.V.row(tets[std::size_t(k)][std::size_t(c)]).transpose()); };
+    if (!(detail::tet_volume6(p(0), p(1), p(2), p(3)) > S(0)))
+      throw MeshError("triangle", triangle[std::size_t(k)],
+                      "its prism between wraps " + std::to_string(layer[std::size_t(k)]) + " and " + std::to_string(layer[std::size_t(k)] + 1) +
+                          " is folded (a tet of non-positive volume): the wraps cross there");
+  });
   // inner copies that no tet uses (where pinched columns surround a vertex) are dropped: a vertex
   // without a tet would be a zero row of every solver's matrix. The outer wrap's stay (0..nv−1).
   std::vector<char> used(static_cast<std::size_t>(r.mesh.V.rows()), 0);
@@ -184,7 +188,6 @@ PrismShell<S> prism_shell(P policy, const Tris& F, const std::vector<Points<S>>&
   for (std::size_t t = 0; t < tets.size(); ++t)
     for (int c = 0; c < 4; ++c) r.mesh.T(Index(t), c) = tets[t][std::size_t(c)];
   r.tet_layer = Eigen::Map<const IndexVector>(layer.data(), Index(layer.size()));
-  (void)policy;
   return r;
 }
 

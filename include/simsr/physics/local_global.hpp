@@ -127,7 +127,7 @@ class LocalGlobalSolver {
   void factor(P policy, const DirichletBoundary<S>& boundary, const Terms&... terms) {
     static_assert((assert_projective_term<Terms, S>() && ...));
     if constexpr ((ProjectiveTerm<Terms, S> && ...)) {
-      fixed_mask(boundary, factor_fixed_);
+      detail::dirichlet_mask(n_, boundary, factor_fixed_);
       L_.set_zero();
       (terms.add_global_matrix(policy, L_), ...);
       const SparseMatrix<S>& A = L_.assemble(policy, factor_fixed_);
@@ -171,21 +171,18 @@ class LocalGlobalSolver {
       report.factored = true;
     }
     forget();
-    double reference = 0, magnitude = 0;
+    detail::GradientTest test(options_.relative_tolerance, options_.absolute_tolerance, options_.reference_force);
+    double magnitude = 0;
     double E = detail::total_energy(policy, x, magnitude, terms...);
     double balance = detail::free_gradient(policy, x, fixed_, scratch_, g_, terms...);
     for (Index it = 0;; ++it) {
       if (!std::isfinite(E)) throw ConvergenceError("local-global solver (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
       const double gnorm = double(g_.norm());
-      if (it == 0) {
-        report.initial_gradient_norm = gnorm;
-        reference = std::max(options_.reference_force, gnorm);
-      }
-      reference = std::max(reference, balance);
+      if (it == 0) report.initial_gradient_norm = gnorm;
       report.iterations = it;
       report.energy = E;
       report.gradient_norm = gnorm;
-      if (gnorm <= std::max(options_.absolute_tolerance, options_.relative_tolerance * reference)) {
+      if (test.converged(it, gnorm, balance)) {
         report.converged = true;
         return report;
       }
@@ -219,7 +216,7 @@ class LocalGlobalSolver {
       x.swap(trial_);
       g_old_ = g_;
       balance = detail::free_gradient(policy, x, fixed_, scratch_, g_, terms...);
-      remember(S(alpha) * d_, g_ - g_old_);
+      remember(alpha);
       LocalGlobalIteration record{it, E, gnorm, alpha, backtracks};
       report.history.push_back(record);
       if (options_.progress) options_.progress(record);
@@ -227,53 +224,55 @@ class LocalGlobalSolver {
     }
   }
 
-  /// d_ = −H̃⁻¹ g_ by L-BFGS's two loops with L⁻¹ as the initial inverse Hessian.
+  /// d_ = −H̃⁻¹ g_ by L-BFGS's two loops with L⁻¹ as the initial inverse Hessian. The pairs live
+  /// in a ring of `history` slots allocated once per solve size: an iteration allocates nothing.
   template <class P>
   void direction(P policy) {
-    const std::size_t m = pairs_s_.size();
     q_ = g_;
-    alphas_.resize(m);
-    for (std::size_t i = m; i-- > 0;) {
-      alphas_[i] = pairs_rho_[i] * pairs_s_[i].dot(q_);
-      q_ -= alphas_[i] * pairs_y_[i];
+    alphas_.resize(std::size_t(stored_));
+    for (Index k = stored_; k-- > 0;) {  // newest first
+      const std::size_t i = slot(k);
+      alphas_[std::size_t(k)] = rho_[i] * s_[i].dot(q_);
+      q_ -= alphas_[std::size_t(k)] * y_[i];
     }
     const LinearSolveInfo info = linear_.solve(policy, q_, d_);
     if (!info.converged) throw ConvergenceError("local-global solver (global step: the linear solve did not converge)", info.iterations, info.relative_residual);
-    for (std::size_t i = 0; i < m; ++i) {
-      const S beta = pairs_rho_[i] * pairs_y_[i].dot(d_);
-      d_ += (alphas_[i] - beta) * pairs_s_[i];
+    for (Index k = 0; k < stored_; ++k) {  // oldest first
+      const std::size_t i = slot(k);
+      d_ += (alphas_[std::size_t(k)] - rho_[i] * y_[i].dot(d_)) * s_[i];
     }
     d_ = -d_;
   }
 
+  /// The k-th stored pair, oldest first.
+  std::size_t slot(Index k) const { return std::size_t((first_ + k) % Index(s_.size())); }
+
   void forget() {
-    pairs_s_.clear();
-    pairs_y_.clear();
-    pairs_rho_.clear();
+    stored_ = 0;
+    first_ = 0;
+    const std::size_t m = std::size_t(std::max<Index>(options_.history, 0));
+    if (s_.size() != m || (m > 0 && s_[0].size() != 3 * n_)) {
+      s_.assign(m, VecX<S>::Zero(3 * n_));
+      y_.assign(m, VecX<S>::Zero(3 * n_));
+      rho_.assign(m, S(0));
+    }
   }
 
-  /// Keeps (s, y) when it has positive curvature yᵀs > 0 (the update stays positive definite).
-  void remember(const VecX<S>& s, const VecX<S>& y) {
-    if (options_.history <= 0) return;
-    const S ys = y.dot(s);
-    if (!(ys > S(1e-12) * std::sqrt(double(y.squaredNorm() * s.squaredNorm())))) return;
-    if (Index(pairs_s_.size()) == options_.history) {
-      pairs_s_.erase(pairs_s_.begin());
-      pairs_y_.erase(pairs_y_.begin());
-      pairs_rho_.erase(pairs_rho_.begin());
-    }
-    pairs_s_.push_back(s);
-    pairs_y_.push_back(y);
-    pairs_rho_.push_back(S(1) / ys);
-  }
-
-  void fixed_mask(const DirichletBoundary<S>& b, std::vector<char>& fixed) const {
-    fixed.assign(std::size_t(3 * n_), 0);
-    for (Index k = 0; k < b.vertices.size(); ++k) {
-      const VIndex v = b.vertices[k];
-      if (v < 0 || v >= n_) throw MeshError("vertex", v, "Dirichlet vertex out of range [0, " + std::to_string(n_) + ")");
-      for (int c = 0; c < 3; ++c) fixed[std::size_t(3 * v + c)] = 1;
-    }
+  /// Keeps the step s_k = x_{k+1} − x_k (alpha · d_) and y_k = g_{k+1} − g_k (g_ − g_old_) when
+  /// yᵀs > 0 (the update stays positive definite), the oldest pair giving way.
+  void remember(double alpha) {
+    if (s_.empty()) return;
+    const S ys = S(alpha) * (g_ - g_old_).dot(d_);  // Eigen evaluates these expressions without temporaries
+    const double yy = double((g_ - g_old_).squaredNorm()), ss = alpha * alpha * double(d_.squaredNorm());
+    if (!(ys > S(1e-12) * std::sqrt(yy * ss))) return;
+    const std::size_t i = stored_ < Index(s_.size()) ? slot(stored_) : slot(0);
+    s_[i] = S(alpha) * d_;
+    y_[i] = g_ - g_old_;
+    rho_[i] = S(1) / ys;
+    if (stored_ < Index(s_.size()))
+      ++stored_;
+    else
+      first_ = (first_ + 1) % Index(s_.size());
   }
 
   Index n_;
@@ -285,8 +284,9 @@ class LocalGlobalSolver {
   std::vector<char> fixed_, factor_fixed_;
   Points<S> scratch_, trial_;
   VecX<S> g_, g_old_, d_, q_;
-  std::vector<VecX<S>> pairs_s_, pairs_y_;
-  std::vector<S> pairs_rho_, alphas_;
+  std::vector<VecX<S>> s_, y_;  // the L-BFGS ring (forget, remember)
+  std::vector<S> rho_, alphas_;
+  Index stored_ = 0, first_ = 0;
 };
 
 }  // namespace simsr::physics

@@ -127,22 +127,18 @@ class QuasistaticSolver {
     detail::require_positions("QuasistaticSolver::solve: x", x, n_);
     apply_boundary(x, boundary);
     NewtonReport report;
-    double reference = 0;
+    detail::GradientTest test(options_.relative_tolerance, options_.absolute_tolerance, options_.reference_force);
     const double size = double((x.colwise().maxCoeff() - x.colwise().minCoeff()).norm());
     for (Index it = 0;; ++it) {
       const double E = total_energy(policy, x, terms...);
       if (!std::isfinite(E)) throw ConvergenceError("quasistatic Newton (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
       const double balance = compute_gradient(policy, x, terms...);
       const double gnorm = double(g_.norm());
-      if (it == 0) {
-        report.initial_gradient_norm = gnorm;
-        reference = std::max(options_.reference_force, gnorm);
-      }
-      reference = std::max(reference, balance);
+      if (it == 0) report.initial_gradient_norm = gnorm;
       report.iterations = it;
       report.energy = E;
       report.gradient_norm = gnorm;
-      if (gnorm <= std::max(options_.absolute_tolerance, options_.relative_tolerance * reference)) {
+      if (test.converged(it, gnorm, balance)) {
         report.converged = true;
         return report;
       }

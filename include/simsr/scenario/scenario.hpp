@@ -22,4 +22,5 @@
 #include "softdeca/layered_head.hpp"
 #include "softdeca/parameters.hpp"
 #include "softdeca/softdeca_simulator.hpp"
+#include "softdeca/sphere_template.hpp"
 #include "softdeca/template.hpp"

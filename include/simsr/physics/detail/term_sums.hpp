@@ -4,6 +4,7 @@
 /// local–global solver): set the Dirichlet vertices, sum the terms' energies, and sum their
 /// gradients over the free DOFs together with the size of the forces in balance.
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -16,7 +17,19 @@
 
 namespace simsr::physics::detail {
 
-/// Sets x's boundary vertices to their targets and fixed[3v + c] = 1 for them (0 elsewhere).
+/// fixed[3v + c] = 1 for the boundary's vertices over n vertices (0 elsewhere). MeshError for a
+/// vertex out of range.
+template <class S>
+void dirichlet_mask(Index n, const DirichletBoundary<S>& b, std::vector<char>& fixed) {
+  fixed.assign(std::size_t(3 * n), 0);
+  for (Index k = 0; k < b.vertices.size(); ++k) {
+    const VIndex v = b.vertices[k];
+    if (v < 0 || v >= n) throw MeshError("vertex", v, "Dirichlet vertex out of range [0, " + std::to_string(n) + ")");
+    for (int c = 0; c < 3; ++c) fixed[std::size_t(3 * v + c)] = 1;
+  }
+}
+
+/// Sets x's boundary vertices to their targets and their DOFs in `fixed` (dirichlet_mask).
 /// ShapeError for a target array of the wrong shape, MeshError for a vertex out of range or a
 /// non-finite target, ShapeError when x has a non-finite entry afterwards.
 template <class S>
@@ -24,16 +37,31 @@ void apply_dirichlet(const char* solver, Points<S>& x, const DirichletBoundary<S
   const Index n = x.rows();
   if (b.targets.rows() != b.vertices.size() || b.targets.cols() != 3)
     throw ShapeError(std::string(solver) + ": Dirichlet targets", {b.vertices.size(), 3}, {b.targets.rows(), b.targets.cols()});
-  fixed.assign(std::size_t(3 * n), 0);
+  dirichlet_mask(n, b, fixed);
   for (Index k = 0; k < b.vertices.size(); ++k) {
-    const VIndex v = b.vertices[k];
-    if (v < 0 || v >= n) throw MeshError("vertex", v, "Dirichlet vertex out of range [0, " + std::to_string(n) + ")");
-    if (!b.targets.row(k).allFinite()) throw MeshError("vertex", v, "Dirichlet target is not finite");
-    x.row(v) = b.targets.row(k);
-    for (int c = 0; c < 3; ++c) fixed[std::size_t(3 * v + c)] = 1;
+    if (!b.targets.row(k).allFinite()) throw MeshError("vertex", b.vertices[k], "Dirichlet target is not finite");
+    x.row(b.vertices[k]) = b.targets.row(k);
   }
   if (!x.allFinite()) throw ShapeError(std::string(solver) + ": x has non-finite entries", {n, 3}, {x.rows(), x.cols()});
 }
+
+/// The solvers' one stopping rule (NewtonOptions says it): ‖g‖ ≤ max(absolute, relative ·
+/// reference), the reference the largest of reference_force, ‖g‖ at the first iterate and every
+/// iterate's Σ_k ‖g_k‖ (the forces in balance).
+class GradientTest {
+ public:
+  GradientTest(double relative, double absolute, double reference_force)
+      : relative_(relative), absolute_(absolute), reference_(reference_force) {}
+  /// Whether iterate `it` (gradient norm, forces' scale) has converged; call once per iterate.
+  bool converged(Index it, double gradient_norm, double balance) {
+    if (it == 0) reference_ = std::max(reference_, gradient_norm);
+    reference_ = std::max(reference_, balance);
+    return gradient_norm <= std::max(absolute_, relative_ * reference_);
+  }
+
+ private:
+  double relative_, absolute_, reference_;
+};
 
 /// Σ terms' energies at x; `magnitude` gets Σ |E_k| (the scale of round-off in the sum).
 template <class S, class P, class... Terms>
