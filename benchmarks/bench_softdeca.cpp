@@ -19,9 +19,16 @@
 //   BM_softdeca_frame/<scene>/<solver>/<policy>    one frame; counters iterations, s_per_iteration
 //   BM_softdeca_local_step/<scene>/<policy>        every term's gradient at the frame's start
 //                                                  (the local step: projections in parallel)
-//   BM_softdeca_global_step/<scene>                one solve with the prefactored matrix
-//   BM_softdeca_factor/<scene>                     assembling and factoring the global matrix
-//                                                  (once per weight set)
+//   BM_softdeca_energy_then_gradient/<scene>       a trial's energy, then the gradient at the
+//                                                  accepted point: each strain tet decomposed twice
+//                                                  (the solver before the fused evaluation)
+//   BM_softdeca_energy_gradient_fused/<scene>      both in one pass (one SVD per tet): the ratio
+//                                                  of these two is the fused evaluation's gain
+//   BM_softdeca_global_step/<scene>/<reduced|full> one solve with the prefactored matrix: the
+//                                                  #V×#V matrix of an isotropic L, three solves, vs
+//                                                  the 3V×3V one (isotropic_reduction off)
+//   BM_softdeca_factor/<scene>/<reduced|full>      assembling and factoring the global matrix
+//                                                  (once per weight set), both ways
 //
 // Run: build/benchmarks/bench_softdeca [--benchmark_filter=bouaziz]
 #include <benchmark/benchmark.h>
@@ -111,9 +118,36 @@ void BM_softdeca_local_step(benchmark::State& state, const std::string& name, P 
   sizes(state, s);
 }
 
-/// The global step: one solve with the prefactored matrix.
-void BM_softdeca_global_step(benchmark::State& state, const std::string& name) {
+/// A line-search trial's energy and then the gradient at the accepted point (two passes).
+template <class P>
+void BM_softdeca_energy_then_gradient(benchmark::State& state, const std::string& name, P policy) {
   Scene& s = scene(name);
+  Points<> g(s.settled.rows(), 3);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(s.sim->energy(policy, s.settled));
+    s.sim->gradient(policy, s.settled, g);
+    benchmark::DoNotOptimize(g.data());
+  }
+  sizes(state, s);
+}
+
+/// The same in one pass (the solver's evaluation of a unit step).
+template <class P>
+void BM_softdeca_energy_gradient_fused(benchmark::State& state, const std::string& name, P policy) {
+  Scene& s = scene(name);
+  Points<> g(s.settled.rows(), 3);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(s.sim->energy_and_gradient(policy, s.settled, g));
+    benchmark::DoNotOptimize(g.data());
+  }
+  sizes(state, s);
+}
+
+/// The global step: one solve with the prefactored matrix, reduced (#V×#V, three solves) or full (3V×3V).
+void BM_softdeca_global_step(benchmark::State& state, const std::string& name, bool reduced) {
+  Scene& s = scene(name);
+  s.sim->step_solver().options().isotropic_reduction = reduced;
+  s.sim->factor_step(exec::omp);
   Points<> g(s.settled.rows(), 3);
   s.sim->gradient(exec::omp, s.settled, g);
   VecX<> q = Eigen::Map<const VecX<>>(g.data(), g.size()), d(q.size());
@@ -122,13 +156,19 @@ void BM_softdeca_global_step(benchmark::State& state, const std::string& name) {
     s.sim->step_solver().apply_inverse(exec::omp, q, d);
     benchmark::DoNotOptimize(d.data());
   }
+  if (s.sim->step_solver().reduced() != reduced) state.SkipWithError("the global matrix was not reduced as asked");
+  s.sim->step_solver().options().isotropic_reduction = true;
+  s.sim->factor_step(exec::omp);
   sizes(state, s);
 }
 
-/// Assembling and factoring the global matrix (once per weight set).
-void BM_softdeca_factor(benchmark::State& state, const std::string& name) {
+/// Assembling and factoring the global matrix (once per weight set), reduced or full.
+void BM_softdeca_factor(benchmark::State& state, const std::string& name, bool reduced) {
   Scene& s = scene(name);
+  s.sim->step_solver().options().isotropic_reduction = reduced;
   for (auto _ : state) s.sim->factor_step(exec::omp);
+  s.sim->step_solver().options().isotropic_reduction = true;
+  s.sim->factor_step(exec::omp);
   sizes(state, s);
 }
 
@@ -141,8 +181,16 @@ void BM_softdeca_factor(benchmark::State& state, const std::string& name) {
       ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);                                                                         \
   BENCHMARK_CAPTURE(BM_softdeca_local_step, scene_name##_seq, std::string(#scene_name), exec::seq)->Unit(benchmark::kMillisecond)->UseRealTime(); \
   BENCHMARK_CAPTURE(BM_softdeca_local_step, scene_name##_omp, std::string(#scene_name), exec::omp)->Unit(benchmark::kMillisecond)->UseRealTime(); \
-  BENCHMARK_CAPTURE(BM_softdeca_global_step, scene_name, std::string(#scene_name))->Unit(benchmark::kMillisecond)->UseRealTime();              \
-  BENCHMARK_CAPTURE(BM_softdeca_factor, scene_name, std::string(#scene_name))->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+  BENCHMARK_CAPTURE(BM_softdeca_energy_then_gradient, scene_name##_omp, std::string(#scene_name), exec::omp)                                 \
+      ->Unit(benchmark::kMillisecond)->UseRealTime();                                                                                        \
+  BENCHMARK_CAPTURE(BM_softdeca_energy_gradient_fused, scene_name##_omp, std::string(#scene_name), exec::omp)                                \
+      ->Unit(benchmark::kMillisecond)->UseRealTime();                                                                                        \
+  BENCHMARK_CAPTURE(BM_softdeca_global_step, scene_name##_reduced, std::string(#scene_name), true)->Unit(benchmark::kMillisecond)->UseRealTime(); \
+  BENCHMARK_CAPTURE(BM_softdeca_global_step, scene_name##_full, std::string(#scene_name), false)->Unit(benchmark::kMillisecond)->UseRealTime();   \
+  BENCHMARK_CAPTURE(BM_softdeca_factor, scene_name##_reduced, std::string(#scene_name), true)                                                 \
+      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);                                                                         \
+  BENCHMARK_CAPTURE(BM_softdeca_factor, scene_name##_full, std::string(#scene_name), false)                                                   \
+      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
 SIMSR_SOFTDECA_CASES(bouaziz_49k)
 // The ICT template's cases (the scene "ict_template" above) are not registered yet: a sampled

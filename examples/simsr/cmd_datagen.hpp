@@ -6,11 +6,20 @@
 // stdout and in DIR/face_data.json. A rerun resumes; a finished performance is reused. Then the
 // LR-only unseen-force sequences of §5.3 in DIR/unseen/ (scenario/face/unseen_forces.hpp;
 // --no-unseen-forces skips them).
+//
+// `simsr datagen --scenario softdeca --samples N --out DIR [--template ict|sphere] [--layers L]
+//  [--sphere-level K] [--seed S] [--steps K] [--solver local_global|newton] [--active-expressions A]`:
+// SoftDECA's layered head template (from the same kit, or the sphere stand-in of
+// scenario/softdeca/sphere_template.hpp), N sampled parameter sets and expressions simulated on it
+// (scenario/softdeca/softdeca_datagen.hpp), resumable, a progress line per sample.
 #include <simsr/scenario/scenario.hpp>
+#include <simsr/scenario/softdeca/softdeca_datagen.hpp>
+#include <simsr/scenario/softdeca/sphere_template.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -28,7 +37,45 @@ struct DatagenArgs {
   bool unseen_forces = true;
   Index vtk_every = 10;
   Index unseen_frames = 40;
+  // softdeca
+  Index samples = 100, layers = 1, steps = 6, active_expressions = -1, sphere_level = 3;
+  std::string solver = "local_global", softdeca_template = "ict";
 };
+
+inline int datagen_softdeca(const DatagenArgs& a) {
+  scenario::SoftDecaDatagenOptions o;
+  o.samples = a.samples;
+  o.seed = a.seed;
+  o.simulation.steps = a.steps;
+  if (a.solver == "newton")
+    o.simulation.solver = scenario::SoftDecaSolver::newton;
+  else if (a.solver != "local_global")
+    throw ArgumentError("--solver: local_global or newton (got '" + a.solver + "')");
+  const auto say = [](const std::string& line) { std::fprintf(stderr, "softdeca: %s\n", line.c_str()); };
+  nlohmann::ordered_json j;
+  // the default mixes 3 expressions, or all of a template's when it has fewer (the sphere's 2)
+  const auto mix = [&](const scenario::SoftDecaTemplate& tpl) {
+    o.active_expressions = a.active_expressions >= 0 ? a.active_expressions : std::min<Index>(3, Index(tpl.expression_names.size()));
+  };
+  if (a.softdeca_template == "ict") {
+    scenario::SoftDecaTemplateOptions t;
+    t.head.layers = a.layers;
+    say("building the layered template from " + a.kit + " (" + std::to_string(a.layers) + " layer(s) per shell)");
+    const scenario::IctTemplate tpl = scenario::softdeca_template(exec::omp, scenario::read_ict_kit(a.kit), t);
+    mix(tpl);
+    j = scenario::generate_softdeca_dataset(exec::omp, tpl, "ict", o, a.out, say);
+  } else if (a.softdeca_template == "sphere") {
+    const scenario::SoftDecaTemplate tpl = scenario::sphere_softdeca_template(exec::omp, a.sphere_level, a.layers);
+    mix(tpl);
+    j = scenario::generate_softdeca_dataset(exec::omp, tpl, "sphere level " + std::to_string(a.sphere_level), o, a.out, say);
+  } else {
+    throw ArgumentError("--template: ict or sphere (got '" + a.softdeca_template + "')");
+  }
+  nlohmann::ordered_json brief = j;
+  brief.erase("per_sample");
+  std::cout << brief.dump() << '\n';
+  return 0;
+}
 
 /// The mesh options of a preset, then the explicit overrides.
 inline scenario::FaceModelOptions face_model_options(const DatagenArgs& a) {
@@ -40,7 +87,8 @@ inline scenario::FaceModelOptions face_model_options(const DatagenArgs& a) {
 }
 
 inline int datagen(const DatagenArgs& a) {
-  if (a.scenario != "face") throw ArgumentError("--scenario: only 'face' is built (got '" + a.scenario + "')");
+  if (a.scenario == "softdeca") return datagen_softdeca(a);
+  if (a.scenario != "face") throw ArgumentError("--scenario: face or softdeca (got '" + a.scenario + "')");
   scenario::FaceDatasetOptions o;
   o.kit = a.kit;
   o.model = face_model_options(a);
@@ -60,9 +108,20 @@ inline int datagen(const DatagenArgs& a) {
 }
 
 inline void add_datagen(CLI::App& app, std::function<int()>& action) {
-  auto* cmd = app.add_subcommand("datagen", "Simulate paired LR/HR data (the face of the core paper, §4)");
+  auto* cmd = app.add_subcommand("datagen", "Simulate paired LR/HR data (the face of the core paper, §4) or SoftDECA's sampled layered-head data");
   auto a = std::make_shared<DatagenArgs>();
-  cmd->add_option("--scenario", a->scenario, "what to simulate: face")->capture_default_str();
+  cmd->add_option("--scenario", a->scenario, "what to simulate: face (paired LR/HR frames) or softdeca (sampled parameters on the layered head)")
+      ->capture_default_str();
+  cmd->add_option("--samples", a->samples, "softdeca: parameter samples to simulate")->capture_default_str()->check(CLI::Range(1, 10000000));
+  cmd->add_option("--layers", a->layers, "softdeca: prism layers per shell of the template (its resolution)")->capture_default_str()->check(CLI::Range(1, 16));
+  cmd->add_option("--steps", a->steps, "softdeca: implicit steps from rest to the expression")->capture_default_str()->check(CLI::Range(1, 10000));
+  cmd->add_option("--solver", a->solver, "softdeca: local_global (projective dynamics) or newton")->capture_default_str();
+  cmd->add_option("--active-expressions", a->active_expressions, "softdeca: expressions mixed per sample (default 3, or all of a template with fewer)")
+      ->check(CLI::Range(0, 100000));
+  cmd->add_option("--template", a->softdeca_template, "softdeca: ict (the layered head from --kit) or sphere (the stand-in ball with two expressions)")
+      ->capture_default_str();
+  cmd->add_option("--sphere-level", a->sphere_level, "softdeca --template sphere: icosphere level of the ball (2: 162 skin vertices, 3: 642)")
+      ->capture_default_str()->check(CLI::Range(1, 6));
   cmd->add_option("--out", a->out, "output directory (rest shapes, one .npz per performance, face_data.json)")->required();
   cmd->add_option("--kit", a->kit, "the ICT face kit directory (full_neutral.obj, regions.json, expressions_full.npz)")->capture_default_str();
   cmd->add_option("--performances", a->performances, "built-in performances: amazement, anger, fear, pain (\"\": none, only --controls)")
@@ -70,7 +129,7 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
       ->capture_default_str();
   cmd->add_option("--controls", a->controls, "a controls file (.npz: names C strings, weights F×C), simulated as a performance named after the file (less a trailing _controls)");
   cmd->add_option("--frames", a->frames, "frames per built-in performance")->capture_default_str()->check(CLI::Range(14, 100000));
-  cmd->add_option("--seed", a->seed, "seed of the built-in performances")->capture_default_str();
+  cmd->add_option("--seed", a->seed, "seed of the built-in performances (softdeca: of the parameter sampler)")->capture_default_str();
   cmd->add_option("--preset", a->preset, "mesh sizes: default (LR 10.8k tets, 12.5x fewer than HR), paper-ratio (26x), paper-lr (LR 73k tets, the paper's)")->capture_default_str();
   cmd->add_option("--lr-cell", a->lr_cell, "LR BCC cell size in cm (overrides the preset)")->check(CLI::PositiveNumber);
   cmd->add_option("--skull-lattice", a->skull_lattice, "skull surface resolution in cm (overrides the preset)")->check(CLI::PositiveNumber);

@@ -21,6 +21,7 @@
 #include "cmd_infer.hpp"
 #include "cmd_knn.hpp"
 #include "cmd_neighbors.hpp"
+#include "cmd_surrogate.hpp"
 #include "cmd_train.hpp"
 #include "cmd_upsample.hpp"
 #include "commands.hpp"
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
   simsr::cli::add_train(app, action);
   simsr::cli::add_infer(app, action);
   simsr::cli::add_datagen(app, action);
+  simsr::cli::add_train_surrogate(app, action);
   simsr::cli::add_demo(app, action);
   simsr::cli::add_ablate(app, action);
   simsr::cli::add_animate(app, action);

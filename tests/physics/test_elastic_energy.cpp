@@ -1,5 +1,6 @@
 #include <simsr/mesh/generators.hpp>
 #include <simsr/physics/elastic_energy.hpp>
+#include <simsr/physics/materials/strain_limit.hpp>
 
 #include <doctest/doctest.h>
 
@@ -152,6 +153,73 @@ TEST_CASE("BlockHessian: blocks outside the pattern grow it, keep every value an
   CHECK(F(3, 4) == 0.0);
   CHECK(F(4, 5) == 0.0);
   CHECK(F(3, 5) == 5.0);
+}
+
+TEST_CASE("BlockHessian: an isotropic matrix (every block c·I) is A ⊗ I3 with A from assemble_isotropic, fixed vertices eliminated alike") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto mesh = box_tet_mesh<double>(2, 2, 1);
+  const Index n = mesh.num_vertices();
+  for (int trial = 0; trial < 20; ++trial) {
+    BlockHessian<> H(n, mesh.T);
+    H.set_zero();
+    for (Index v = 0; v < n; ++v) H.add(VIndex(v), VIndex(v), (3.0 + u(rng)) * Mat3<>::Identity());
+    for (Index t = 0; t < mesh.num_tets(); ++t) {
+      const double c = u(rng);
+      H.add(mesh.T(t, 0), mesh.T(t, 1), c * Mat3<>::Identity());
+      H.add(mesh.T(t, 1), mesh.T(t, 0), c * Mat3<>::Identity());
+    }
+    const double far = u(rng);  // a pair outside the tets' pattern: pending until merged
+    H.add(0, VIndex(n - 1), far * Mat3<>::Identity());
+    H.add(VIndex(n - 1), 0, far * Mat3<>::Identity());
+    REQUIRE(H.isotropic());
+    std::vector<char> fixed_vertices(std::size_t(n), 0), fixed(std::size_t(3 * n), 0);
+    for (Index v = 0; v < n; ++v)
+      if (rng() % 5 == 0) {
+        fixed_vertices[std::size_t(v)] = 1;
+        for (int c = 0; c < 3; ++c) fixed[std::size_t(3 * v + c)] = 1;
+      }
+    const Eigen::MatrixXd full = Eigen::MatrixXd(H.assemble(exec::seq, fixed));
+    const Eigen::MatrixXd A = Eigen::MatrixXd(H.assemble_isotropic(exec::omp, fixed_vertices));
+    Eigen::MatrixXd kron = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+    for (Index i = 0; i < n; ++i)
+      for (Index j = 0; j < n; ++j) kron.block<3, 3>(3 * i, 3 * j) = A(i, j) * Mat3<>::Identity();
+    CHECK(kron == full);
+    CHECK(A(0, n - 1) == (fixed_vertices[0] || fixed_vertices[std::size_t(n - 1)] ? 0.0 : far));
+  }
+  // one off-diagonal entry or one unequal diagonal entry in one block: not isotropic
+  for (int entry = 1; entry < 9; ++entry) {
+    BlockHessian<> H(n, mesh.T);
+    H.set_zero();
+    for (Index v = 0; v < n; ++v) H.add(VIndex(v), VIndex(v), Mat3<>::Identity());
+    Mat3<> b = Mat3<>::Zero();
+    b(entry % 3, entry / 3) = 1e-3;
+    H.add(mesh.T(0, 2), mesh.T(0, 3), b);
+    CHECK_FALSE(H.isotropic());
+    CHECK_THROWS_AS(H.assemble_isotropic(exec::seq, std::vector<char>(std::size_t(n), 0)), ArgumentError);
+  }
+  BlockHessian<> H(n, mesh.T);
+  H.set_zero();
+  CHECK_THROWS_AS(H.assemble_isotropic(exec::seq, std::vector<char>(std::size_t(n - 1), 0)), ShapeError);
+}
+
+TEST_CASE("ElasticEnergy::add_energy_gradient equals energy() and add_gradient() (fused StrainLimit and the fallback), seq == omp") {
+  const auto mesh = box_tet_mesh<double>(3, 2, 2);
+  for (unsigned seed = 0; seed < 10; ++seed) {
+    const Points<> x = perturbed(mesh.V, 0.25, 100 + seed);  // large enough to invert some tets
+    const auto check = [&](const auto& E) {
+      Points<> g0 = Points<>::Zero(mesh.num_vertices(), 3), g1 = g0, g2 = g0;
+      E.add_gradient(exec::seq, x, g0);
+      const double e1 = E.add_energy_gradient(exec::seq, x, g1);
+      const double e2 = E.add_energy_gradient(exec::omp, x, g2);
+      CHECK(e1 == doctest::Approx(E.energy(exec::seq, x)).epsilon(1e-13));
+      CHECK(e1 == e2);
+      CHECK((g1 - g0).cwiseAbs().maxCoeff() <= 1e-13 * (1 + g0.cwiseAbs().maxCoeff()));
+      CHECK(g1 == g2);
+    };
+    check(ElasticEnergy<StrainLimit<>>(mesh, StrainLimit<>(1.5, 0.7 + 0.06 * seed)));
+    check(ElasticEnergy<simsr_test::StVK>(mesh, {}));
+  }
 }
 
 TEST_CASE("ElasticEnergy: element data count is checked") {

@@ -39,6 +39,12 @@ namespace detail {
 template <class M>
 concept ChecksElements = requires(const M& m, const typename M::Element& e) { m.check(e); };
 /// Materials usable in the local–global solver offer the stiffness of their constant matrix.
+/// Materials that compute ψ and P together more cheaply than apart (one SVD instead of two)
+/// offer `energy_and_stress(F, element) -> std::pair<ψ, P>`.
+template <class M>
+concept HasEnergyAndStress = requires(const M& m, const Mat3<typename M::scalar_type>& F, const typename M::Element& e) {
+  { m.energy_and_stress(F, e) } -> std::convertible_to<std::pair<typename M::scalar_type, Mat3<typename M::scalar_type>>>;
+};
 template <class M>
 concept HasProjectiveStiffness = requires(const M& m) { { m.projective_stiffness() } -> std::convertible_to<typename M::scalar_type>; };
 }  // namespace detail
@@ -120,14 +126,37 @@ class ElasticEnergy {
     physics::detail::require_positions("ElasticEnergy::add_gradient: g", g, n_);
     forces_.resize(3, 4 * T_.rows());
     exec::parallel_for(policy, T_.rows(), [&](Index t) {
-      const Mat3<S> stress = material_.stress(deformation_gradient(x, t), elements_[std::size_t(t)]);
-      forces_.template middleCols<4>(4 * t).noalias() = rest_.volume[t] * stress * D_[std::size_t(t)].transpose();
+      element_forces(t, material_.stress(deformation_gradient(x, t), elements_[std::size_t(t)]));
     });
-    exec::parallel_for(policy, n_, [&](Index v) {
-      Vec3<S> sum = Vec3<S>::Zero();
-      for (Index k = vertex_offsets_[std::size_t(v)]; k < vertex_offsets_[std::size_t(v) + 1]; ++k) sum += forces_.col(vertex_entries_[std::size_t(k)]);
-      g.row(v) += sum.transpose();
-    });
+    gather_forces(policy, g);
+  }
+
+  /// E(x), and g += ∂E/∂x, in one pass over the tets (FusedEnergyGradient): each F is formed
+  /// once, and a material with energy_and_stress (StrainLimit) decomposes it once.
+  template <exec::HostPolicy P>
+  S add_energy_gradient(P policy, const Points<S>& x, Points<S>& g) const {
+    physics::detail::require_positions("ElasticEnergy::add_energy_gradient: x", x, n_);
+    physics::detail::require_positions("ElasticEnergy::add_energy_gradient: g", g, n_);
+    forces_.resize(3, 4 * T_.rows());
+    const S e = exec::parallel_reduce(
+        policy, T_.rows(), S(0),
+        [&](Index t) {
+          const Mat3<S> F = deformation_gradient(x, t);
+          const Element& el = elements_[std::size_t(t)];
+          S psi;
+          if constexpr (detail::HasEnergyAndStress<M>) {
+            const auto [energy, stress] = material_.energy_and_stress(F, el);
+            psi = energy;
+            element_forces(t, stress);
+          } else {
+            psi = material_.energy(F, el);
+            element_forces(t, material_.stress(F, el));
+          }
+          return rest_.volume[t] * psi;
+        },
+        [](S a, S b) { return a + b; });
+    gather_forces(policy, g);
+    return e;
   }
 
   /// Element stiffness of tet t (12×12, vertex-major), with the definiteness fix by default.
@@ -192,6 +221,21 @@ class ElasticEnergy {
   }
 
  private:
+  /// Tet t's nodal forces V_t P D_tᵀ into forces_.
+  void element_forces(Index t, const Mat3<S>& stress) const {
+    forces_.template middleCols<4>(4 * t).noalias() = rest_.volume[t] * stress * D_[std::size_t(t)].transpose();
+  }
+
+  /// g += every vertex's sum of its tets' forces, in a fixed order (deterministic, no atomics).
+  template <exec::HostPolicy P>
+  void gather_forces(P policy, Points<S>& g) const {
+    exec::parallel_for(policy, n_, [&](Index v) {
+      Vec3<S> sum = Vec3<S>::Zero();
+      for (Index k = vertex_offsets_[std::size_t(v)]; k < vertex_offsets_[std::size_t(v) + 1]; ++k) sum += forces_.col(vertex_entries_[std::size_t(k)]);
+      g.row(v) += sum.transpose();
+    });
+  }
+
   template <exec::HostPolicy P>
   void build_gather(P policy, const BlockHessian<S>& H) const {
     const Index nb = H.num_blocks();

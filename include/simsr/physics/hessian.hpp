@@ -156,6 +156,52 @@ class BlockHessian {
     return scalar_;
   }
 
+  /// Whether every block is a multiple of the identity, c·I (exactly: the terms of projective
+  /// dynamics add only such blocks). Then the matrix is A ⊗ I₃ with A the #V×#V matrix of the
+  /// c's, and a solver can factor A (a third of the unknowns, a ninth of the nonzeros) and
+  /// solve the three coordinates one by one. Pending blocks (outside the pattern) are merged
+  /// into it first.
+  bool isotropic() {
+    if (overflow_.size() > 0) grow();
+    for (std::size_t s = 0; s < cols_.size(); ++s) {
+      const S* b = values_.data() + 9 * s;
+      if (b[1] != S(0) || b[2] != S(0) || b[3] != S(0) || b[5] != S(0) || b[6] != S(0) || b[7] != S(0) || b[4] != b[0] || b[8] != b[0])
+        return false;
+    }
+    return true;
+  }
+
+  /// The #V×#V matrix A of an isotropic Hessian (A ⊗ I₃ is this matrix; isotropic() must hold,
+  /// ArgumentError otherwise): A_ij = block(i, j)(0, 0). Vertices with fixed_vertices[v] != 0 get
+  /// an identity row and column. The reference stays valid until the next call; its pattern is
+  /// the blocks' and is identified by isotropic_pattern_version().
+  template <exec::HostPolicy P>
+  const SparseMatrix<S>& assemble_isotropic(P policy, const std::vector<char>& fixed_vertices) {
+    if (!isotropic()) throw ArgumentError("BlockHessian::assemble_isotropic: a block is not a multiple of the identity");
+    if (fixed_vertices.size() != std::size_t(n_))
+      throw ShapeError("BlockHessian::assemble_isotropic: fixed-vertex mask", {n_}, {Index(fixed_vertices.size())});
+    if (isotropic_version_ != version_) {
+      isotropic_.resize(n_, n_);
+      isotropic_.resizeNonZeros(Index(cols_.size()));
+      std::copy(row_offsets_.begin(), row_offsets_.end(), isotropic_.outerIndexPtr());
+      std::copy(cols_.begin(), cols_.end(), isotropic_.innerIndexPtr());
+      isotropic_version_ = version_;
+      isotropic_pattern_version_ = next_version();
+    }
+    S* val = isotropic_.valuePtr();
+    exec::parallel_for(policy, n_, [&](Index v) {
+      const bool row_fixed = fixed_vertices[std::size_t(v)] != 0;
+      for (Index s = row_offsets_[std::size_t(v)]; s < row_offsets_[std::size_t(v) + 1]; ++s) {
+        const VIndex c = cols_[std::size_t(s)];
+        val[s] = (row_fixed || fixed_vertices[std::size_t(c)]) ? S(c == v ? 1 : 0) : values_[std::size_t(9 * s)];
+      }
+    });
+    return isotropic_;
+  }
+  /// Identifies the pattern of the last assemble_isotropic() (unique across all matrices, like
+  /// pattern_version()).
+  std::uint64_t isotropic_pattern_version() const { return isotropic_pattern_version_; }
+
  private:
   static std::uint64_t key(VIndex i, VIndex j) { return (std::uint64_t(std::uint32_t(i)) << 32) | std::uint32_t(j); }
 
@@ -222,6 +268,8 @@ class BlockHessian {
   BlockTriplets<S> overflow_;
   SparseMatrix<S> scalar_;
   std::uint64_t version_ = 0;
+  SparseMatrix<S> isotropic_;  // assemble_isotropic
+  std::uint64_t isotropic_version_ = 0, isotropic_pattern_version_ = 0;
 };
 
 }  // namespace simsr::physics

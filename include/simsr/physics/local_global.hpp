@@ -5,12 +5,15 @@
 ///
 ///   global matrix  L = Σ_k L_k, each term's constant matrix (add_global_matrix: w AᵀA of a
 ///                  projective term, a stated stand-in for the others), Dirichlet DOFs eliminated,
-///                  factored once per weight set (and per boundary vertex set);
+///                  factored once per weight set (and per boundary vertex set); where every
+///                  block is c·I (SoftDECA's terms) it is A ⊗ I₃ and only the #V×#V A is
+///                  factored, the coordinates solved one by one;
 ///   local step     every term's gradient at x, which for a projective term is L_k x − w Aᵀp
 ///                  with p the projections (strain band, sphere, curvature magnitude), computed per
 ///                  element in parallel under the policy;
 ///   global step    d = −L⁻¹ g, refined by L-BFGS over the last `history` steps (0: none);
-///   line search    backtracking on the total energy from the unit step.
+///   line search    backtracking on the total energy from the unit step (the unit step's
+///                  energy and gradient in one pass: FusedEnergyGradient).
 ///
 /// With history 0 and only projective terms this is Bouaziz et al.'s iteration x ← L⁻¹(Σ w Aᵀp)
 /// exactly: the unit step minimizes the quadratic that majorizes E at x, so it is always accepted.
@@ -88,6 +91,11 @@ struct LocalGlobalOptions {
   Index history = 5;
   double armijo = 1e-4;
   Index max_backtracks = 40;
+  /// When every block of the global matrix is c·I (all of SoftDECA's terms: tets, targets,
+  /// bending, inertia), factor the #V×#V matrix of the c's and solve x, y and z one after the
+  /// other: a third of the unknowns and a ninth of the nonzeros of the 3V×3V matrix, whose
+  /// ordering cannot see that the coordinates decouple. false: always the 3V×3V matrix.
+  bool isotropic_reduction = true;
   std::function<void(const LocalGlobalIteration&)> progress = {};
 };
 
@@ -119,6 +127,8 @@ class LocalGlobalSolver {
   /// The weights changed: the next solve factors the global matrix again.
   void invalidate() { factored_ = false; }
   bool factored() const { return factored_; }
+  /// Whether the last factorization was of the #V×#V matrix (LocalGlobalOptions::isotropic_reduction).
+  bool reduced() const { return reduced_; }
   Index factorizations() const { return factorizations_; }
 
   /// Builds and factors L from the terms (Dirichlet DOFs of `boundary` eliminated). solve() calls
@@ -130,8 +140,14 @@ class LocalGlobalSolver {
       detail::dirichlet_mask(n_, boundary, factor_fixed_);
       L_.set_zero();
       (terms.add_global_matrix(policy, L_), ...);
-      const SparseMatrix<S>& A = L_.assemble(policy, factor_fixed_);
-      linear_.compute(policy, A, L_.pattern_version());
+      reduced_ = options_.isotropic_reduction && L_.isotropic();
+      if (reduced_) {
+        fixed_vertices_.resize(std::size_t(n_));
+        for (Index v = 0; v < n_; ++v) fixed_vertices_[std::size_t(v)] = factor_fixed_[std::size_t(3 * v)];
+        linear_.compute(policy, L_.assemble_isotropic(policy, fixed_vertices_), L_.isotropic_pattern_version());
+      } else {
+        linear_.compute(policy, L_.assemble(policy, factor_fixed_), L_.pattern_version());
+      }
       factored_ = true;
       ++factorizations_;
     }
@@ -142,8 +158,8 @@ class LocalGlobalSolver {
   template <exec::HostPolicy P>
   void apply_inverse(P policy, const VecX<S>& q, VecX<S>& d) {
     if (!factored_) throw Error("LocalGlobalSolver::apply_inverse before the matrix was factored (factor() or solve())");
-    const LinearSolveInfo info = linear_.solve(policy, q, d);
-    if (!info.converged) throw ConvergenceError("local-global solver (global step: the linear solve did not converge)", info.iterations, info.relative_residual);
+    if (q.size() != 3 * n_) throw ShapeError("LocalGlobalSolver::apply_inverse: q", {3 * n_}, {q.size()});
+    global_solve(policy, q, d);
   }
 
   /// Minimizes Σ terms over x (#V×3, in/out: the warm start), boundary vertices set first.
@@ -172,9 +188,8 @@ class LocalGlobalSolver {
     }
     forget();
     detail::GradientTest test(options_.relative_tolerance, options_.absolute_tolerance, options_.reference_force);
-    double magnitude = 0;
-    double E = detail::total_energy(policy, x, magnitude, terms...);
-    double balance = detail::free_gradient(policy, x, fixed_, scratch_, g_, terms...);
+    double magnitude = 0, balance = 0;
+    double E = detail::energy_and_free_gradient(policy, x, fixed_, scratch_, g_, magnitude, balance, terms...);
     for (Index it = 0;; ++it) {
       if (!std::isfinite(E)) throw ConvergenceError("local-global solver (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
       const double gnorm = double(g_.norm());
@@ -198,13 +213,19 @@ class LocalGlobalSolver {
       if (!(slope < 0)) throw ConvergenceError("local-global solver (the global step is no descent direction: L is not positive definite)", it, gnorm);
 
       const double noise = 64 * std::numeric_limits<double>::epsilon() * magnitude;
-      double alpha = 1, Et = 0;
+      // The unit step, usually accepted, is evaluated with its gradient in one pass (one SVD
+      // per tet for the strain term, not one for the energy and another for the gradient);
+      // backtracking steps with the energy alone.
+      double alpha = 1, Et = 0, trial_balance = 0;
       Index backtracks = 0;
       for (;; ++backtracks) {
         trial_ = x;
         Eigen::Map<VecX<S>>(trial_.data(), 3 * n_) += S(alpha) * d_;
         double mag = 0;
-        Et = detail::total_energy(policy, trial_, mag, terms...);
+        if (backtracks == 0)
+          Et = detail::energy_and_free_gradient(policy, trial_, fixed_, scratch_, g_trial_, mag, trial_balance, terms...);
+        else
+          Et = detail::total_energy(policy, trial_, mag, terms...);
         if (std::isfinite(Et) && Et <= E + options_.armijo * alpha * slope + noise) {
           magnitude = mag;
           break;
@@ -214,8 +235,13 @@ class LocalGlobalSolver {
         alpha *= 0.5;
       }
       x.swap(trial_);
-      g_old_ = g_;
-      balance = detail::free_gradient(policy, x, fixed_, scratch_, g_, terms...);
+      g_old_.swap(g_);
+      if (backtracks == 0) {
+        g_.swap(g_trial_);
+        balance = trial_balance;
+      } else {
+        balance = detail::free_gradient(policy, x, fixed_, scratch_, g_, terms...);
+      }
       remember(alpha);
       LocalGlobalIteration record{it, E, gnorm, alpha, backtracks};
       report.history.push_back(record);
@@ -235,13 +261,32 @@ class LocalGlobalSolver {
       alphas_[std::size_t(k)] = rho_[i] * s_[i].dot(q_);
       q_ -= alphas_[std::size_t(k)] * y_[i];
     }
-    const LinearSolveInfo info = linear_.solve(policy, q_, d_);
-    if (!info.converged) throw ConvergenceError("local-global solver (global step: the linear solve did not converge)", info.iterations, info.relative_residual);
+    global_solve(policy, q_, d_);
     for (Index k = 0; k < stored_; ++k) {  // oldest first
       const std::size_t i = slot(k);
       d_ += (alphas_[std::size_t(k)] - rho_[i] * y_[i].dot(d_)) * s_[i];
     }
     d_ = -d_;
+  }
+
+  /// d = L⁻¹ q: one 3V solve, or three #V solves with the reduced matrix (one per coordinate).
+  template <class P>
+  void global_solve(P policy, const VecX<S>& q, VecX<S>& d) {
+    const auto check = [](const LinearSolveInfo& info) {
+      if (!info.converged)
+        throw ConvergenceError("local-global solver (global step: the linear solve did not converge)", info.iterations, info.relative_residual);
+    };
+    if (!reduced_) {
+      check(linear_.solve(policy, q, d));
+      return;
+    }
+    d.resize(3 * n_);
+    qc_.resize(n_);
+    for (int c = 0; c < 3; ++c) {
+      qc_ = Eigen::Map<const VecX<S>, 0, Eigen::InnerStride<3>>(q.data() + c, n_);
+      check(linear_.solve(policy, qc_, dc_));
+      Eigen::Map<VecX<S>, 0, Eigen::InnerStride<3>>(d.data() + c, n_) = dc_;
+    }
   }
 
   /// The k-th stored pair, oldest first.
@@ -279,11 +324,12 @@ class LocalGlobalSolver {
   LocalGlobalOptions options_;
   Linear linear_;
   BlockHessian<S> L_;
-  bool factored_ = false;
+  bool factored_ = false, reduced_ = false;
   Index factorizations_ = 0;
-  std::vector<char> fixed_, factor_fixed_;
+  std::vector<char> fixed_, factor_fixed_, fixed_vertices_;
+  VecX<S> qc_, dc_;  // one coordinate of the reduced solve
   Points<S> scratch_, trial_;
-  VecX<S> g_, g_old_, d_, q_;
+  VecX<S> g_, g_old_, g_trial_, d_, q_;
   std::vector<VecX<S>> s_, y_;  // the L-BFGS ring (forget, remember)
   std::vector<S> rho_, alphas_;
   Index stored_ = 0, first_ = 0;

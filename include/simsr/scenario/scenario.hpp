@@ -21,6 +21,8 @@
 #include "softdeca/ict_template.hpp"
 #include "softdeca/layered_head.hpp"
 #include "softdeca/parameters.hpp"
+#include "softdeca/softdeca_datagen.hpp"
 #include "softdeca/softdeca_simulator.hpp"
 #include "softdeca/sphere_template.hpp"
+#include "softdeca/surrogate.hpp"
 #include "softdeca/template.hpp"

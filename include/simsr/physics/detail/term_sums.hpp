@@ -2,11 +2,14 @@
 /// \file
 /// What every solver over a sum of EnergyTerms does the same way (the Newton solver and the
 /// local–global solver): set the Dirichlet vertices, sum the terms' energies, and sum their
-/// gradients over the free DOFs together with the size of the forces in balance.
+/// gradients over the free DOFs together with the size of the forces in balance (both in one
+/// pass where a term can: FusedEnergyGradient).
 
 #include <algorithm>
 #include <cmath>
+#include <concepts>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -77,6 +80,27 @@ double total_energy(P policy, const Points<S>& x, double& magnitude, const Terms
   return sum;
 }
 
+/// A term that computes its energy and adds its gradient in one pass (sharing the per-element
+/// work, e.g. one SVD per tet instead of two): `E = term.add_energy_gradient(policy, x, g)`.
+/// Optional: the sums below fall back to energy() and add_gradient().
+template <class T, class S, class P>
+concept FusedEnergyGradient = requires(const T& t, P p, const Points<S>& x, Points<S>& g) {
+  { t.add_energy_gradient(p, x, g) } -> std::convertible_to<S>;
+};
+
+/// g += scratch over the free DOFs; returns ‖scratch‖ over them.
+template <class S>
+double add_free(const Points<S>& scratch, const std::vector<char>& fixed, VecX<S>& g) {
+  const Eigen::Map<const VecX<S>> tg(scratch.data(), g.size());
+  double sq = 0;
+  for (Index k = 0; k < g.size(); ++k)
+    if (!fixed[std::size_t(k)]) {
+      g[k] += tg[k];
+      sq += double(tg[k]) * double(tg[k]);
+    }
+  return std::sqrt(sq);
+}
+
 /// g = ∂E/∂x over the free DOFs (fixed ones 0), a 3V vector, vertex-major; returns Σ_k ‖∂E_k/∂x‖
 /// over the free DOFs, the scale of the forces in balance. `scratch` is a #V×3 buffer.
 template <class S, class P, class... Terms>
@@ -88,17 +112,37 @@ double free_gradient(P policy, const Points<S>& x, const std::vector<char>& fixe
   const auto one = [&](const auto& term) {
     scratch.setZero(n, 3);
     term.add_gradient(policy, x, scratch);
-    const Eigen::Map<const VecX<S>> tg(scratch.data(), 3 * n);
-    double sq = 0;
-    for (Index k = 0; k < 3 * n; ++k)
-      if (!fixed[std::size_t(k)]) {
-        g[k] += tg[k];
-        sq += double(tg[k]) * double(tg[k]);
-      }
-    balance += std::sqrt(sq);
+    balance += add_free(scratch, fixed, g);
   };
   (one(terms), ...);
   return balance;
+}
+
+/// total_energy and free_gradient at one x in one pass over each term that offers
+/// FusedEnergyGradient: returns Σ E_k; `magnitude` and `balance` as there.
+template <class S, class P, class... Terms>
+double energy_and_free_gradient(P policy, const Points<S>& x, const std::vector<char>& fixed, Points<S>& scratch, VecX<S>& g,
+                                double& magnitude, double& balance, const Terms&... terms) {
+  const Index n = x.rows();
+  g.setZero(3 * n);
+  double sum = 0, mag = 0, bal = 0;
+  const auto one = [&](const auto& term) {
+    scratch.setZero(n, 3);
+    double e = 0;
+    if constexpr (FusedEnergyGradient<std::remove_cvref_t<decltype(term)>, S, P>) {
+      e = double(term.add_energy_gradient(policy, x, scratch));
+    } else {
+      e = double(term.energy(policy, x));
+      term.add_gradient(policy, x, scratch);
+    }
+    sum += e;
+    mag += std::abs(e);
+    bal += add_free(scratch, fixed, g);
+  };
+  (one(terms), ...);
+  magnitude = mag;
+  balance = bal;
+  return sum;
 }
 
 }  // namespace simsr::physics::detail

@@ -74,6 +74,18 @@ class StrainLimit {
   /// P = 2w (F − project(F)).
   Mat3<S> stress(const Mat3<S>& F, const Element& = {}) const { return S(2) * w_ * (F - project(F)); }
 
+  /// ψ and P from one decomposition (ElasticEnergy's fused energy and gradient).
+  std::pair<S, Mat3<S>> energy_and_stress(const Mat3<S>& F, const Element& = {}) const {
+    const SignedSvd<S> svd = signed_svd(F);
+    Vec3<S> c;
+    S e = 0;
+    for (int i = 0; i < 3; ++i) {
+      c(i) = clamp(svd.sigma(i));
+      e += (svd.sigma(i) - c(i)) * (svd.sigma(i) - c(i));
+    }
+    return {w_ * e, S(2) * w_ * (F - svd.U * c.asDiagonal() * svd.V.transpose())};
+  }
+
   Mat9<S> stress_derivative(const Mat3<S>& F, const Element&, Definiteness definiteness) const {
     const SignedSvd<S> svd = signed_svd(F);
     return isotropic_stress_derivative(svd, principal(svd.sigma), definiteness);

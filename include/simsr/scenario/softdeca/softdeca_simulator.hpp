@@ -29,6 +29,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -218,6 +219,30 @@ class SoftDecaSimulator {
     distances_.add_gradient(policy, x, g);
     gravity_.add_gradient(policy, x, g);
     inertia_.add_gradient(policy, x, g);
+  }
+  /// Σ terms' energies at x (J): what a line-search trial evaluates.
+  template <exec::HostPolicy P>
+  double energy(P policy, const Points<>& x) const {
+    double magnitude = 0;
+    return physics::detail::total_energy(policy, x, magnitude, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_,
+                                         inertia_);
+  }
+  /// Σ terms' energies at x, and their gradients into g (#V×3), in one pass over each term that
+  /// can (physics::detail::FusedEnergyGradient): what the local-global solver evaluates at a unit step.
+  template <exec::HostPolicy P>
+  double energy_and_gradient(P policy, const Points<>& x, Points<>& g) const {
+    g.setZero(x.rows(), 3);
+    double e = 0;
+    const auto one = [&](const auto& term) {
+      if constexpr (physics::detail::FusedEnergyGradient<std::remove_cvref_t<decltype(term)>, double, P>) {
+        e += double(term.add_energy_gradient(policy, x, g));
+      } else {
+        e += double(term.energy(policy, x));
+        term.add_gradient(policy, x, g);
+      }
+    };
+    one(strain_soft_), one(strain_muscle_), one(volume_), one(bending_), one(targets_), one(distances_), one(gravity_), one(inertia_);
+    return e;
   }
   /// Factors the step solver's matrix for the current weights (what step() does once per sample).
   template <exec::HostPolicy P>

@@ -1,0 +1,301 @@
+#pragma once
+/// \file
+/// SoftDECA's training data (softdeca supplement §1): N samples of simulation parameters and
+/// expressions, each simulated on a layered template (softdeca_simulator.hpp: the ICT head of
+/// ict_template.hpp, or any SoftDecaTemplate such as sphere_template.hpp's), written as
+///
+///     DIR/template_skin.obj           the template's skin at rest (m)
+///     DIR/template_soft_tissue.msh    the soft-tissue tets, DIR/template_muscle.msh the muscle tets
+///     DIR/samples/sample_NNNNNN.npz   one sample: parameters (20, parameters.hpp), expression (E),
+///                                     skin and skin_at_rest (#skin×3), iterations, seconds
+///     DIR/softdeca_samples.npz        all of them: parameters N×20, parameter_names, expressions
+///                                     N×E, expression_names, skin and skin_at_rest N×#skin×3,
+///                                     rest_skin #skin×3 (the template's), seconds N (each
+///                                     sample's simulation), fingerprint
+///     DIR/softdeca_data.json          template sizes, options, per-sample iterations and seconds
+///
+/// read_softdeca_dataset() reads softdeca_samples.npz back (the surrogate's input, surrogate.hpp).
+///
+/// Sample i's parameters and expression depend on (seed, i) alone, and each sample file is written
+/// atomically when its simulation ends, so a killed run resumes at the first missing sample and
+/// produces what an uninterrupted run would. A sample file from another run (other template,
+/// options, stiffness or seed: its fingerprint differs) is an Error naming it, never mixed in.
+///
+/// Expressions: `active_expressions` of the kit's expressions, chosen at random, each with a
+/// weight uniform in [0, 1] (sparse mixtures, as faces activate few muscles at once).
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "../../core/error.hpp"
+#include "../../core/fingerprint.hpp"
+#include "../../core/parallel.hpp"
+#include "../../io/atomic_file.hpp"
+#include "../../io/mesh_io.hpp"
+#include "../../io/npz.hpp"
+#include "ict_template.hpp"
+#include "parameters.hpp"
+#include "softdeca_simulator.hpp"
+#include "template.hpp"
+
+namespace simsr::scenario {
+
+/// What a SoftDECA datagen run is asked for.
+struct SoftDecaDatagenOptions {
+  Index samples = 100;
+  std::uint64_t seed = 1;
+  Index active_expressions = 3;
+  SoftDecaSimulationOptions simulation;
+  SoftDecaStiffness stiffness;
+  SoftDecaRanges ranges;
+};
+
+/// Expression weights of sample `index` (see the file comment): E weights, `active` of them in (0, 1].
+inline VecX<> sample_expression_weights(std::uint64_t seed, std::uint64_t index, Index E, Index active) {
+  if (E < 1 || active < 0 || active > E)
+    throw ArgumentError("sample_expression_weights: need 0 <= active <= E and E >= 1 (got " + std::to_string(active) + " of " + std::to_string(E) + ")");
+  std::seed_seq seq{std::uint32_t(seed), std::uint32_t(seed >> 32), std::uint32_t(index), std::uint32_t(index >> 32), std::uint32_t(0xe4e55105)};
+  std::mt19937_64 rng(seq);
+  std::vector<Index> order(static_cast<std::size_t>(E));
+  for (Index e = 0; e < E; ++e) order[std::size_t(e)] = e;
+  std::shuffle(order.begin(), order.end(), rng);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  VecX<> w = VecX<>::Zero(E);
+  for (Index k = 0; k < active; ++k) w[order[std::size_t(k)]] = 1.0 - u(rng);  // (0, 1]
+  return w;
+}
+
+/// A template's sizes as reported in softdeca_data.json (the supplement's Table 1 counts and ours).
+inline nlohmann::ordered_json softdeca_template_sizes(const SoftDecaTemplate& tpl) {
+  const LayeredHead& h = tpl.head;
+  return {{"wrap_vertices", h.wrap_vertices},
+          {"wrap_triangles", h.outer_triangles.rows()},
+          {"skin_vertices", tpl.skin.size()},
+          {"skin_triangles", tpl.skin_triangles.rows()},
+          {"layers_per_shell", h.layers},
+          {"vertices", h.mesh.num_vertices()},
+          {"tets", h.mesh.num_tets()},
+          {"soft_tissue_tets", h.count(TissueLayer::soft_tissue)},
+          {"muscle_tets", h.count(TissueLayer::muscle)},
+          {"cranium_vertices", h.count(Bone::cranium)},
+          {"jaw_vertices", h.count(Bone::jaw)},
+          {"neck_vertices", h.count(Bone::neck)},
+          {"thinned_vertices", h.repaired_vertices},
+          {"pinched_vertices", h.collapsed_vertices},
+          {"expressions", tpl.expression_names.size()}};
+}
+
+namespace detail {
+inline std::string sample_file_name(Index i) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "sample_%06lld.npz", static_cast<long long>(i));
+  return buf;
+}
+}  // namespace detail
+
+/// Runs (or resumes) a SoftDECA datagen on `tpl` into `dir` (see the file comment); `name`
+/// names the template in the JSON summary, `say` gets one progress line per sample. Returns the
+/// JSON summary it also writes.
+template <exec::HostPolicy P>
+nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplate& tpl, const std::string& name, const SoftDecaDatagenOptions& o,
+                                                 const std::filesystem::path& dir, const std::function<void(const std::string&)>& say = {}) {
+  namespace fs = std::filesystem;
+  if (o.samples < 1) throw ArgumentError("softdeca datagen: samples must be >= 1, got " + std::to_string(o.samples));
+  const Index E = Index(tpl.expression_names.size());
+  if (tpl.expression_deltas.rows() != E || tpl.expression_deltas.cols() != 3 * tpl.skin.size())
+    throw ShapeError("softdeca datagen: the template's expression displacements", {E, 3 * tpl.skin.size()},
+                     {tpl.expression_deltas.rows(), tpl.expression_deltas.cols()});
+  if (o.active_expressions < 0 || o.active_expressions > E)
+    throw ArgumentError("softdeca datagen: active expressions must be in [0, " + std::to_string(E) + "] (the template's), got " +
+                        std::to_string(o.active_expressions));
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto tell = [&](const std::string& s) {
+    if (say) say(s);
+  };
+  fs::create_directories(dir / "samples");
+  const LayeredHead& h = tpl.head;
+  const Index M = tpl.skin.size();
+  const nlohmann::ordered_json sizes = softdeca_template_sizes(tpl);
+  tell("template " + name + ": " + sizes.dump());
+
+  // the template's files
+  {
+    std::vector<VIndex> local(std::size_t(h.mesh.num_vertices()), -1);
+    io::MeshData<double> skin;
+    skin.V.resize(M, 3);
+    for (Index k = 0; k < M; ++k) {
+      local[std::size_t(tpl.skin[k])] = VIndex(k);
+      skin.V.row(k) = h.mesh.V.row(tpl.skin[k]);
+    }
+    skin.F.resize(tpl.skin_triangles.rows(), 3);
+    for (Index f = 0; f < skin.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) skin.F(f, c) = local[std::size_t(tpl.skin_triangles(f, c))];
+    io::write_mesh(dir / "template_skin.obj", skin);
+    for (const auto& [name, layer] : {std::pair{"template_soft_tissue.msh", TissueLayer::soft_tissue}, std::pair{"template_muscle.msh", TissueLayer::muscle}}) {
+      const TetMesh<> m = h.layer_mesh(layer);
+      io::MeshData<double> d;
+      d.V = m.V;
+      d.T = m.T;
+      io::write_mesh(dir / name, d);
+    }
+  }
+
+  // what makes a sample file this run's
+  Fingerprint fp;
+  fp.add(h.mesh.V).add(h.mesh.T).add(tpl.expression_deltas).add(o.seed).add(o.active_expressions).add(o.simulation.steps).add(o.simulation.time_step)
+      .add(o.simulation.relative_tolerance).add(int(o.simulation.solver)).add(o.simulation.history);
+  const nlohmann::ordered_json stiffness = o.stiffness.to_json();  // kept: a range-for over a temporary's items() dangles
+  for (const auto& [k, v] : stiffness.items()) fp.add(double(v));
+  for (double r : {o.ranges.weight_min, o.ranges.weight_max, o.ranges.volume_min, o.ranges.volume_max, o.ranges.strain_min, o.ranges.strain_max,
+                   o.ranges.gravity_min, o.ranges.gravity_max, o.ranges.scale_min, o.ranges.scale_max, o.ranges.dynamics_min, o.ranges.dynamics_max})
+    fp.add(r);
+  const std::string print = fp.hex();
+
+  SoftDecaSimulator sim(tpl, o.stiffness);
+  Eigen::MatrixXd params(o.samples, SoftDecaParameters::size), expressions(o.samples, E);
+  std::vector<Points<>> skins(static_cast<std::size_t>(o.samples)), rests(static_cast<std::size_t>(o.samples));
+  nlohmann::ordered_json per_sample = nlohmann::ordered_json::array();
+  VecX<> seconds(o.samples);
+  Index simulated = 0, resumed = 0;
+  double sim_seconds = 0;
+  for (Index i = 0; i < o.samples; ++i) {
+    const fs::path file = dir / "samples" / detail::sample_file_name(i);
+    const SoftDecaParameters p = sample_softdeca_parameters(o.seed, std::uint64_t(i), o.ranges);
+    const VecX<> w = sample_expression_weights(o.seed, std::uint64_t(i), E, o.active_expressions);
+    params.row(i) = p.to_vector().transpose();
+    expressions.row(i) = w.transpose();
+    if (fs::exists(file)) {
+      const io::NpzArrays z = io::read_npz(file);
+      if (!z.contains("fingerprint") || z.at("fingerprint").to_strings() != std::vector<std::string>{print})
+        throw Error("softdeca datagen: " + file.string() + " is from another run (its template, options or seed differ): move it away or use another --out");
+      skins[std::size_t(i)] = z.at("skin").to_points();
+      rests[std::size_t(i)] = z.at("skin_at_rest").to_points();
+      if (skins[std::size_t(i)].rows() != M || rests[std::size_t(i)].rows() != M)
+        throw Error("softdeca datagen: " + file.string() + ": skin has " + std::to_string(skins[std::size_t(i)].rows()) + " vertices, the template " + std::to_string(M));
+      seconds[i] = z.at("seconds").item<double>();
+      per_sample.push_back({{"sample", i}, {"resumed", true}, {"seconds", seconds[i]}});
+      ++resumed;
+      continue;
+    }
+    SoftDecaResult r;
+    try {
+      r = sim.simulate(policy, p, w, o.simulation);
+    } catch (const Error& e) {
+      throw Error("softdeca datagen: sample " + std::to_string(i) + " (" + p.to_json().dump() + "): " + e.what());
+    }
+    skins[std::size_t(i)] = r.skin;
+    seconds[i] = r.seconds;
+    rests[std::size_t(i)] = r.skin_at_rest;
+    io::NpzArrays z;
+    z["parameters"] = io::make_npy(p.to_vector());
+    z["expression"] = io::make_npy(w);
+    z["skin"] = io::make_npy(r.skin);
+    z["skin_at_rest"] = io::make_npy(r.skin_at_rest);
+    std::vector<std::int64_t> its(r.iterations.begin(), r.iterations.end());
+    z["iterations"] = io::make_npy<std::int64_t>({std::int64_t(its.size())}, its.data());
+    z["seconds"] = io::make_npy<double>({}, &r.seconds);
+    z["inverted_tets"] = io::make_npy<std::int64_t>({}, &r.inverted_tets);
+    z["fingerprint"] = io::make_npy(std::vector<std::string>{print});
+    io::write_npz(file, z);
+    ++simulated;
+    sim_seconds += r.seconds;
+    per_sample.push_back({{"sample", i}, {"iterations", r.iterations}, {"seconds", r.seconds}, {"inverted_tets", r.inverted_tets}});
+    const double mean = sim_seconds / double(simulated);
+    char line[256];
+    std::snprintf(line, sizeof line, "sample %lld/%lld: %lld iterations, %.1f s (%.1f s/sample, ETA %.0f s)", static_cast<long long>(i + 1),
+                  static_cast<long long>(o.samples), static_cast<long long>(r.total_iterations()), r.seconds, mean, mean * double(o.samples - i - 1));
+    tell(line);
+  }
+
+  io::NpzArrays all;
+  all["parameters"] = io::make_npy(params);
+  all["parameter_names"] = io::make_npy(SoftDecaParameters::names());
+  all["expressions"] = io::make_npy(expressions);
+  all["expression_names"] = io::make_npy(tpl.expression_names);
+  all["skin"] = io::make_npy_frames(skins);
+  all["skin_at_rest"] = io::make_npy_frames(rests);
+  Points<> rest_skin(M, 3);
+  for (Index k = 0; k < M; ++k) rest_skin.row(k) = h.mesh.V.row(tpl.skin[k]);
+  all["rest_skin"] = io::make_npy(rest_skin);
+  all["seconds"] = io::make_npy(seconds);
+  all["fingerprint"] = io::make_npy(std::vector<std::string>{print});
+  io::write_npz(dir / "softdeca_samples.npz", all);
+
+  nlohmann::ordered_json j;
+  j["scenario"] = "softdeca";
+  j["template_name"] = name;
+  j["template"] = sizes;
+  j["samples"] = o.samples;
+  j["simulated"] = simulated;
+  j["resumed"] = resumed;
+  j["seed"] = o.seed;
+  j["solver"] = o.simulation.solver == SoftDecaSolver::newton ? "newton" : "local_global";
+  j["steps"] = o.simulation.steps;
+  j["time_step"] = o.simulation.time_step;
+  j["stiffness"] = o.stiffness.to_json();
+  j["seconds_simulating"] = sim_seconds;
+  j["seconds_total"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  j["fingerprint"] = print;
+  j["per_sample"] = per_sample;
+  io::write_file_atomic(dir / "softdeca_data.json", j.dump(2) + "\n");
+  return j;
+}
+
+/// softdeca_samples.npz read back.
+struct SoftDecaDataset {
+  Eigen::MatrixXd parameters;   ///< N × 20 (SoftDecaParameters::to_vector)
+  std::vector<std::string> parameter_names;
+  Eigen::MatrixXd expressions;  ///< N × E weights
+  std::vector<std::string> expression_names;
+  Eigen::MatrixXd displacements;  ///< N × 3·#skin: skin at the last step − the template's rest skin (m), vertex-major
+  Points<> rest_skin;             ///< #skin × 3 (m)
+  VecX<> seconds;                 ///< N: each sample's simulation time (s)
+  std::string fingerprint;
+  Index size() const { return parameters.rows(); }
+  Index skin_vertices() const { return rest_skin.rows(); }
+};
+
+/// Reads DIR/softdeca_samples.npz (or the .npz given). Error naming the file and the array for a
+/// missing array or inconsistent shapes.
+inline SoftDecaDataset read_softdeca_dataset(const std::filesystem::path& path) {
+  const std::filesystem::path file = std::filesystem::is_directory(path) ? path / "softdeca_samples.npz" : path;
+  const io::NpzArrays z = io::read_npz(file);
+  const auto need = [&](const char* name) -> const io::NpyArray& {
+    if (!z.contains(name)) throw Error("softdeca dataset " + file.string() + ": no array '" + name + "' (not a simsr datagen --scenario softdeca output?)");
+    return z.at(name);
+  };
+  SoftDecaDataset d;
+  d.parameters = need("parameters").to_matrix<double>();
+  d.parameter_names = need("parameter_names").to_strings();
+  d.expressions = need("expressions").to_matrix<double>();
+  d.expression_names = need("expression_names").to_strings();
+  d.rest_skin = need("rest_skin").to_points();
+  d.seconds = need("seconds").to_matrix<double>().reshaped();
+  d.fingerprint = need("fingerprint").to_strings().at(0);
+  const io::NpyArray& skin = need("skin");
+  const Index N = d.parameters.rows(), M = d.rest_skin.rows();
+  const auto bad = [&](const std::string& what) { throw Error("softdeca dataset " + file.string() + ": " + what); };
+  if (d.parameters.cols() != SoftDecaParameters::size || Index(d.parameter_names.size()) != SoftDecaParameters::size)
+    bad("parameters must be N x " + std::to_string(SoftDecaParameters::size));
+  if (d.expressions.rows() != N || d.expressions.cols() != Index(d.expression_names.size())) bad("expressions must be N x E (E names)");
+  if (d.seconds.size() != N) bad("seconds must have N entries");
+  if (skin.ndim() != 3 || skin.num_frames() != N || skin.shape[1] != M || skin.shape[2] != 3) bad("skin must be N x #skin x 3");
+  if (!d.parameters.allFinite() || !d.expressions.allFinite()) bad("non-finite parameters or expressions");
+  d.displacements.resize(N, 3 * M);
+  for (Index i = 0; i < N; ++i) {
+    const Points<> s = skin.frame_points(i);
+    if (!s.allFinite()) bad("sample " + std::to_string(i) + "'s skin is not finite");
+    d.displacements.row(i) = Eigen::Map<const VecX<>>(Points<>(s - d.rest_skin).data(), 3 * M).transpose();
+  }
+  return d;
+}
+
+}  // namespace simsr::scenario

@@ -1,0 +1,365 @@
+#pragma once
+/// \file
+/// SoftDECA's learned surrogate (softdeca supplement §4, Fig. 1: fully connected layers only): a
+/// network of the library's own layers (nn::Mlp of nn::Linear + LeakyReLU) from a sample's
+/// expression weights and simulation parameters to the skin's displacement from the template's
+/// rest skin, standing in for the layered-head simulation (softdeca_simulator.hpp).
+///
+///   input   [expression weights (E), parameters (20: SoftDecaParameters::to_vector, weights as
+///           log10)], each feature standardized by the training set's mean and deviation
+///   hidden  FC widths (default 256, 256, 256), LeakyReLU(0.01) after each
+///   output  FC to 3·#skin, the displacement standardized by the training mean displacement and
+///           one global scale (so the loss weighs every vertex and axis alike, in metres)
+///
+/// Why these dimensions: the supplement's figure gives only the kind of layer; the inputs are few
+/// (E + 20) and smooth in their effect, while the output is a whole skin, so a few hundred hidden
+/// units carry the nonlinearity (the skull scaling's and gravity's interplay with the weights)
+/// and the last layer acts as a learned displacement basis of 256 modes. Wider layers overfit the
+/// few hundred samples a CPU can simulate (`simsr train-surrogate --hidden` tries others).
+///
+/// Training: Adam (lr cosine-decayed to 1 % over the epochs), mean squared error of the
+/// standardized displacement, mini-batches in a seeded order; the last `held_out` fraction of
+/// the samples (by index, so a grown dataset keeps its held-out set) never enters training, and
+/// the last `validation` fraction of the rest picks the epoch whose weights are kept (early
+/// stopping: with few samples and 20 inputs, most of them weak, the network fits the training
+/// samples long before it stops improving on others). The report compares the held-out error
+/// with two baselines fitted on all training samples: the mean displacement and ridge
+/// regression (a linear map of the same standardized inputs).
+///
+///     auto data = scenario::read_softdeca_dataset("out/softdeca");
+///     scenario::SoftDecaSurrogate net(data.expressions.cols(), data.skin_vertices(), {256, 256, 256}, 1);
+///     auto report = scenario::train_softdeca_surrogate(exec::omp, data, {}, net);
+///     Eigen::MatrixXd d = net.predict(exec::omp, data.parameters, data.expressions);   // N × 3·#skin (m)
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "../../core/error.hpp"
+#include "../../core/parallel.hpp"
+#include "../../core/types.hpp"
+#include "../../io/npz.hpp"
+#include "../../nn/adam.hpp"
+#include "../../nn/losses.hpp"
+#include "../../nn/mlp.hpp"
+#include "../../nn/model_file.hpp"
+#include "../../nn/parameters.hpp"
+#include "parameters.hpp"
+#include "softdeca_datagen.hpp"
+
+namespace simsr::scenario {
+
+/// How the surrogate is trained.
+struct SoftDecaSurrogateOptions {
+  Index epochs = 300;
+  Index batch = 16;
+  double lr = 1e-3;           ///< Adam's, cosine-decayed to lr_final_fraction · lr
+  double lr_final_fraction = 0.01;
+  double held_out = 0.2;      ///< the last fraction of the samples, never trained on
+  /// The last fraction of the training samples that picks the epoch: the weights kept are those
+  /// of the epoch with the least validation loss (early stopping; 0: the last epoch's).
+  double validation = 0.15;
+  double weight_decay = 0;    ///< Adam's L2 weight decay
+  double ridge_lambda = 1e-3; ///< the ridge baseline's regularization (on standardized inputs)
+  std::uint64_t seed = 1;     ///< batch order
+  std::function<void(Index epoch, double train_loss)> progress = {};
+};
+
+/// The network and its input/output standardization (see the file comment).
+class SoftDecaSurrogate {
+ public:
+  /// E expressions, M skin vertices, hidden widths (≥ 1 layer), initialization seed.
+  SoftDecaSurrogate(Index expressions, Index skin_vertices, std::vector<Index> hidden, std::uint64_t seed)
+      : E_(expressions), M_(skin_vertices), hidden_(std::move(hidden)) {
+    if (E_ < 0 || M_ < 1) throw ArgumentError("SoftDecaSurrogate: need >= 0 expressions and >= 1 skin vertex");
+    if (hidden_.empty()) throw ArgumentError("SoftDecaSurrogate: needs at least one hidden layer");
+    for (Index h : hidden_)
+      if (h < 1 || h > 65536) throw ArgumentError("SoftDecaSurrogate: hidden widths must be in [1, 65536], got " + std::to_string(h));
+    std::vector<nn::MlpStage> stages;
+    Index in = inputs();
+    for (std::size_t i = 0; i < hidden_.size(); ++i) {
+      stages.push_back(nn::MlpStage::linear(in, hidden_[i], "fc" + std::to_string(i)).dims(0).then(nn::Act::leaky_relu, 0.01));
+      in = hidden_[i];
+    }
+    stages.push_back(nn::MlpStage::linear(in, 3 * M_, "fc" + std::to_string(hidden_.size())).dims(0));
+    nn::Rng rng(seed);
+    mlp_ = std::make_unique<nn::Mlp<float>>(*store_, "surrogate", stages, rng);
+    in_mean_ = VecX<>::Zero(inputs());
+    in_scale_ = VecX<>::Ones(inputs());
+    out_mean_ = VecX<>::Zero(3 * M_);
+  }
+
+  Index expressions() const { return E_; }
+  Index skin_vertices() const { return M_; }
+  Index inputs() const { return E_ + SoftDecaParameters::size; }
+  const std::vector<Index>& hidden() const { return hidden_; }
+  nn::ParameterStore<float>& store() { return *store_; }
+  nn::Mlp<float>& mlp() { return *mlp_; }
+
+  /// Fits the standardization to training inputs (N × inputs) and displacements (N × 3M).
+  void fit_normalization(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements) {
+    check_inputs("fit_normalization", inputs_);
+    if (displacements.rows() != inputs_.rows() || displacements.cols() != 3 * M_)
+      throw ShapeError("SoftDecaSurrogate::fit_normalization: displacements", {inputs_.rows(), 3 * M_}, {displacements.rows(), displacements.cols()});
+    in_mean_ = inputs_.colwise().mean().transpose();
+    const VecX<> sd = ((inputs_.rowwise() - in_mean_.transpose()).array().square().colwise().mean()).sqrt().transpose();
+    in_scale_ = sd.unaryExpr([](double s) { return s > 1e-12 ? s : 1.0; });  // a constant feature stays as it is
+    out_mean_ = displacements.colwise().mean().transpose();
+    const double spread = std::sqrt((displacements.rowwise() - out_mean_.transpose()).array().square().mean());
+    out_scale_ = spread > 0 ? spread : 1.0;
+  }
+
+  /// [expression weights, parameters] per row (N × inputs()).
+  Eigen::MatrixXd join(const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions) const {
+    if (parameters.cols() != SoftDecaParameters::size || expressions.cols() != E_ || parameters.rows() != expressions.rows())
+      throw ShapeError("SoftDecaSurrogate: parameters (N x 20) and expressions (N x E)", {parameters.rows(), SoftDecaParameters::size + E_},
+                       {expressions.rows(), parameters.cols() + expressions.cols()});
+    Eigen::MatrixXd x(parameters.rows(), inputs());
+    x << expressions, parameters;
+    return x;
+  }
+
+  /// Standardized network input of raw inputs (N × inputs()), as float.
+  nn::Matrix<float> standardize(const Eigen::MatrixXd& inputs_) const {
+    check_inputs("standardize", inputs_);
+    return ((inputs_.rowwise() - in_mean_.transpose()).array().rowwise() / in_scale_.transpose().array()).matrix().cast<float>();
+  }
+  /// Standardized displacements (the training target).
+  nn::Matrix<float> standardize_output(const Eigen::MatrixXd& displacements) const {
+    return ((displacements.rowwise() - out_mean_.transpose()) / out_scale_).cast<float>();
+  }
+
+  /// Skin displacements (N × 3M, m, vertex-major) at the given parameters and expressions.
+  template <exec::HostPolicy P>
+  Eigen::MatrixXd predict(P policy, const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions) {
+    const nn::Matrix<float> in = standardize(join(parameters, expressions));
+    mlp_->forward(policy, nn::Mode::eval, in, out_);
+    return (out_.cast<double>() * out_scale_).rowwise() + out_mean_.transpose();
+  }
+
+  /// Writes the model (state tensors, standardization, dimensions, `meta`) atomically.
+  void save(const std::filesystem::path& path, const nlohmann::ordered_json& meta = {}) const {
+    io::NpzArrays z;
+    nn::add_state(z, *store_);
+    z["in_mean"] = io::make_npy(in_mean_);
+    z["in_scale"] = io::make_npy(in_scale_);
+    z["out_mean"] = io::make_npy(out_mean_);
+    z["out_scale"] = io::make_npy<double>({}, &out_scale_);
+    nlohmann::ordered_json j = {{"kind", "simsr softdeca surrogate"}, {"expressions", E_}, {"skin_vertices", M_}, {"hidden", hidden_}};
+    j["meta"] = meta;
+    z["config"] = io::make_npy(std::vector<std::string>{j.dump()});
+    io::write_npz(path, z);  // atomic (npz.hpp)
+  }
+
+  /// Reads a model written by save(). Error naming the file for another kind of file or a
+  /// tensor of the wrong shape.
+  static SoftDecaSurrogate load(const std::filesystem::path& path) {
+    const io::NpzArrays z = io::read_npz(path);
+    if (!z.contains("config")) throw Error("SoftDecaSurrogate::load: " + path.string() + " has no 'config' (not a surrogate model)");
+    const auto j = nlohmann::json::parse(z.at("config").to_strings().at(0));
+    if (j.value("kind", "") != "simsr softdeca surrogate") throw Error("SoftDecaSurrogate::load: " + path.string() + " is not a surrogate model");
+    SoftDecaSurrogate s(j.at("expressions").get<Index>(), j.at("skin_vertices").get<Index>(), j.at("hidden").get<std::vector<Index>>(), 0);
+    nn::load_state(*s.store_, z);
+    s.in_mean_ = z.at("in_mean").to_matrix<double>().reshaped();
+    s.in_scale_ = z.at("in_scale").to_matrix<double>().reshaped();
+    s.out_mean_ = z.at("out_mean").to_matrix<double>().reshaped();
+    s.out_scale_ = z.at("out_scale").item<double>();
+    if (s.in_mean_.size() != s.inputs() || s.in_scale_.size() != s.inputs() || s.out_mean_.size() != 3 * s.M_)
+      throw Error("SoftDecaSurrogate::load: " + path.string() + ": standardization arrays do not match the dimensions in its config");
+    return s;
+  }
+
+ private:
+  void check_inputs(const char* what, const Eigen::MatrixXd& x) const {
+    if (x.cols() != inputs()) throw ShapeError(std::string("SoftDecaSurrogate::") + what + ": inputs", {x.rows(), inputs()}, {x.rows(), x.cols()});
+    if (!x.allFinite()) throw ArgumentError(std::string("SoftDecaSurrogate::") + what + ": non-finite input");
+  }
+
+  Index E_ = 0, M_ = 0;
+  std::vector<Index> hidden_;
+  // on the heap: the layers point into the store, and the surrogate is movable (load() returns one)
+  std::unique_ptr<nn::ParameterStore<float>> store_ = std::make_unique<nn::ParameterStore<float>>();
+  std::unique_ptr<nn::Mlp<float>> mlp_;
+  VecX<> in_mean_, in_scale_, out_mean_;
+  double out_scale_ = 1;
+  nn::Matrix<float> out_;
+};
+
+/// Errors of one predictor on a set of samples (per skin vertex, Euclidean, m).
+struct SurrogateErrors {
+  double mean = 0, rms = 0, max = 0;
+  double relative = 0;  ///< mean error / mean ‖displacement − the training mean displacement‖ (1: no better than the mean)
+  nlohmann::ordered_json to_json() const { return {{"mean_m", mean}, {"rms_m", rms}, {"max_m", max}, {"relative_to_mean_predictor", relative}}; }
+};
+
+/// What train_softdeca_surrogate measured.
+struct SoftDecaSurrogateReport {
+  Index train_samples = 0, validation_samples = 0, held_out_samples = 0, epochs = 0, parameters = 0;
+  std::vector<double> loss;             ///< per epoch, the mean training loss (standardized MSE)
+  std::vector<double> validation_loss;  ///< per epoch, on the validation samples (empty without)
+  Index best_epoch = 0;                 ///< the epoch whose weights were kept (0-based)
+  SurrogateErrors train, held_out, mean_baseline, ridge_baseline;  ///< the last three on the held-out samples
+  double train_seconds = 0;
+  double inference_seconds = 0;  ///< one sample (batch of 1), median of repeated calls, the policy's threads
+  double solver_seconds = 0;     ///< mean simulation time of the held-out samples (from the dataset)
+  nlohmann::ordered_json to_json() const {
+    return {{"train_samples", train_samples},
+            {"validation_samples", validation_samples},
+            {"held_out_samples", held_out_samples},
+            {"epochs", epochs},
+            {"best_epoch", best_epoch + 1},
+            {"network_parameters", parameters},
+            {"final_train_loss", loss.empty() ? 0.0 : loss.back()},
+            {"best_validation_loss", validation_loss.empty() ? 0.0 : validation_loss[std::size_t(best_epoch)]},
+            {"train", train.to_json()},
+            {"held_out", held_out.to_json()},
+            {"held_out_mean_baseline", mean_baseline.to_json()},
+            {"held_out_ridge_baseline", ridge_baseline.to_json()},
+            {"train_seconds", train_seconds},
+            {"inference_seconds_per_sample", inference_seconds},
+            {"solver_seconds_per_sample", solver_seconds},
+            {"speedup", inference_seconds > 0 ? solver_seconds / inference_seconds : 0.0}};
+  }
+};
+
+/// Per-vertex Euclidean errors of `pred` against `truth` (N × 3M), relative to `reference`'s
+/// (the training mean displacement's) distance from the truth.
+inline SurrogateErrors surrogate_errors(const Eigen::MatrixXd& pred, const Eigen::MatrixXd& truth, const VecX<>& reference) {
+  SurrogateErrors e;
+  const Index N = truth.rows(), M = truth.cols() / 3;
+  if (N == 0) return e;
+  double sum = 0, sq = 0, ref = 0;
+  for (Index i = 0; i < N; ++i)
+    for (Index v = 0; v < M; ++v) {
+      const double d = (pred.row(i).segment<3>(3 * v) - truth.row(i).segment<3>(3 * v)).norm();
+      sum += d;
+      sq += d * d;
+      e.max = std::max(e.max, d);
+      ref += (reference.segment<3>(3 * v).transpose() - truth.row(i).segment<3>(3 * v)).norm();
+    }
+  const double n = double(N * M);
+  e.mean = sum / n;
+  e.rms = std::sqrt(sq / n);
+  e.relative = ref > 0 ? sum / ref : 0;
+  return e;
+}
+
+/// Trains `net` on the first (1 − held_out) of `data`'s samples and reports (see the file
+/// comment). ArgumentError when fewer than 2 samples would be trained on or none held out.
+template <exec::HostPolicy P>
+SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const SoftDecaDataset& data, const SoftDecaSurrogateOptions& o, SoftDecaSurrogate& net) {
+  const Index N = data.size();
+  if (data.expressions.cols() != net.expressions() || data.skin_vertices() != net.skin_vertices())
+    throw ShapeError("train_softdeca_surrogate: the network's expressions and skin vertices vs the dataset's", {net.expressions(), net.skin_vertices()},
+                     {data.expressions.cols(), data.skin_vertices()});
+  if (!(o.held_out > 0 && o.held_out < 1)) throw ArgumentError("train_softdeca_surrogate: held_out must be in (0, 1)");
+  if (!(o.validation >= 0 && o.validation < 1)) throw ArgumentError("train_softdeca_surrogate: validation must be in [0, 1)");
+  if (o.epochs < 1 || o.batch < 1 || !(o.lr > 0)) throw ArgumentError("train_softdeca_surrogate: need epochs >= 1, batch >= 1, lr > 0");
+  const Index test = std::max<Index>(1, Index(std::llround(o.held_out * double(N)))), train = N - test;
+  const Index val = o.validation > 0 ? std::max<Index>(1, Index(std::llround(o.validation * double(train)))) : 0, fit = train - val;
+  if (fit < 2) throw ArgumentError("train_softdeca_surrogate: " + std::to_string(N) + " samples leave fewer than 2 to train on");
+  const auto t0 = std::chrono::steady_clock::now();
+  SoftDecaSurrogateReport r;
+  r.train_samples = fit;
+  r.validation_samples = val;
+  r.held_out_samples = test;
+  r.epochs = o.epochs;
+  r.parameters = net.store().num_parameters();
+
+  const Eigen::MatrixXd X = net.join(data.parameters, data.expressions);
+  const Eigen::MatrixXd Xtr = X.topRows(train), Xte = X.bottomRows(test);
+  const Eigen::MatrixXd Ytr = data.displacements.topRows(train), Yte = data.displacements.bottomRows(test);
+  net.fit_normalization(Xtr, Ytr);
+  const nn::Matrix<float> in = net.standardize(Xtr), target = net.standardize_output(Ytr);
+
+  nn::Adam<float> adam(net.store(), {.lr = o.lr, .weight_decay = o.weight_decay});
+  nn::Rng rng(o.seed);
+  std::vector<Index> order(static_cast<std::size_t>(fit));
+  std::iota(order.begin(), order.end(), Index(0));
+  nn::Matrix<float> xb, yb, out, d_out, val_out;
+  const Index steps_per_epoch = (fit + o.batch - 1) / o.batch;
+  std::vector<float> best(net.store().values().data(), net.store().values().data() + net.store().num_parameters());
+  double best_loss = std::numeric_limits<double>::infinity();
+  for (Index epoch = 0; epoch < o.epochs; ++epoch) {
+    const double progress = double(epoch) / double(std::max<Index>(1, o.epochs - 1));
+    adam.set_lr(o.lr * (o.lr_final_fraction + (1 - o.lr_final_fraction) * 0.5 * (1 + std::cos(3.14159265358979323846 * progress))));
+    std::shuffle(order.begin(), order.end(), rng);
+    double loss = 0;
+    for (Index s = 0; s < steps_per_epoch; ++s) {
+      const Index b = s * o.batch, n = std::min(o.batch, fit - b);
+      xb.resize(n, in.cols());
+      yb.resize(n, target.cols());
+      for (Index k = 0; k < n; ++k) {
+        xb.row(k) = in.row(order[std::size_t(b + k)]);
+        yb.row(k) = target.row(order[std::size_t(b + k)]);
+      }
+      net.store().zero_grad();
+      net.mlp().forward(policy, nn::Mode::train, xb, out);
+      const nn::Matrix<float> diff = out - yb;
+      loss += double(nn::mean_square(policy, diff, &d_out)) * double(n);
+      net.mlp().backward(policy, xb, out, d_out, nullptr);
+      adam.step(policy);
+    }
+    r.loss.push_back(loss / double(fit));
+    if (!std::isfinite(r.loss.back())) throw ConvergenceError("train_softdeca_surrogate (the loss is not finite)", epoch, r.loss.back());
+    if (val > 0) {
+      net.mlp().forward(policy, nn::Mode::eval, in.bottomRows(val), val_out);
+      const double v = double((val_out - target.bottomRows(val)).squaredNorm()) / double(val_out.size());
+      r.validation_loss.push_back(v);
+      if (v < best_loss) {
+        best_loss = v;
+        r.best_epoch = epoch;
+        std::copy_n(net.store().values().data(), best.size(), best.begin());
+      }
+    } else {
+      r.best_epoch = epoch;
+    }
+    if (o.progress) o.progress(epoch, r.loss.back());
+  }
+  if (val > 0) std::copy(best.begin(), best.end(), net.store().values().data());
+  r.train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const VecX<> mean = Ytr.colwise().mean().transpose();
+  r.train = surrogate_errors(net.predict(policy, data.parameters.topRows(train), data.expressions.topRows(train)), Ytr, mean);
+  r.held_out = surrogate_errors(net.predict(policy, data.parameters.bottomRows(test), data.expressions.bottomRows(test)), Yte, mean);
+  r.mean_baseline = surrogate_errors(Eigen::MatrixXd(mean.transpose().replicate(test, 1)), Yte, mean);
+  {  // ridge on the same standardized inputs: [1, x] → y
+    const Eigen::MatrixXd Z = net.standardize(Xtr).cast<double>(), Zte = net.standardize(Xte).cast<double>();
+    Eigen::MatrixXd A(train, Z.cols() + 1), Ate(test, Z.cols() + 1);
+    A << Eigen::VectorXd::Ones(train), Z;
+    Ate << Eigen::VectorXd::Ones(test), Zte;
+    Eigen::MatrixXd G = A.transpose() * A;
+    G.diagonal().tail(Z.cols()).array() += o.ridge_lambda * double(train);
+    const Eigen::MatrixXd W = G.ldlt().solve(A.transpose() * Ytr);
+    r.ridge_baseline = surrogate_errors(Ate * W, Yte, mean);
+  }
+  // speed: one sample at a time, as a solver would be asked
+  {
+    const Eigen::MatrixXd p1 = data.parameters.bottomRows(1), e1 = data.expressions.bottomRows(1);
+    net.predict(policy, p1, e1);  // warm-up: buffers sized
+    std::vector<double> times;
+    for (int k = 0; k < 21; ++k) {
+      const auto a = std::chrono::steady_clock::now();
+      net.predict(policy, p1, e1);
+      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count());
+    }
+    std::nth_element(times.begin(), times.begin() + 10, times.end());
+    r.inference_seconds = times[10];
+  }
+  r.solver_seconds = data.seconds.tail(test).mean();
+  return r;
+}
+
+}  // namespace simsr::scenario
