@@ -4,9 +4,10 @@
 # runtimes and LLVM's OpenMP with Archer), so it exports SIMSR_REQUIRE_PEERS=1: after that, a peer,
 # the ../shared/data folder or clang that is still missing is a real failure here, never a skip.
 #
-#   1. build/       g++, a test build (SIMSR_TEST_BUILD: -O1 everywhere): the interp, nn, pipeline and
-#                   scenario suites (the libgomp allocation checks; the demo, animate and ablation
-#                   runs; the SoftDECA template from the kit),
+#   1. build/       g++, a test build (SIMSR_TEST_BUILD: -O1 everywhere): the nn suite and
+#                   interp's, pipeline's and scenario's files the sanitizer builds leave out (the
+#                   libgomp allocation checks; the demo, animate and ablation runs; the SoftDECA
+#                   template from the kit),
 #                   test_threads, the tool and examples, the fuzz-corpus replays, the peers (gmsh,
 #                   meshio, numpy, scipy, torch), install + consumer project, compile-fail checks,
 #                   cuda-compile, and each benchmark compiled (clang syntax only, a ctest each: none
