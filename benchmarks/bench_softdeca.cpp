@@ -9,7 +9,9 @@
 //                 vertices = 53.8k DOFs, 92,160 tets
 //   ict_template  the ICT kit's layered head (scenario/softdeca/ict_template.hpp, 1 layer per
 //                 shell; 42,084 vertices, 167,778 tets): the local-global cases only (the end of
-//                 the file says why)
+//                 the file says why). On 2026-11-26 its setup's settle did not converge within
+//                 5,000 local-global iterations (23.5 min on 2 threads, gradient 2.7e-4 N left):
+//                 its cases are then skipped with that error
 // Every frame is the SoftDecaSimulator's second part, one implicit step at a sampled parameter
 // set (sample 0 of seed 1, skull scaling kept at 1 so every scene takes the same problem), from
 // the settled individual (computed once at setup) to the expression; the solvers stop at the same
@@ -55,7 +57,15 @@ struct Scene {
   SoftDecaParameters params;
   VecX<> expression;
   Points<> settled;  ///< the individual at rest (the frame's start)
+  std::string error;  ///< why the scene could not be set up (its cases are skipped with it)
 };
+
+/// Skips the case (with the setup's error) when the scene could not be set up; true then.
+bool skipped(benchmark::State& state, const Scene& s) {
+  if (s.error.empty()) return false;
+  state.SkipWithError(s.error.c_str());
+  return true;
+}
 
 Scene& scene(const std::string& name) {
   static std::map<std::string, Scene> scenes;
@@ -74,8 +84,14 @@ Scene& scene(const std::string& name) {
   s.expression = VecX<>::Zero(Index(s.tpl->expression_names.size()));
   s.expression.head(std::min<Index>(2, s.expression.size())).setConstant(0.7);
   s.sim->prepare(s.params);
-  const Index its = s.sim->settle(exec::omp, s.settled);
-  s.sim->factor_step(exec::omp);
+  Index its = 0;
+  try {
+    its = s.sim->settle(exec::omp, s.settled);
+    s.sim->factor_step(exec::omp);
+  } catch (const Error& e) {  // the ICT head's settle did not converge in 5,000 iterations (README)
+    s.error = std::string("setting up ") + name + ": " + e.what();
+    std::fprintf(stderr, "bench_softdeca: %s\n", s.error.c_str());
+  }
   std::fprintf(stderr, "bench_softdeca: %s: %lld vertices (%lld DOFs), %lld tets; settled in %lld local-global iterations\n", name.c_str(),
                static_cast<long long>(s.tpl->head.mesh.num_vertices()), static_cast<long long>(3 * s.tpl->head.mesh.num_vertices()),
                static_cast<long long>(s.tpl->head.mesh.num_tets()), static_cast<long long>(its));
@@ -91,6 +107,7 @@ void sizes(benchmark::State& state, const Scene& s) {
 template <class P>
 void BM_softdeca_frame(benchmark::State& state, const std::string& name, SoftDecaSolver solver, P policy) {
   Scene& s = scene(name);
+  if (skipped(state, s)) return;
   const SoftDecaSimulationOptions o{.solver = solver, .steps = 1};
   Index its = 0;
   Points<> x;
@@ -111,6 +128,7 @@ void BM_softdeca_frame(benchmark::State& state, const std::string& name, SoftDec
 template <class P>
 void BM_softdeca_local_step(benchmark::State& state, const std::string& name, P policy) {
   Scene& s = scene(name);
+  if (skipped(state, s)) return;
   Points<> g(s.settled.rows(), 3);
   for (auto _ : state) {
     s.sim->gradient(policy, s.settled, g);
@@ -123,6 +141,7 @@ void BM_softdeca_local_step(benchmark::State& state, const std::string& name, P 
 template <class P>
 void BM_softdeca_energy_then_gradient(benchmark::State& state, const std::string& name, P policy) {
   Scene& s = scene(name);
+  if (skipped(state, s)) return;
   Points<> g(s.settled.rows(), 3);
   for (auto _ : state) {
     benchmark::DoNotOptimize(s.sim->energy(policy, s.settled));
@@ -136,6 +155,7 @@ void BM_softdeca_energy_then_gradient(benchmark::State& state, const std::string
 template <class P>
 void BM_softdeca_energy_gradient_fused(benchmark::State& state, const std::string& name, P policy) {
   Scene& s = scene(name);
+  if (skipped(state, s)) return;
   Points<> g(s.settled.rows(), 3);
   for (auto _ : state) {
     benchmark::DoNotOptimize(s.sim->energy_and_gradient(policy, s.settled, g));
@@ -147,6 +167,7 @@ void BM_softdeca_energy_gradient_fused(benchmark::State& state, const std::strin
 /// The global step: one solve with the prefactored matrix, reduced (#V×#V, three solves) or full (3V×3V).
 void BM_softdeca_global_step(benchmark::State& state, const std::string& name, bool reduced) {
   Scene& s = scene(name);
+  if (skipped(state, s)) return;
   s.sim->step_solver().options().isotropic_reduction = reduced;
   s.sim->factor_step(exec::omp);
   Points<> g(s.settled.rows(), 3);
@@ -166,6 +187,7 @@ void BM_softdeca_global_step(benchmark::State& state, const std::string& name, b
 /// Assembling and factoring the global matrix (once per weight set), reduced or full.
 void BM_softdeca_factor(benchmark::State& state, const std::string& name, bool reduced) {
   Scene& s = scene(name);
+  if (skipped(state, s)) return;
   s.sim->step_solver().options().isotropic_reduction = reduced;
   for (auto _ : state) s.sim->factor_step(exec::omp);
   s.sim->step_solver().options().isotropic_reduction = true;
