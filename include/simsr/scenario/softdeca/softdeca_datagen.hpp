@@ -21,8 +21,8 @@
 /// produces what an uninterrupted run would. A sample file from another run (other template,
 /// options, stiffness or seed: its fingerprint differs) is an Error naming it, never mixed in.
 ///
-/// Expressions: `active_expressions` of the kit's expressions, chosen at random, each with a
-/// weight uniform in [0, 1] (sparse mixtures, as faces activate few muscles at once).
+/// Expressions: `active_expressions` of the template's expressions, chosen at random, each with a
+/// weight uniform in (0, 1] (sparse mixtures, as faces activate few muscles at once).
 
 #include <algorithm>
 #include <chrono>
@@ -41,7 +41,6 @@
 #include "../../io/atomic_file.hpp"
 #include "../../io/mesh_io.hpp"
 #include "../../io/npz.hpp"
-#include "ict_template.hpp"
 #include "parameters.hpp"
 #include "softdeca_simulator.hpp"
 #include "template.hpp"
