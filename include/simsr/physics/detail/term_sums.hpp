@@ -9,7 +9,6 @@
 #include <cmath>
 #include <concepts>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -88,6 +87,18 @@ concept FusedEnergyGradient = requires(const T& t, P p, const Points<S>& x, Poin
   { t.add_energy_gradient(p, x, g) } -> std::convertible_to<S>;
 };
 
+/// One term's energy at x, its gradient added to g, in one pass where the term offers it
+/// (FusedEnergyGradient), else by energy() and add_gradient().
+template <class S, class P, class T>
+double add_energy_gradient(P policy, const T& term, const Points<S>& x, Points<S>& g) {
+  if constexpr (FusedEnergyGradient<T, S, P>) {
+    return double(term.add_energy_gradient(policy, x, g));
+  } else {
+    term.add_gradient(policy, x, g);
+    return double(term.energy(policy, x));
+  }
+}
+
 /// g += scratch over the free DOFs; returns ‖scratch‖ over them.
 template <class S>
 double add_free(const Points<S>& scratch, const std::vector<char>& fixed, VecX<S>& g) {
@@ -128,13 +139,7 @@ double energy_and_free_gradient(P policy, const Points<S>& x, const std::vector<
   double sum = 0, mag = 0, bal = 0;
   const auto one = [&](const auto& term) {
     scratch.setZero(n, 3);
-    double e = 0;
-    if constexpr (FusedEnergyGradient<std::remove_cvref_t<decltype(term)>, S, P>) {
-      e = double(term.add_energy_gradient(policy, x, scratch));
-    } else {
-      e = double(term.energy(policy, x));
-      term.add_gradient(policy, x, scratch);
-    }
+    const double e = add_energy_gradient(policy, term, x, scratch);
     sum += e;
     mag += std::abs(e);
     bal += add_free(scratch, fixed, g);

@@ -29,7 +29,6 @@
 #include <chrono>
 #include <cmath>
 #include <string>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -211,46 +210,37 @@ class SoftDecaSimulator {
   template <exec::HostPolicy P>
   void gradient(P policy, const Points<>& x, Points<>& g) const {
     g.setZero(x.rows(), 3);
-    strain_soft_.add_gradient(policy, x, g);
-    strain_muscle_.add_gradient(policy, x, g);
-    volume_.add_gradient(policy, x, g);
-    bending_.add_gradient(policy, x, g);
-    targets_.add_gradient(policy, x, g);
-    distances_.add_gradient(policy, x, g);
-    gravity_.add_gradient(policy, x, g);
-    inertia_.add_gradient(policy, x, g);
+    with_terms([&](const auto&... term) { (term.add_gradient(policy, x, g), ...); });
   }
   /// Σ terms' energies at x (J): what a line-search trial evaluates.
   template <exec::HostPolicy P>
   double energy(P policy, const Points<>& x) const {
     double magnitude = 0;
-    return physics::detail::total_energy(policy, x, magnitude, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_,
-                                         inertia_);
+    return with_terms([&](const auto&... term) { return physics::detail::total_energy(policy, x, magnitude, term...); });
   }
   /// Σ terms' energies at x, and their gradients into g (#V×3), in one pass over each term that
   /// can (physics::detail::FusedEnergyGradient): what the local-global solver evaluates at a unit step.
   template <exec::HostPolicy P>
   double energy_and_gradient(P policy, const Points<>& x, Points<>& g) const {
     g.setZero(x.rows(), 3);
-    double e = 0;
-    const auto one = [&](const auto& term) {
-      if constexpr (physics::detail::FusedEnergyGradient<std::remove_cvref_t<decltype(term)>, double, P>) {
-        e += double(term.add_energy_gradient(policy, x, g));
-      } else {
-        e += double(term.energy(policy, x));
-        term.add_gradient(policy, x, g);
-      }
-    };
-    one(strain_soft_), one(strain_muscle_), one(volume_), one(bending_), one(targets_), one(distances_), one(gravity_), one(inertia_);
+    double e = 0;  // a comma fold: the terms in order (a + fold leaves the order of their additions to g open)
+    with_terms([&](const auto&... term) { ((e += physics::detail::add_energy_gradient(policy, term, x, g)), ...); });
     return e;
   }
   /// Factors the step solver's matrix for the current weights (what step() does once per sample).
   template <exec::HostPolicy P>
   void factor_step(P policy) {
-    step_.factor(policy, bones_, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_, inertia_);
+    with_terms([&](const auto&... term) { step_.factor(policy, bones_, term...); });
   }
 
  private:
+  /// f(every term of the energy), in one order: the one list the solvers, the gradient and the
+  /// energy share (see the file comment).
+  template <class F>
+  decltype(auto) with_terms(F&& f) const {
+    return f(strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_, inertia_);
+  }
+
   static TetMesh<> layer(const SoftDecaTemplate& tpl, TissueLayer l) {
     std::vector<Index> rows;
     for (Index t = 0; t < tpl.head.mesh.num_tets(); ++t)
@@ -304,12 +294,12 @@ class SoftDecaSimulator {
     const physics::DirichletBoundary<>& bones = bones_;
     if (o.solver == SoftDecaSolver::newton) {
       newton_.options().relative_tolerance = o.relative_tolerance;
-      return newton_.solve(policy, x, bones, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_, inertia_).iterations;
+      return with_terms([&](const auto&... term) { return newton_.solve(policy, x, bones, term...).iterations; });
     }
     pd.options().relative_tolerance = o.relative_tolerance;
     pd.options().max_iterations = o.max_iterations;
     pd.options().history = o.history;
-    return pd.solve(policy, x, bones, strain_soft_, strain_muscle_, volume_, bending_, targets_, distances_, gravity_, inertia_).iterations;
+    return with_terms([&](const auto&... term) { return pd.solve(policy, x, bones, term...).iterations; });
   }
 
   const SoftDecaTemplate& tpl_;
