@@ -21,10 +21,10 @@
 //   BM_softdeca_frame/<scene>/<solver>/<policy>    one frame; counters iterations, s_per_iteration
 //   BM_softdeca_local_step/<scene>/<policy>        every term's gradient at the frame's start
 //                                                  (the local step: projections in parallel)
-//   BM_softdeca_energy_then_gradient/<scene>       a trial's energy, then the gradient at the
+//   BM_softdeca_energy_gradient/<scene>_separate   a trial's energy, then the gradient at the
 //                                                  accepted point: each strain tet decomposed twice
 //                                                  (the solver before the fused evaluation)
-//   BM_softdeca_energy_gradient_fused/<scene>      both in one pass (one SVD per tet): the ratio
+//   BM_softdeca_energy_gradient/<scene>_fused      both in one pass (one SVD per tet): the ratio
 //                                                  of these two is the fused evaluation's gain
 //   BM_softdeca_global_step/<scene>/<reduced|full> one solve with the prefactored matrix: the
 //                                                  #V×#V matrix of an isotropic L, three solves, vs
@@ -137,39 +137,49 @@ void BM_softdeca_local_step(benchmark::State& state, const std::string& name, P 
   sizes(state, s);
 }
 
-/// A line-search trial's energy and then the gradient at the accepted point (two passes).
+/// The energy and the gradient at one point: in one pass (`fused`, the solver's evaluation of a
+/// unit step) or as a line-search trial's energy and then the gradient at the accepted point.
 template <class P>
-void BM_softdeca_energy_then_gradient(benchmark::State& state, const std::string& name, P policy) {
+void BM_softdeca_energy_gradient(benchmark::State& state, const std::string& name, P policy, bool fused) {
   Scene& s = scene(name);
   if (skipped(state, s)) return;
   Points<> g(s.settled.rows(), 3);
   for (auto _ : state) {
-    benchmark::DoNotOptimize(s.sim->energy(policy, s.settled));
-    s.sim->gradient(policy, s.settled, g);
+    if (fused) {
+      benchmark::DoNotOptimize(s.sim->energy_and_gradient(policy, s.settled, g));
+    } else {
+      benchmark::DoNotOptimize(s.sim->energy(policy, s.settled));
+      s.sim->gradient(policy, s.settled, g);
+    }
     benchmark::DoNotOptimize(g.data());
   }
   sizes(state, s);
 }
 
-/// The same in one pass (the solver's evaluation of a unit step).
-template <class P>
-void BM_softdeca_energy_gradient_fused(benchmark::State& state, const std::string& name, P policy) {
-  Scene& s = scene(name);
-  if (skipped(state, s)) return;
-  Points<> g(s.settled.rows(), 3);
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(s.sim->energy_and_gradient(policy, s.settled, g));
-    benchmark::DoNotOptimize(g.data());
+/// For the span of a case, the step solver factors the #V×#V matrix (`reduced`) or the 3V×3V
+/// one; afterwards the scene is back to the reduced factorization the other cases use.
+class Reduction {
+ public:
+  Reduction(Scene& s, bool reduced) : s_(s) { s_.sim->step_solver().options().isotropic_reduction = reduced; }
+  ~Reduction() {
+    s_.sim->step_solver().options().isotropic_reduction = true;
+    s_.sim->factor_step(exec::omp);
   }
-  sizes(state, s);
-}
+
+ private:
+  Scene& s_;
+};
 
 /// The global step: one solve with the prefactored matrix, reduced (#V×#V, three solves) or full (3V×3V).
 void BM_softdeca_global_step(benchmark::State& state, const std::string& name, bool reduced) {
   Scene& s = scene(name);
   if (skipped(state, s)) return;
-  s.sim->step_solver().options().isotropic_reduction = reduced;
+  const Reduction as_asked(s, reduced);
   s.sim->factor_step(exec::omp);
+  if (s.sim->step_solver().reduced() != reduced) {
+    state.SkipWithError("the global matrix was not reduced as asked");
+    return;
+  }
   Points<> g(s.settled.rows(), 3);
   s.sim->gradient(exec::omp, s.settled, g);
   VecX<> q = Eigen::Map<const VecX<>>(g.data(), g.size()), d(q.size());
@@ -178,9 +188,6 @@ void BM_softdeca_global_step(benchmark::State& state, const std::string& name, b
     s.sim->step_solver().apply_inverse(exec::omp, q, d);
     benchmark::DoNotOptimize(d.data());
   }
-  if (s.sim->step_solver().reduced() != reduced) state.SkipWithError("the global matrix was not reduced as asked");
-  s.sim->step_solver().options().isotropic_reduction = true;
-  s.sim->factor_step(exec::omp);
   sizes(state, s);
 }
 
@@ -188,10 +195,8 @@ void BM_softdeca_global_step(benchmark::State& state, const std::string& name, b
 void BM_softdeca_factor(benchmark::State& state, const std::string& name, bool reduced) {
   Scene& s = scene(name);
   if (skipped(state, s)) return;
-  s.sim->step_solver().options().isotropic_reduction = reduced;
+  const Reduction as_asked(s, reduced);
   for (auto _ : state) s.sim->factor_step(exec::omp);
-  s.sim->step_solver().options().isotropic_reduction = true;
-  s.sim->factor_step(exec::omp);
   sizes(state, s);
 }
 
@@ -204,9 +209,9 @@ void BM_softdeca_factor(benchmark::State& state, const std::string& name, bool r
       ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);                                                                         \
   BENCHMARK_CAPTURE(BM_softdeca_local_step, scene_name##_seq, std::string(#scene_name), exec::seq)->Unit(benchmark::kMillisecond)->UseRealTime(); \
   BENCHMARK_CAPTURE(BM_softdeca_local_step, scene_name##_omp, std::string(#scene_name), exec::omp)->Unit(benchmark::kMillisecond)->UseRealTime(); \
-  BENCHMARK_CAPTURE(BM_softdeca_energy_then_gradient, scene_name##_omp, std::string(#scene_name), exec::omp)                                 \
+  BENCHMARK_CAPTURE(BM_softdeca_energy_gradient, scene_name##_separate_omp, std::string(#scene_name), exec::omp, false)                      \
       ->Unit(benchmark::kMillisecond)->UseRealTime();                                                                                        \
-  BENCHMARK_CAPTURE(BM_softdeca_energy_gradient_fused, scene_name##_omp, std::string(#scene_name), exec::omp)                                \
+  BENCHMARK_CAPTURE(BM_softdeca_energy_gradient, scene_name##_fused_omp, std::string(#scene_name), exec::omp, true)                          \
       ->Unit(benchmark::kMillisecond)->UseRealTime();                                                                                        \
   BENCHMARK_CAPTURE(BM_softdeca_global_step, scene_name##_reduced, std::string(#scene_name), true)->Unit(benchmark::kMillisecond)->UseRealTime(); \
   BENCHMARK_CAPTURE(BM_softdeca_factor, scene_name##_reduced, std::string(#scene_name), true)                                                 \
