@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace simsr::cli {
@@ -38,7 +39,8 @@ struct DatagenArgs {
   Index vtk_every = 10;
   Index unseen_frames = 40;
   // softdeca
-  Index samples = 100, layers = 1, steps = 6, active_expressions = -1, sphere_level = 3;
+  Index samples = 100, layers = 1, steps = 6, sphere_level = 3;
+  std::optional<Index> active_expressions;
   std::string solver = "local_global", softdeca_template = "ict";
 };
 
@@ -46,6 +48,7 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   scenario::SoftDecaDatagenOptions o;
   o.samples = a.samples;
   o.seed = a.seed;
+  o.active_expressions = a.active_expressions;
   o.simulation.steps = a.steps;
   if (a.solver == "newton")
     o.simulation.solver = scenario::SoftDecaSolver::newton;
@@ -53,20 +56,14 @@ inline int datagen_softdeca(const DatagenArgs& a) {
     throw ArgumentError("--solver: local_global or newton (got '" + a.solver + "')");
   const auto say = [](const std::string& line) { std::fprintf(stderr, "softdeca: %s\n", line.c_str()); };
   nlohmann::ordered_json j;
-  // the default mixes 3 expressions, or all of a template's when it has fewer (the sphere's 2)
-  const auto mix = [&](const scenario::SoftDecaTemplate& tpl) {
-    o.active_expressions = a.active_expressions >= 0 ? a.active_expressions : std::min<Index>(3, Index(tpl.expression_names.size()));
-  };
   if (a.softdeca_template == "ict") {
     scenario::SoftDecaTemplateOptions t;
     t.head.layers = a.layers;
     say("building the layered template from " + a.kit + " (" + std::to_string(a.layers) + " layer(s) per shell)");
     const scenario::IctTemplate tpl = scenario::softdeca_template(exec::omp, scenario::read_ict_kit(a.kit), t);
-    mix(tpl);
     j = scenario::generate_softdeca_dataset(exec::omp, tpl, "ict", o, a.out, say);
   } else if (a.softdeca_template == "sphere") {
     const scenario::SoftDecaTemplate tpl = scenario::sphere_softdeca_template(exec::omp, a.sphere_level, a.layers);
-    mix(tpl);
     j = scenario::generate_softdeca_dataset(exec::omp, tpl, "sphere level " + std::to_string(a.sphere_level), o, a.out, say);
   } else {
     throw ArgumentError("--template: ict or sphere (got '" + a.softdeca_template + "')");

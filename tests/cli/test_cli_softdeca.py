@@ -91,6 +91,7 @@ check(report.get("inference_seconds_per_sample", 0) > 0 and report.get("solver_s
 loss = list(csv.DictReader(open(os.path.join(out, "surrogate_loss.csv")))) if os.path.exists(os.path.join(out, "surrogate_loss.csv")) else []
 check(len(loss) == 40, f"one loss row per epoch: {len(loss)}")
 check(len(loss) == 40 and float(loss[-1]["train_loss"]) < float(loss[0]["train_loss"]), "the training loss fell")
+check(len(loss) == 40 and all(row["validation_loss"] != "" for row in loss), "a validation loss per epoch (1 validation sample)")
 m = np.load(os.path.join(out, "surrogate.npz"))
 check("surrogate.fc0.weight" in m.files and m["surrogate.fc0.weight"].shape == (32, 22), f"first layer 22 -> 32: {m.files}")
 check(m["surrogate.fc2.weight"].shape == (126, 32), "last layer -> 3 x 42 displacements")

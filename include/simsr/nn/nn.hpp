@@ -30,6 +30,7 @@
 #include "positional_encoding.hpp"
 #include "sequential.hpp"
 #include "siren_decoder.hpp"
+#include "softdeca_surrogate.hpp"
 #include "super_resolution_loss.hpp"
 #include "super_resolution_net.hpp"
 #include "tensor.hpp"

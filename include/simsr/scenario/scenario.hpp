@@ -22,7 +22,7 @@
 #include "softdeca/layered_head.hpp"
 #include "softdeca/parameters.hpp"
 #include "softdeca/softdeca_datagen.hpp"
+#include "softdeca/softdeca_dataset.hpp"
 #include "softdeca/softdeca_simulator.hpp"
 #include "softdeca/sphere_template.hpp"
-#include "softdeca/surrogate.hpp"
 #include "softdeca/template.hpp"

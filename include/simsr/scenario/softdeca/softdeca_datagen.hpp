@@ -14,7 +14,8 @@
 ///                                     sample's simulation), fingerprint
 ///     DIR/softdeca_data.json          template sizes, options, per-sample iterations and seconds
 ///
-/// read_softdeca_dataset() reads softdeca_samples.npz back (the surrogate's input, surrogate.hpp).
+/// read_softdeca_dataset() (softdeca_dataset.hpp) reads softdeca_samples.npz back (the surrogate's
+/// input, nn/softdeca_surrogate.hpp).
 ///
 /// Sample i's parameters and expression depend on (seed, i) alone, and each sample file is written
 /// atomically when its simulation ends, so a killed run resumes at the first missing sample and
@@ -29,6 +30,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -42,6 +44,7 @@
 #include "../../io/mesh_io.hpp"
 #include "../../io/npz.hpp"
 #include "parameters.hpp"
+#include "softdeca_dataset.hpp"
 #include "softdeca_simulator.hpp"
 #include "template.hpp"
 
@@ -51,7 +54,8 @@ namespace simsr::scenario {
 struct SoftDecaDatagenOptions {
   Index samples = 100;
   std::uint64_t seed = 1;
-  Index active_expressions = 3;
+  /// Expressions mixed per sample; unset: 3, or all of a template that has fewer (the sphere's 2).
+  std::optional<Index> active_expressions;
   SoftDecaSimulationOptions simulation;
   SoftDecaStiffness stiffness;
   SoftDecaRanges ranges;
@@ -112,9 +116,10 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   if (tpl.expression_deltas.rows() != E || tpl.expression_deltas.cols() != 3 * tpl.skin.size())
     throw ShapeError("softdeca datagen: the template's expression displacements", {E, 3 * tpl.skin.size()},
                      {tpl.expression_deltas.rows(), tpl.expression_deltas.cols()});
-  if (o.active_expressions < 0 || o.active_expressions > E)
+  const Index active = o.active_expressions.value_or(std::min<Index>(3, E));
+  if (active < 0 || active > E)
     throw ArgumentError("softdeca datagen: active expressions must be in [0, " + std::to_string(E) + "] (the template's), got " +
-                        std::to_string(o.active_expressions));
+                        std::to_string(active));
   const auto t0 = std::chrono::steady_clock::now();
   const auto tell = [&](const std::string& s) {
     if (say) say(s);
@@ -149,7 +154,7 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
 
   // what makes a sample file this run's
   Fingerprint fp;
-  fp.add(h.mesh.V).add(h.mesh.T).add(tpl.expression_deltas).add(o.seed).add(o.active_expressions).add(o.simulation.steps).add(o.simulation.time_step)
+  fp.add(h.mesh.V).add(h.mesh.T).add(tpl.expression_deltas).add(o.seed).add(active).add(o.simulation.steps).add(o.simulation.time_step)
       .add(o.simulation.relative_tolerance).add(int(o.simulation.solver)).add(o.simulation.history);
   const nlohmann::ordered_json stiffness = o.stiffness.to_json();  // kept: a range-for over a temporary's items() dangles
   for (const auto& [k, v] : stiffness.items()) fp.add(double(v));
@@ -168,7 +173,7 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   for (Index i = 0; i < o.samples; ++i) {
     const fs::path file = dir / "samples" / detail::sample_file_name(i);
     const SoftDecaParameters p = sample_softdeca_parameters(o.seed, std::uint64_t(i), o.ranges);
-    const VecX<> w = sample_expression_weights(o.seed, std::uint64_t(i), E, o.active_expressions);
+    const VecX<> w = sample_expression_weights(o.seed, std::uint64_t(i), E, active);
     params.row(i) = p.to_vector().transpose();
     expressions.row(i) = w.transpose();
     if (fs::exists(file)) {
@@ -236,6 +241,7 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   j["simulated"] = simulated;
   j["resumed"] = resumed;
   j["seed"] = o.seed;
+  j["active_expressions"] = active;
   j["solver"] = o.simulation.solver == SoftDecaSolver::newton ? "newton" : "local_global";
   j["steps"] = o.simulation.steps;
   j["time_step"] = o.simulation.time_step;
@@ -246,55 +252,6 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   j["per_sample"] = per_sample;
   io::write_file_atomic(dir / "softdeca_data.json", j.dump(2) + "\n");
   return j;
-}
-
-/// softdeca_samples.npz read back.
-struct SoftDecaDataset {
-  Eigen::MatrixXd parameters;   ///< N × 20 (SoftDecaParameters::to_vector)
-  std::vector<std::string> parameter_names;
-  Eigen::MatrixXd expressions;  ///< N × E weights
-  std::vector<std::string> expression_names;
-  Eigen::MatrixXd displacements;  ///< N × 3·#skin: skin at the last step − the template's rest skin (m), vertex-major
-  Points<> rest_skin;             ///< #skin × 3 (m)
-  VecX<> seconds;                 ///< N: each sample's simulation time (s)
-  std::string fingerprint;
-  Index size() const { return parameters.rows(); }
-  Index skin_vertices() const { return rest_skin.rows(); }
-};
-
-/// Reads DIR/softdeca_samples.npz (or the .npz given). Error naming the file and the array for a
-/// missing array or inconsistent shapes.
-inline SoftDecaDataset read_softdeca_dataset(const std::filesystem::path& path) {
-  const std::filesystem::path file = std::filesystem::is_directory(path) ? path / "softdeca_samples.npz" : path;
-  const io::NpzArrays z = io::read_npz(file);
-  const auto need = [&](const char* name) -> const io::NpyArray& {
-    if (!z.contains(name)) throw Error("softdeca dataset " + file.string() + ": no array '" + name + "' (not a simsr datagen --scenario softdeca output?)");
-    return z.at(name);
-  };
-  SoftDecaDataset d;
-  d.parameters = need("parameters").to_matrix<double>();
-  d.parameter_names = need("parameter_names").to_strings();
-  d.expressions = need("expressions").to_matrix<double>();
-  d.expression_names = need("expression_names").to_strings();
-  d.rest_skin = need("rest_skin").to_points();
-  d.seconds = need("seconds").to_matrix<double>().reshaped();
-  d.fingerprint = need("fingerprint").to_strings().at(0);
-  const io::NpyArray& skin = need("skin");
-  const Index N = d.parameters.rows(), M = d.rest_skin.rows();
-  const auto bad = [&](const std::string& what) { throw Error("softdeca dataset " + file.string() + ": " + what); };
-  if (d.parameters.cols() != SoftDecaParameters::size || Index(d.parameter_names.size()) != SoftDecaParameters::size)
-    bad("parameters must be N x " + std::to_string(SoftDecaParameters::size));
-  if (d.expressions.rows() != N || d.expressions.cols() != Index(d.expression_names.size())) bad("expressions must be N x E (E names)");
-  if (d.seconds.size() != N) bad("seconds must have N entries");
-  if (skin.ndim() != 3 || skin.num_frames() != N || skin.shape[1] != M || skin.shape[2] != 3) bad("skin must be N x #skin x 3");
-  if (!d.parameters.allFinite() || !d.expressions.allFinite()) bad("non-finite parameters or expressions");
-  d.displacements.resize(N, 3 * M);
-  for (Index i = 0; i < N; ++i) {
-    const Points<> s = skin.frame_points(i);
-    if (!s.allFinite()) bad("sample " + std::to_string(i) + "'s skin is not finite");
-    d.displacements.row(i) = Eigen::Map<const VecX<>>(Points<>(s - d.rest_skin).data(), 3 * M).transpose();
-  }
-  return d;
 }
 
 }  // namespace simsr::scenario

@@ -3,7 +3,9 @@
 /// SoftDECA's learned surrogate (softdeca supplement §4, Fig. 1: fully connected layers only): a
 /// network of the library's own layers (nn::Mlp of nn::Linear + LeakyReLU) from a sample's
 /// expression weights and simulation parameters to the skin's displacement from the template's
-/// rest skin, standing in for the layered-head simulation (softdeca_simulator.hpp).
+/// rest skin, standing in for the layered-head simulation (scenario/softdeca/softdeca_simulator.hpp)
+/// on the data of scenario/softdeca/softdeca_datagen.hpp (read by softdeca_dataset.hpp). In nn/, right of scenario/ in the data
+/// flow: a network trained on simulated data, like the super-resolution network.
 ///
 ///   input   [expression weights (E), parameters (20: SoftDecaParameters::to_vector, weights as
 ///           log10)], each feature standardized by the training set's mean and deviation
@@ -27,12 +29,15 @@
 /// regression (a linear map of the same standardized inputs).
 ///
 ///     auto data = scenario::read_softdeca_dataset("out/softdeca");
-///     scenario::SoftDecaSurrogate net(data.expressions.cols(), data.skin_vertices(), {256, 256, 256}, 1);
-///     auto report = scenario::train_softdeca_surrogate(exec::omp, data, {}, net);
+///     nn::SoftDecaSurrogate net(data.expressions.cols(), data.skin_vertices(), {256, 256, 256}, 1);
+///     auto report = nn::train_softdeca_surrogate(exec::omp, data, {}, net);
 ///     Eigen::MatrixXd d = net.predict(exec::omp, data.parameters, data.expressions);   // N × 3·#skin (m)
+///     // or all of it, with the model, report and loss curve written (simsr train-surrogate):
+///     auto j = nn::train_softdeca_surrogate_files(exec::omp, "out/softdeca", "out/surrogate", {256, 256, 256}, {});
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -47,19 +52,20 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-#include "../../core/error.hpp"
-#include "../../core/parallel.hpp"
-#include "../../core/types.hpp"
-#include "../../io/npz.hpp"
-#include "../../nn/adam.hpp"
-#include "../../nn/losses.hpp"
-#include "../../nn/mlp.hpp"
-#include "../../nn/model_file.hpp"
-#include "../../nn/parameters.hpp"
+#include "../core/error.hpp"
+#include "../core/parallel.hpp"
+#include "../core/types.hpp"
+#include "../io/atomic_file.hpp"
+#include "../io/npz.hpp"
+#include "../scenario/softdeca/parameters.hpp"
+#include "../scenario/softdeca/softdeca_dataset.hpp"
+#include "adam.hpp"
+#include "losses.hpp"
+#include "mlp.hpp"
+#include "model_file.hpp"
 #include "parameters.hpp"
-#include "softdeca_datagen.hpp"
 
-namespace simsr::scenario {
+namespace simsr::nn {
 
 /// How the surrogate is trained.
 struct SoftDecaSurrogateOptions {
@@ -87,15 +93,15 @@ class SoftDecaSurrogate {
     if (hidden_.empty()) throw ArgumentError("SoftDecaSurrogate: needs at least one hidden layer");
     for (Index h : hidden_)
       if (h < 1 || h > 65536) throw ArgumentError("SoftDecaSurrogate: hidden widths must be in [1, 65536], got " + std::to_string(h));
-    std::vector<nn::MlpStage> stages;
+    std::vector<MlpStage> stages;
     Index in = inputs();
     for (std::size_t i = 0; i < hidden_.size(); ++i) {
-      stages.push_back(nn::MlpStage::linear(in, hidden_[i], "fc" + std::to_string(i)).dims(0).then(nn::Act::leaky_relu, 0.01));
+      stages.push_back(MlpStage::linear(in, hidden_[i], "fc" + std::to_string(i)).dims(0).then(Act::leaky_relu, 0.01));
       in = hidden_[i];
     }
-    stages.push_back(nn::MlpStage::linear(in, 3 * M_, "fc" + std::to_string(hidden_.size())).dims(0));
-    nn::Rng rng(seed);
-    mlp_ = std::make_unique<nn::Mlp<float>>(*store_, "surrogate", stages, rng);
+    stages.push_back(MlpStage::linear(in, 3 * M_, "fc" + std::to_string(hidden_.size())).dims(0));
+    Rng rng(seed);
+    mlp_ = std::make_unique<Mlp<float>>(*store_, "surrogate", stages, rng);
     in_mean_ = VecX<>::Zero(inputs());
     in_scale_ = VecX<>::Ones(inputs());
     out_mean_ = VecX<>::Zero(3 * M_);
@@ -103,10 +109,10 @@ class SoftDecaSurrogate {
 
   Index expressions() const { return E_; }
   Index skin_vertices() const { return M_; }
-  Index inputs() const { return E_ + SoftDecaParameters::size; }
+  Index inputs() const { return E_ + scenario::SoftDecaParameters::size; }
   const std::vector<Index>& hidden() const { return hidden_; }
-  nn::ParameterStore<float>& store() { return *store_; }
-  nn::Mlp<float>& mlp() { return *mlp_; }
+  ParameterStore<float>& store() { return *store_; }
+  Mlp<float>& mlp() { return *mlp_; }
 
   /// Fits the standardization to training inputs (N × inputs) and displacements (N × 3M).
   void fit_normalization(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements) {
@@ -123,36 +129,50 @@ class SoftDecaSurrogate {
 
   /// [expression weights, parameters] per row (N × inputs()).
   Eigen::MatrixXd join(const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions) const {
-    if (parameters.cols() != SoftDecaParameters::size || expressions.cols() != E_ || parameters.rows() != expressions.rows())
-      throw ShapeError("SoftDecaSurrogate: parameters (N x 20) and expressions (N x E)", {parameters.rows(), SoftDecaParameters::size + E_},
-                       {expressions.rows(), parameters.cols() + expressions.cols()});
+    check_pair(parameters, expressions);
     Eigen::MatrixXd x(parameters.rows(), inputs());
     x << expressions, parameters;
     return x;
   }
 
   /// Standardized network input of raw inputs (N × inputs()), as float.
-  nn::Matrix<float> standardize(const Eigen::MatrixXd& inputs_) const {
+  Matrix<float> standardize(const Eigen::MatrixXd& inputs_) const {
     check_inputs("standardize", inputs_);
     return ((inputs_.rowwise() - in_mean_.transpose()).array().rowwise() / in_scale_.transpose().array()).matrix().cast<float>();
   }
   /// Standardized displacements (the training target).
-  nn::Matrix<float> standardize_output(const Eigen::MatrixXd& displacements) const {
+  Matrix<float> standardize_output(const Eigen::MatrixXd& displacements) const {
     return ((displacements.rowwise() - out_mean_.transpose()) / out_scale_).cast<float>();
   }
 
-  /// Skin displacements (N × 3M, m, vertex-major) at the given parameters and expressions.
+  /// Skin displacements (N × 3M, m, vertex-major) at the given parameters and expressions, into
+  /// `displacements` (resized only when N changes: a warm call of the same N allocates nothing
+  /// but what the network's layers do).
+  template <exec::HostPolicy P>
+  void predict(P policy, const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions, Eigen::MatrixXd& displacements) {
+    check_pair(parameters, expressions);
+    if (!parameters.allFinite() || !expressions.allFinite()) throw ArgumentError("SoftDecaSurrogate::predict: non-finite input");
+    in_.resize(parameters.rows(), inputs());
+    const Index E = E_, K = scenario::SoftDecaParameters::size;
+    in_.leftCols(E) = ((expressions.rowwise() - in_mean_.head(E).transpose()).array().rowwise() / in_scale_.head(E).transpose().array())
+                          .matrix().cast<float>();
+    in_.rightCols(K) = ((parameters.rowwise() - in_mean_.tail(K).transpose()).array().rowwise() / in_scale_.tail(K).transpose().array())
+                           .matrix().cast<float>();
+    mlp_->forward(policy, Mode::eval, in_, out_);
+    displacements.resize(out_.rows(), out_.cols());
+    displacements.noalias() = (out_.cast<double>() * out_scale_).rowwise() + out_mean_.transpose();
+  }
   template <exec::HostPolicy P>
   Eigen::MatrixXd predict(P policy, const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions) {
-    const nn::Matrix<float> in = standardize(join(parameters, expressions));
-    mlp_->forward(policy, nn::Mode::eval, in, out_);
-    return (out_.cast<double>() * out_scale_).rowwise() + out_mean_.transpose();
+    Eigen::MatrixXd d;
+    predict(policy, parameters, expressions, d);
+    return d;
   }
 
   /// Writes the model (state tensors, standardization, dimensions, `meta`) atomically.
   void save(const std::filesystem::path& path, const nlohmann::ordered_json& meta = {}) const {
     io::NpzArrays z;
-    nn::add_state(z, *store_);
+    add_state(z, *store_);
     z["in_mean"] = io::make_npy(in_mean_);
     z["in_scale"] = io::make_npy(in_scale_);
     z["out_mean"] = io::make_npy(out_mean_);
@@ -171,17 +191,25 @@ class SoftDecaSurrogate {
     const auto j = nlohmann::json::parse(z.at("config").to_strings().at(0));
     if (j.value("kind", "") != "simsr softdeca surrogate") throw Error("SoftDecaSurrogate::load: " + path.string() + " is not a surrogate model");
     SoftDecaSurrogate s(j.at("expressions").get<Index>(), j.at("skin_vertices").get<Index>(), j.at("hidden").get<std::vector<Index>>(), 0);
-    nn::load_state(*s.store_, z);
+    load_state(*s.store_, z);
     s.in_mean_ = z.at("in_mean").to_matrix<double>().reshaped();
     s.in_scale_ = z.at("in_scale").to_matrix<double>().reshaped();
     s.out_mean_ = z.at("out_mean").to_matrix<double>().reshaped();
     s.out_scale_ = z.at("out_scale").item<double>();
     if (s.in_mean_.size() != s.inputs() || s.in_scale_.size() != s.inputs() || s.out_mean_.size() != 3 * s.M_)
       throw Error("SoftDecaSurrogate::load: " + path.string() + ": standardization arrays do not match the dimensions in its config");
+    if (!s.in_mean_.allFinite() || !s.out_mean_.allFinite() || !(s.in_scale_.array() > 0).all() || !(s.out_scale_ > 0))
+      throw Error("SoftDecaSurrogate::load: " + path.string() + ": standardization means must be finite and scales > 0");
     return s;
   }
 
  private:
+  void check_pair(const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions) const {
+    const Index K = scenario::SoftDecaParameters::size;
+    if (parameters.cols() != K || expressions.cols() != E_ || parameters.rows() != expressions.rows())
+      throw ShapeError("SoftDecaSurrogate: parameters (N x 20) and expressions (N x E)", {parameters.rows(), K + E_},
+                       {expressions.rows(), parameters.cols() + expressions.cols()});
+  }
   void check_inputs(const char* what, const Eigen::MatrixXd& x) const {
     if (x.cols() != inputs()) throw ShapeError(std::string("SoftDecaSurrogate::") + what + ": inputs", {x.rows(), inputs()}, {x.rows(), x.cols()});
     if (!x.allFinite()) throw ArgumentError(std::string("SoftDecaSurrogate::") + what + ": non-finite input");
@@ -190,11 +218,11 @@ class SoftDecaSurrogate {
   Index E_ = 0, M_ = 0;
   std::vector<Index> hidden_;
   // on the heap: the layers point into the store, and the surrogate is movable (load() returns one)
-  std::unique_ptr<nn::ParameterStore<float>> store_ = std::make_unique<nn::ParameterStore<float>>();
-  std::unique_ptr<nn::Mlp<float>> mlp_;
+  std::unique_ptr<ParameterStore<float>> store_ = std::make_unique<ParameterStore<float>>();
+  std::unique_ptr<Mlp<float>> mlp_;
   VecX<> in_mean_, in_scale_, out_mean_;
   double out_scale_ = 1;
-  nn::Matrix<float> out_;
+  Matrix<float> in_, out_;  // predict's buffers
 };
 
 /// Errors of one predictor on a set of samples (per skin vertex, Euclidean, m).
@@ -259,7 +287,7 @@ inline SurrogateErrors surrogate_errors(const Eigen::MatrixXd& pred, const Eigen
 /// Trains `net` on the first (1 − held_out) of `data`'s samples and reports (see the file
 /// comment). ArgumentError when fewer than 2 samples would be trained on or none held out.
 template <exec::HostPolicy P>
-SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const SoftDecaDataset& data, const SoftDecaSurrogateOptions& o, SoftDecaSurrogate& net) {
+SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const scenario::SoftDecaDataset& data, const SoftDecaSurrogateOptions& o, SoftDecaSurrogate& net) {
   const Index N = data.size();
   if (data.expressions.cols() != net.expressions() || data.skin_vertices() != net.skin_vertices())
     throw ShapeError("train_softdeca_surrogate: the network's expressions and skin vertices vs the dataset's", {net.expressions(), net.skin_vertices()},
@@ -282,13 +310,13 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const SoftDecaDataset
   const Eigen::MatrixXd Xtr = X.topRows(train), Xte = X.bottomRows(test);
   const Eigen::MatrixXd Ytr = data.displacements.topRows(train), Yte = data.displacements.bottomRows(test);
   net.fit_normalization(Xtr, Ytr);
-  const nn::Matrix<float> in = net.standardize(Xtr), target = net.standardize_output(Ytr);
+  const Matrix<float> in = net.standardize(Xtr), target = net.standardize_output(Ytr);
 
-  nn::Adam<float> adam(net.store(), {.lr = o.lr, .weight_decay = o.weight_decay});
-  nn::Rng rng(o.seed);
+  Adam<float> adam(net.store(), {.lr = o.lr, .weight_decay = o.weight_decay});
+  Rng rng(o.seed);
   std::vector<Index> order(static_cast<std::size_t>(fit));
   std::iota(order.begin(), order.end(), Index(0));
-  nn::Matrix<float> xb, yb, out, d_out, val_out;
+  Matrix<float> xb, yb, out, diff, d_out, val_out;
   const Index steps_per_epoch = (fit + o.batch - 1) / o.batch;
   std::vector<float> best(net.store().values().data(), net.store().values().data() + net.store().num_parameters());
   double best_loss = std::numeric_limits<double>::infinity();
@@ -306,16 +334,16 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const SoftDecaDataset
         yb.row(k) = target.row(order[std::size_t(b + k)]);
       }
       net.store().zero_grad();
-      net.mlp().forward(policy, nn::Mode::train, xb, out);
-      const nn::Matrix<float> diff = out - yb;
-      loss += double(nn::mean_square(policy, diff, &d_out)) * double(n);
+      net.mlp().forward(policy, Mode::train, xb, out);
+      diff.noalias() = out - yb;
+      loss += double(mean_square(policy, diff, &d_out)) * double(n);
       net.mlp().backward(policy, xb, out, d_out, nullptr);
       adam.step(policy);
     }
     r.loss.push_back(loss / double(fit));
     if (!std::isfinite(r.loss.back())) throw ConvergenceError("train_softdeca_surrogate (the loss is not finite)", epoch, r.loss.back());
     if (val > 0) {
-      net.mlp().forward(policy, nn::Mode::eval, in.bottomRows(val), val_out);
+      net.mlp().forward(policy, Mode::eval, in.bottomRows(val), val_out);
       const double v = double((val_out - target.bottomRows(val)).squaredNorm()) / double(val_out.size());
       r.validation_loss.push_back(v);
       if (v < best_loss) {
@@ -348,11 +376,12 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const SoftDecaDataset
   // speed: one sample at a time, as a solver would be asked
   {
     const Eigen::MatrixXd p1 = data.parameters.bottomRows(1), e1 = data.expressions.bottomRows(1);
-    net.predict(policy, p1, e1);  // warm-up: buffers sized
+    Eigen::MatrixXd d1;
+    net.predict(policy, p1, e1, d1);  // warm-up: buffers sized
     std::vector<double> times;
     for (int k = 0; k < 21; ++k) {
       const auto a = std::chrono::steady_clock::now();
-      net.predict(policy, p1, e1);
+      net.predict(policy, p1, e1, d1);
       times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count());
     }
     std::nth_element(times.begin(), times.begin() + 10, times.end());
@@ -362,4 +391,53 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const SoftDecaDataset
   return r;
 }
 
-}  // namespace simsr::scenario
+/// What `simsr train-surrogate` does: reads a datagen output (`data`: its directory or its
+/// softdeca_samples.npz), trains a surrogate of the given hidden widths and writes, atomically,
+/// OUT/surrogate.npz (the model, naming its data's fingerprint), OUT/surrogate_report.json (the
+/// report with the run's settings) and OUT/surrogate_loss.csv (training and validation loss per
+/// epoch). Returns the report's JSON. `say` gets a line at the start and every 25 epochs.
+template <exec::HostPolicy P>
+nlohmann::ordered_json train_softdeca_surrogate_files(P policy, const std::filesystem::path& data_path, const std::filesystem::path& out,
+                                                      const std::vector<Index>& hidden, SoftDecaSurrogateOptions o,
+                                                      const std::function<void(const std::string&)>& say = {}) {
+  const scenario::SoftDecaDataset data = scenario::read_softdeca_dataset(data_path);
+  const auto tell = [&](const std::string& line) {
+    if (say) say(line);
+  };
+  tell(std::to_string(data.size()) + " samples, " + std::to_string(data.skin_vertices()) + " skin vertices, " +
+       std::to_string(data.expressions.cols()) + " expressions");
+  SoftDecaSurrogate net(data.expressions.cols(), data.skin_vertices(), hidden, o.seed);
+  const auto user_progress = o.progress;
+  o.progress = [&](Index epoch, double loss) {
+    if (user_progress) user_progress(epoch, loss);
+    if (epoch == 0 || (epoch + 1) % 25 == 0 || epoch + 1 == o.epochs)
+      tell("epoch " + std::to_string(epoch + 1) + "/" + std::to_string(o.epochs) + " loss " + std::to_string(loss));
+  };
+  const SoftDecaSurrogateReport r = train_softdeca_surrogate(policy, data, o, net);
+  std::filesystem::create_directories(out);
+  net.save(out / "surrogate.npz", {{"data", data_path.string()}, {"data_fingerprint", data.fingerprint}});
+  nlohmann::ordered_json j = r.to_json();
+  j["data"] = data_path.string();
+  j["data_fingerprint"] = data.fingerprint;
+  j["hidden"] = hidden;
+  j["batch"] = o.batch;
+  j["lr"] = o.lr;
+  j["weight_decay"] = o.weight_decay;
+  j["seed"] = o.seed;
+  io::write_file_atomic(out / "surrogate_report.json", j.dump(2) + "\n");
+  std::string csv = "epoch,train_loss,validation_loss\n";
+  for (std::size_t e = 0; e < r.loss.size(); ++e) {
+    char row[96];
+    std::snprintf(row, sizeof row, "%zu,%.9g,", e + 1, r.loss[e]);  // validation loss after the comma, or empty
+    csv += row;
+    if (e < r.validation_loss.size()) {
+      std::snprintf(row, sizeof row, "%.9g", r.validation_loss[e]);
+      csv += row;
+    }
+    csv += '\n';
+  }
+  io::write_file_atomic(out / "surrogate_loss.csv", csv);
+  return j;
+}
+
+}  // namespace simsr::nn

@@ -1,8 +1,8 @@
-// SoftDECA's surrogate (scenario/softdeca/surrogate.hpp) on a synthetic dataset whose skin
+// SoftDECA's surrogate (nn/softdeca_surrogate.hpp) on a synthetic dataset whose skin
 // displacement is a known nonlinear function of the inputs (products and a saturation that no
 // linear map reproduces): it learns what ridge cannot, on samples it never saw; a saved model
 // predicts the same; shapes and options are checked.
-#include <simsr/scenario/softdeca/surrogate.hpp>
+#include <simsr/nn/softdeca_surrogate.hpp>
 
 #include <doctest/doctest.h>
 
@@ -10,10 +10,12 @@
 #include <filesystem>
 #include <random>
 
-namespace scenario_test_softdeca_surrogate {
+namespace nn_test_softdeca_surrogate {
 
 using namespace simsr;
-using namespace simsr::scenario;
+using scenario::SoftDecaDataset;
+using scenario::SoftDecaParameters;
+using scenario::sample_softdeca_parameters;
 
 /// N samples over E = 2 expressions and M skin vertices: parameters drawn by the real sampler,
 /// displacement of vertex v = e_v · (w_bulge · tanh(2 g_y) + 0.5 · w_lift · (s_x − 1)(s_y − 1)·4
@@ -44,13 +46,16 @@ SoftDecaDataset synthetic(Index N, Index M, std::uint64_t seed) {
   return d;
 }
 
-}  // namespace scenario_test_softdeca_surrogate
+}  // namespace nn_test_softdeca_surrogate
 
 using namespace simsr;
-using namespace simsr::scenario;
+using nn::SoftDecaSurrogate;
+using nn::SoftDecaSurrogateReport;
+using nn::train_softdeca_surrogate;
+using scenario::SoftDecaDataset;
 
 TEST_CASE("SoftDecaSurrogate learns a nonlinear parameter-to-skin map on held-out samples, beyond ridge and the mean") {
-  const SoftDecaDataset data = scenario_test_softdeca_surrogate::synthetic(300, 12, 3);
+  const SoftDecaDataset data = nn_test_softdeca_surrogate::synthetic(300, 12, 3);
   SoftDecaSurrogate net(2, 12, {64, 64}, 5);
   const SoftDecaSurrogateReport r =
       train_softdeca_surrogate(exec::omp, data, {.epochs = 300, .batch = 16, .lr = 3e-3, .held_out = 0.2, .validation = 0.15, .weight_decay = 1e-3}, net);
@@ -85,7 +90,7 @@ TEST_CASE("SoftDecaSurrogate learns a nonlinear parameter-to-skin map on held-ou
 }
 
 TEST_CASE("SoftDecaSurrogate: shapes, options and files are checked") {
-  const SoftDecaDataset data = scenario_test_softdeca_surrogate::synthetic(20, 4, 1);
+  const SoftDecaDataset data = nn_test_softdeca_surrogate::synthetic(20, 4, 1);
   SoftDecaSurrogate other(3, 4, {8}, 1);  // 3 expressions, the data has 2
   CHECK_THROWS_AS(train_softdeca_surrogate(exec::seq, data, {}, other), ShapeError);
   SoftDecaSurrogate net(2, 4, {8}, 1);
