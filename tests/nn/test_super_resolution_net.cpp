@@ -121,7 +121,10 @@ TEST_CASE("nn::SuperResolutionNet official: 706,871 parameters under the officia
   CHECK(maxabs("net_decoder.decoder.layers.1.fc.weight") > 0.9 * std::sqrt(6.0 / 256));
 }
 
-TEST_CASE("nn::SuperResolutionNet: whole-network gradients match finite differences (official, paper, ablations)") {
+// exec::seq throughout: the TSan build leaves it out (tests/CMakeLists.txt, "single-threaded");
+// the next case checks omp against seq bitwise.
+TEST_CASE("nn::SuperResolutionNet: whole-network gradients match finite differences (official, paper, ablations)" *
+          doctest::test_suite("single-threaded")) {
   nn::NetworkConfig cfg = test::tiny_config(nn::NetworkConfig::official());
   SUBCASE("official, B = 2") { check_net_gradients(cfg, 2, 2e-5, 11); }
   SUBCASE("paper, B = 1") { check_net_gradients(test::tiny_config(nn::NetworkConfig::paper()), 1, 2e-5, 12); }
