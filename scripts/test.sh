@@ -8,7 +8,7 @@
 #                   interp's, pipeline's and scenario's files the sanitizer builds leave out (the
 #                   libgomp allocation checks; the demo, animate and ablation runs; the SoftDECA
 #                   template from the kit),
-#                   test_threads, the tool and examples, the fuzz-corpus replays, the peers (gmsh,
+#                   test_threads, the tool and examples, the peers (gmsh,
 #                   meshio, numpy, scipy, torch), install + consumer project, compile-fail checks,
 #                   cuda-compile, and each benchmark compiled (clang syntax only, a ctest each: none
 #                   is built or run here; -DSIMSR_BUILD_BENCHMARKS=ON builds them)
