@@ -36,6 +36,9 @@
 // the head first: minutes)
 #include <benchmark/benchmark.h>
 
+#if defined(SIMSR_HAVE_CHOLMOD)
+#include <simsr/physics/linear_solvers/cholmod_cholesky.hpp>
+#endif
 #include <simsr/scenario/softdeca/ict_template.hpp>
 #include <simsr/scenario/softdeca/softdeca_simulator.hpp>
 #include <simsr/scenario/softdeca/sphere_template.hpp>
@@ -45,15 +48,23 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 using namespace simsr;
 using namespace simsr::scenario;
 
 namespace {
 
+/// The simulator with Eigen's simplicial LDLᵀ and, where built with CHOLMOD, with CHOLMOD's
+/// supernodal LLᵀ (the *_cholmod cases).
+#if defined(SIMSR_HAVE_CHOLMOD)
+using CholmodSimulator = BasicSoftDecaSimulator<physics::CholmodCholesky<>>;
+#endif
+
+template <class Sim = SoftDecaSimulator>
 struct Scene {
   std::unique_ptr<SoftDecaTemplate> tpl;
-  std::unique_ptr<SoftDecaSimulator> sim;
+  std::unique_ptr<Sim> sim;
   SoftDecaParameters params;
   VecX<> expression;
   Points<> settled;  ///< the individual at rest (the frame's start)
@@ -61,24 +72,29 @@ struct Scene {
 };
 
 /// Skips the case (with the setup's error) when the scene could not be set up; true then.
-bool skipped(benchmark::State& state, const Scene& s) {
+template <class Sim>
+bool skipped(benchmark::State& state, const Scene<Sim>& s) {
   if (s.error.empty()) return false;
   state.SkipWithError(s.error.c_str());
   return true;
 }
 
-Scene& scene(const std::string& name) {
-  static std::map<std::string, Scene> scenes;
+/// The scene `name` for simulator Sim. The settle is local-global with the simplicial
+/// factorization (Newton would refactor the 3V×3V matrix every iteration) and Newton with CHOLMOD.
+template <class Sim = SoftDecaSimulator>
+Scene<Sim>& scene(const std::string& name) {
+  static std::map<std::string, Scene<Sim>> scenes;
   auto it = scenes.find(name);
   if (it != scenes.end()) return it->second;
-  Scene s;
+  Scene<Sim> s;
   if (name == "bouaziz_49k") {
     s.tpl = std::make_unique<SoftDecaTemplate>(sphere_softdeca_template(exec::omp, 4, 3));
   } else {
     const auto kit = read_ict_kit(std::filesystem::path(SIMSR_DATA_DIR) / "ict_face");
     s.tpl = std::make_unique<SoftDecaTemplate>(softdeca_template(exec::omp, kit));
   }
-  s.sim = std::make_unique<SoftDecaSimulator>(*s.tpl);
+  s.sim = std::make_unique<Sim>(*s.tpl);
+  const SoftDecaSimulationOptions settle_options{.solver = std::is_same_v<Sim, SoftDecaSimulator> ? SoftDecaSolver::local_global : SoftDecaSolver::newton};
   s.params = sample_softdeca_parameters(1, 0);
   s.params.cranium_scale = s.params.jaw_scale = Vec3<>::Ones();
   s.expression = VecX<>::Zero(Index(s.tpl->expression_names.size()));
@@ -86,27 +102,29 @@ Scene& scene(const std::string& name) {
   s.sim->prepare(s.params);
   Index its = 0;
   try {
-    its = s.sim->settle(exec::omp, s.settled);
+    its = s.sim->settle(exec::omp, s.settled, settle_options);
     s.sim->factor_step(exec::omp);
   } catch (const Error& e) {  // the ICT head's settle did not converge in 5,000 iterations (README)
     s.error = std::string("setting up ") + name + ": " + e.what();
     std::fprintf(stderr, "bench_softdeca: %s\n", s.error.c_str());
   }
-  std::fprintf(stderr, "bench_softdeca: %s: %lld vertices (%lld DOFs), %lld tets; settled in %lld local-global iterations\n", name.c_str(),
+  std::fprintf(stderr, "bench_softdeca: %s: %lld vertices (%lld DOFs), %lld tets; settled in %lld %s iterations\n", name.c_str(),
                static_cast<long long>(s.tpl->head.mesh.num_vertices()), static_cast<long long>(3 * s.tpl->head.mesh.num_vertices()),
-               static_cast<long long>(s.tpl->head.mesh.num_tets()), static_cast<long long>(its));
+               static_cast<long long>(s.tpl->head.mesh.num_tets()), static_cast<long long>(its),
+               settle_options.solver == SoftDecaSolver::newton ? "Newton (CHOLMOD)" : "local-global");
   return scenes.emplace(name, std::move(s)).first->second;
 }
 
-void sizes(benchmark::State& state, const Scene& s) {
+template <class Sim>
+void sizes(benchmark::State& state, const Scene<Sim>& s) {
   state.counters["dofs"] = double(3 * s.tpl->head.mesh.num_vertices());
   state.counters["tets"] = double(s.tpl->head.mesh.num_tets());
 }
 
 /// One implicit step from the settled individual to the expression, to the solver's tolerance.
-template <class P>
+template <class Sim = SoftDecaSimulator, class P>
 void BM_softdeca_frame(benchmark::State& state, const std::string& name, SoftDecaSolver solver, P policy) {
-  Scene& s = scene(name);
+  auto& s = scene<Sim>(name);
   if (skipped(state, s)) return;
   const SoftDecaSimulationOptions o{.solver = solver, .steps = 1};
   Index its = 0;
@@ -127,7 +145,7 @@ void BM_softdeca_frame(benchmark::State& state, const std::string& name, SoftDec
 /// The local step: every term's gradient (projections per element, in parallel under P).
 template <class P>
 void BM_softdeca_local_step(benchmark::State& state, const std::string& name, P policy) {
-  Scene& s = scene(name);
+  auto& s = scene(name);
   if (skipped(state, s)) return;
   Points<> g(s.settled.rows(), 3);
   for (auto _ : state) {
@@ -141,7 +159,7 @@ void BM_softdeca_local_step(benchmark::State& state, const std::string& name, P 
 /// unit step) or as a line-search trial's energy and then the gradient at the accepted point.
 template <class P>
 void BM_softdeca_energy_gradient(benchmark::State& state, const std::string& name, P policy, bool fused) {
-  Scene& s = scene(name);
+  auto& s = scene(name);
   if (skipped(state, s)) return;
   Points<> g(s.settled.rows(), 3);
   for (auto _ : state) {
@@ -158,23 +176,25 @@ void BM_softdeca_energy_gradient(benchmark::State& state, const std::string& nam
 
 /// For the span of a case, the step solver factors the #V×#V matrix (`reduced`) or the 3V×3V
 /// one; afterwards the scene is back to the reduced factorization the other cases use.
+template <class Sim>
 class Reduction {
  public:
-  Reduction(Scene& s, bool reduced) : s_(s) { s_.sim->step_solver().options().isotropic_reduction = reduced; }
+  Reduction(Scene<Sim>& s, bool reduced) : s_(s) { s_.sim->step_solver().options().isotropic_reduction = reduced; }
   ~Reduction() {
     s_.sim->step_solver().options().isotropic_reduction = true;
     s_.sim->factor_step(exec::omp);
   }
 
  private:
-  Scene& s_;
+  Scene<Sim>& s_;
 };
 
 /// The global step: one solve with the prefactored matrix, reduced (#V×#V, three solves) or full (3V×3V).
+template <class Sim = SoftDecaSimulator>
 void BM_softdeca_global_step(benchmark::State& state, const std::string& name, bool reduced) {
-  Scene& s = scene(name);
+  auto& s = scene<Sim>(name);
   if (skipped(state, s)) return;
-  const Reduction as_asked(s, reduced);
+  const Reduction<Sim> as_asked(s, reduced);
   s.sim->factor_step(exec::omp);
   if (s.sim->step_solver().reduced() != reduced) {
     state.SkipWithError("the global matrix was not reduced as asked");
@@ -192,10 +212,11 @@ void BM_softdeca_global_step(benchmark::State& state, const std::string& name, b
 }
 
 /// Assembling and factoring the global matrix (once per weight set), reduced or full.
+template <class Sim = SoftDecaSimulator>
 void BM_softdeca_factor(benchmark::State& state, const std::string& name, bool reduced) {
-  Scene& s = scene(name);
+  auto& s = scene<Sim>(name);
   if (skipped(state, s)) return;
-  const Reduction as_asked(s, reduced);
+  const Reduction<Sim> as_asked(s, reduced);
   for (auto _ : state) s.sim->factor_step(exec::omp);
   sizes(state, s);
 }
@@ -229,5 +250,34 @@ void BM_softdeca_factor(benchmark::State& state, const std::string& name, bool r
 SIMSR_SOFTDECA_LOCAL_GLOBAL_CASES(bouaziz_49k)
 SIMSR_SOFTDECA_FULL_MATRIX_CASES(bouaziz_49k)
 SIMSR_SOFTDECA_LOCAL_GLOBAL_CASES(ict_template)
+
+#if defined(SIMSR_HAVE_CHOLMOD)
+// CHOLMOD's supernodal LLᵀ in place of the simplicial LDLᵀ (built with -DSIMSR_WITH_CHOLMOD=ON):
+// the factorizations both ways, the global step, and both solvers' frames, on the ball and on
+// the ICT head (whose scene settles by Newton here).
+namespace {
+// (BENCHMARK_CAPTURE names a variable after the function: no template arguments there)
+void BM_softdeca_factor_cholmod(benchmark::State& state, const std::string& name, bool reduced) { BM_softdeca_factor<CholmodSimulator>(state, name, reduced); }
+void BM_softdeca_global_step_cholmod(benchmark::State& state, const std::string& name, bool reduced) {
+  BM_softdeca_global_step<CholmodSimulator>(state, name, reduced);
+}
+void BM_softdeca_frame_cholmod(benchmark::State& state, const std::string& name, SoftDecaSolver solver) {
+  BM_softdeca_frame<CholmodSimulator>(state, name, solver, exec::omp);
+}
+}  // namespace
+#define SIMSR_SOFTDECA_CHOLMOD_CASES(scene_name)                                                                                             \
+  BENCHMARK_CAPTURE(BM_softdeca_factor_cholmod, scene_name##_reduced_cholmod, std::string(#scene_name), true)                     \
+      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);                                                                         \
+  BENCHMARK_CAPTURE(BM_softdeca_factor_cholmod, scene_name##_full_cholmod, std::string(#scene_name), false)                      \
+      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);                                                                         \
+  BENCHMARK_CAPTURE(BM_softdeca_global_step_cholmod, scene_name##_reduced_cholmod, std::string(#scene_name), true)               \
+      ->Unit(benchmark::kMillisecond)->UseRealTime();                                                                                        \
+  BENCHMARK_CAPTURE(BM_softdeca_frame_cholmod, scene_name##_local_global_cholmod_omp, std::string(#scene_name), SoftDecaSolver::local_global) \
+      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);                                                                         \
+  BENCHMARK_CAPTURE(BM_softdeca_frame_cholmod, scene_name##_newton_cholmod_omp, std::string(#scene_name), SoftDecaSolver::newton)         \
+      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+SIMSR_SOFTDECA_CHOLMOD_CASES(bouaziz_49k)
+SIMSR_SOFTDECA_CHOLMOD_CASES(ict_template)
+#endif
 
 BENCHMARK_MAIN();

@@ -75,7 +75,7 @@ run_ctest() {
 }
 
 # 1. the normal build
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON -DSIMSR_WITH_CHOLMOD=ON
 cmake --build "$build" -j "$jobs"
 step "build ($build)"
 run_ctest "$build"
@@ -87,7 +87,7 @@ for kind in asan tsan; do
   dir=$asan
   [[ $kind == tsan ]] && dir=$tsan
   cmake -S . -B "$dir" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug -DSIMSR_SANITIZE=$kind \
-    -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_BUILD_EXAMPLES=OFF >/dev/null
+    -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_BUILD_EXAMPLES=OFF -DSIMSR_WITH_CHOLMOD=ON >/dev/null
   cmake --build "$dir" -j "$jobs"
   step "build ($dir)"
   run_ctest "$dir"

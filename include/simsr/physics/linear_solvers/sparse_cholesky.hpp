@@ -70,12 +70,7 @@ class SparseCholesky {
     if (!A_) throw Error("SparseCholesky::solve called before compute");
     if (b.size() != rows_) throw ShapeError("SparseCholesky: right-hand side", {rows_}, {b.size()});
     x = ldlt_->solve(b);
-    LinearSolveInfo info;
-    const S bn = b.norm();
-    sparse_multiply(policy, *A_, x, Ax_);  // into a kept buffer: no allocation per Newton iteration
-    info.relative_residual = bn > S(0) ? double((b - Ax_).norm() / bn) : 0.0;
-    info.converged = std::isfinite(info.relative_residual);
-    return info;
+    return detail::direct_solve_info(policy, *A_, b, x, Ax_);
   }
 
  private:

@@ -5,6 +5,7 @@
 /// omp give bitwise identical results), and a sparse·sparse product that reuses its structure.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "../../core/error.hpp"
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
+#include "linear_solver.hpp"
 
 namespace simsr::physics {
 
@@ -134,5 +136,21 @@ class SparseProduct {
   std::vector<VecX<S>> scratch_;
   std::uint64_t version_ = 0;
 };
+
+namespace detail {
+/// What a direct solver's solve reports: the relative residual ‖b − A x‖ / ‖b‖ computed under the
+/// policy into the kept buffer Ax (no allocation per Newton iteration); converged when finite
+/// and `factored` (the factorization's own success).
+template <exec::HostPolicy P, class S, class StorageIndex>
+LinearSolveInfo direct_solve_info(P policy, const Eigen::SparseMatrix<S, Eigen::RowMajor, StorageIndex>& A, const VecX<S>& b, const VecX<S>& x,
+                                  VecX<S>& Ax, bool factored = true) {
+  LinearSolveInfo info;
+  const S bn = b.norm();
+  sparse_multiply(policy, A, x, Ax);
+  info.relative_residual = bn > S(0) ? double((b - Ax).norm() / bn) : 0.0;
+  info.converged = factored && std::isfinite(info.relative_residual);
+  return info;
+}
+}  // namespace detail
 
 }  // namespace simsr::physics

@@ -78,12 +78,16 @@ struct SoftDecaResult {
 };
 
 /// The layered template's terms, built once and re-weighted per sample (see the file comment).
-class SoftDecaSimulator {
+/// `Linear` factors both solvers' matrices: physics::SparseCholesky (Eigen's simplicial LDLᵀ, the
+/// default) or, built with CHOLMOD, physics::CholmodCholesky (supernodal: what Newton needs at the
+/// ICT template's size). SoftDecaSimulator is the default.
+template <class Linear = physics::SparseCholesky<>>
+class BasicSoftDecaSimulator {
  public:
   using StrainEnergy = physics::ElasticEnergy<physics::StrainLimit<>>;
   using VolumeEnergy = physics::ElasticEnergy<physics::VolumeTarget<>>;
 
-  explicit SoftDecaSimulator(const SoftDecaTemplate& tpl, SoftDecaStiffness k = {})
+  explicit BasicSoftDecaSimulator(const SoftDecaTemplate& tpl, SoftDecaStiffness k = {})
       : tpl_(tpl),
         k_(k),
         n_(tpl.head.mesh.num_vertices()),
@@ -204,7 +208,7 @@ class SoftDecaSimulator {
   }
 
   /// The step solver (local-global), for timing its parts: its factor() and apply_inverse().
-  physics::LocalGlobalSolver<>& step_solver() { return step_; }
+  physics::LocalGlobalSolver<Linear>& step_solver() { return step_; }
   const physics::DirichletBoundary<>& boundary() const { return bones_; }
   /// Σ terms' gradients at x into g (#V×3): the local step of one local-global iteration.
   template <exec::HostPolicy P>
@@ -290,7 +294,7 @@ class SoftDecaSimulator {
     if (w.size() != tpl_.expression_deltas.rows()) throw ShapeError("SoftDecaSimulator: expression weights", {tpl_.expression_deltas.rows()}, {w.size()});
   }
   template <class P>
-  Index solve(P policy, physics::LocalGlobalSolver<>& pd, Points<>& x, const SoftDecaSimulationOptions& o) {
+  Index solve(P policy, physics::LocalGlobalSolver<Linear>& pd, Points<>& x, const SoftDecaSimulationOptions& o) {
     const physics::DirichletBoundary<>& bones = bones_;
     if (o.solver == SoftDecaSolver::newton) {
       newton_.options().relative_tolerance = o.relative_tolerance;
@@ -313,12 +317,15 @@ class SoftDecaSimulator {
   physics::VertexTargets<> distances_;
   physics::Gravity<> gravity_;
   physics::ImplicitInertia<> inertia_;
-  physics::LocalGlobalSolver<> settle_, step_;
-  physics::QuasistaticSolver<> newton_;
+  physics::LocalGlobalSolver<Linear> settle_, step_;
+  physics::QuasistaticSolver<Linear> newton_;
   VecX<> skin_area_, distance_area_;
   SoftDecaParameters p_;
   physics::DirichletBoundary<> bones_;
   std::vector<VIndex> loose_;
 };
+
+/// The simulator with Eigen's simplicial LDLᵀ (no optional dependency).
+using SoftDecaSimulator = BasicSoftDecaSimulator<>;
 
 }  // namespace simsr::scenario
