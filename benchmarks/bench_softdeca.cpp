@@ -31,6 +31,10 @@
 //                                                  the 3V×3V one (isotropic_reduction off)
 //   BM_softdeca_factor/<scene>/<reduced|full>      assembling and factoring the global matrix
 //                                                  (once per weight set), both ways
+//   BM_softdeca_*_cholmod/<scene>_…_cholmod        with -DSIMSR_WITH_CHOLMOD=ON: the same with
+//                                                  CHOLMOD's supernodal LLᵀ (factorizations, global
+//                                                  step) and both solvers' frames; these scenes
+//                                                  settle by Newton (CHOLMOD makes it affordable)
 //
 // Run: build/benchmarks/bench_softdeca [--benchmark_filter=bouaziz] (the ICT scene's setup settles
 // the head first: minutes)
