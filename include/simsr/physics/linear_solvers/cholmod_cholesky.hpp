@@ -57,13 +57,7 @@ class CholmodCholesky {
       llt_ = std::make_unique<Factorization>();
       llt_->cholmod().print = 0;  // failures are this class's typed errors, not CHOLMOD's printout
     }
-    if (!analyzed_ || pattern_version != version_ || A.rows() != rows_ || A.nonZeros() != nnz_) {
-      llt_->analyzePattern(Ac_);
-      analyzed_ = true;
-      version_ = pattern_version;
-      rows_ = A.rows();
-      nnz_ = A.nonZeros();
-    }
+    if (pattern_.changed(A, pattern_version)) llt_->analyzePattern(Ac_);
     llt_->factorize(Ac_);
     if (llt_->info() != Eigen::Success)
       throw ConvergenceError("CholmodCholesky (CHOLMOD's LLT: the matrix is not positive definite)", 0, std::numeric_limits<double>::quiet_NaN());
@@ -74,7 +68,7 @@ class CholmodCholesky {
   template <exec::HostPolicy P>
   LinearSolveInfo solve(P policy, const VecX<S>& b, VecX<S>& x) {
     if (!A_) throw Error("CholmodCholesky::solve called before compute");
-    if (b.size() != rows_) throw ShapeError("CholmodCholesky: right-hand side", {rows_}, {b.size()});
+    if (b.size() != pattern_.rows) throw ShapeError("CholmodCholesky: right-hand side", {pattern_.rows}, {b.size()});
     x = llt_->solve(b);
     return detail::direct_solve_info(policy, *A_, b, x, Ax_, llt_->info() == Eigen::Success);
   }
@@ -93,9 +87,7 @@ class CholmodCholesky {
   Eigen::SparseMatrix<S, Eigen::ColMajor, int> Ac_;
   const SparseMatrix<S>* A_ = nullptr;
   VecX<S> Ax_;
-  bool analyzed_ = false;
-  std::uint64_t version_ = 0;
-  Index rows_ = 0, nnz_ = 0;
+  detail::AnalysedPattern pattern_;
 };
 
 }  // namespace simsr::physics

@@ -47,13 +47,7 @@ class SparseCholesky {
     const Eigen::Map<const Eigen::SparseMatrix<S, Eigen::ColMajor, int>> Ac(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(),
                                                                           A.innerIndexPtr(), A.valuePtr());
     if (!ldlt_) ldlt_ = std::make_unique<Factorization>();
-    if (!analyzed_ || pattern_version != version_ || A.rows() != rows_ || A.nonZeros() != nnz_) {
-      ldlt_->analyzePattern(Ac);
-      analyzed_ = true;
-      version_ = pattern_version;
-      rows_ = A.rows();
-      nnz_ = A.nonZeros();
-    }
+    if (pattern_.changed(A, pattern_version)) ldlt_->analyzePattern(Ac);
     if (relative_shift_ != 0) ldlt_->setShift(S(relative_shift_) * A.diagonal().cwiseAbs().maxCoeff());
     ldlt_->factorize(Ac);
     if (ldlt_->info() != Eigen::Success)
@@ -68,7 +62,7 @@ class SparseCholesky {
   template <exec::HostPolicy P>
   LinearSolveInfo solve(P policy, const VecX<S>& b, VecX<S>& x) {
     if (!A_) throw Error("SparseCholesky::solve called before compute");
-    if (b.size() != rows_) throw ShapeError("SparseCholesky: right-hand side", {rows_}, {b.size()});
+    if (b.size() != pattern_.rows) throw ShapeError("SparseCholesky: right-hand side", {pattern_.rows}, {b.size()});
     x = ldlt_->solve(b);
     return detail::direct_solve_info(policy, *A_, b, x, Ax_);
   }
@@ -80,9 +74,7 @@ class SparseCholesky {
   std::unique_ptr<Factorization> ldlt_;
   const SparseMatrix<S>* A_ = nullptr;
   VecX<S> Ax_;
-  bool analyzed_ = false;
-  std::uint64_t version_ = 0;
-  Index rows_ = 0, nnz_ = 0;
+  detail::AnalysedPattern pattern_;
   double relative_shift_ = 0;
 };
 

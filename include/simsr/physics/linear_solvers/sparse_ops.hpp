@@ -138,6 +138,24 @@ class SparseProduct {
 };
 
 namespace detail {
+/// The pattern a direct solver last analysed (SparseCholesky, CholmodCholesky): the symbolic
+/// analysis is redone only when the caller's pattern version, the size or the nonzero count changes.
+struct AnalysedPattern {
+  bool analysed = false;
+  std::uint64_t version = 0;
+  Index rows = 0, nonzeros = 0;
+  /// True when A's pattern is not the one analysed last, which it then records.
+  template <class Matrix>
+  bool changed(const Matrix& A, std::uint64_t pattern_version) {
+    if (analysed && pattern_version == version && A.rows() == rows && A.nonZeros() == nonzeros) return false;
+    analysed = true;
+    version = pattern_version;
+    rows = A.rows();
+    nonzeros = A.nonZeros();
+    return true;
+  }
+};
+
 /// What a direct solver's solve reports: the relative residual ‖b − A x‖ / ‖b‖ computed under the
 /// policy into the kept buffer Ax (no allocation per Newton iteration); converged when finite
 /// and `factored` (the factorization's own success).
