@@ -8,7 +8,8 @@
 #                          clang builds need: clang, libclang-rt-dev (ASan, UBSan, TSan, libFuzzer),
 #                          libomp-dev (LLVM's OpenMP and its Archer tool, libarcher.so, for TSan) and
 #                          llvm (llvm-symbolizer: sanitizer reports with file and line); libsuitesparse-dev
-#                          (CHOLMOD, the optional physics::CholmodCholesky, whose tests run there)
+#                          (CHOLMOD, the optional physics::CholmodCholesky, whose tests run there) and
+#                          libcgal-dev (CGAL, the optional isotropic_remesh and remeshed SoftDECA template)
 # Needs root (or sudo) only when something is missing.
 set -euo pipefail
 job=${1:-test}
@@ -21,7 +22,7 @@ pkgs=(build-essential cmake ninja-build
 # its own npm and conflicts with Debian's (apt then refuses: "nodejs : Conflicts: npm").
 command -v npm >/dev/null || pkgs+=(npm)
 if [[ $job == test ]]; then
-  pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium libsuitesparse-dev)
+  pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium libsuitesparse-dev libcgal-dev)
 fi
 
 missing=()

@@ -75,7 +75,7 @@ run_ctest() {
 }
 
 # 1. the normal build
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON -DSIMSR_WITH_CHOLMOD=ON
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON -DSIMSR_WITH_CHOLMOD=ON -DSIMSR_WITH_CGAL=ON
 cmake --build "$build" -j "$jobs"
 step "build ($build)"
 run_ctest "$build"

@@ -8,13 +8,22 @@
 // --no-unseen-forces skips them).
 //
 // `simsr datagen --scenario softdeca --samples N --out DIR [--template ict|sphere] [--layers L]
-//  [--sphere-level K] [--seed S] [--steps K] [--solver local_global|newton] [--active-expressions A]`:
+//  [--sphere-level K] [--seed S] [--steps K] [--solver local_global|newton] [--active-expressions A]
+//  [--skin-edge CM] [--linear-solver simplicial|cholmod]`:
 // SoftDECA's layered head template (from the same kit, or the sphere stand-in of
 // scenario/softdeca/sphere_template.hpp), N sampled parameter sets and expressions simulated on it
-// (scenario/softdeca/softdeca_datagen.hpp), resumable, a progress line per sample.
+// (scenario/softdeca/softdeca_datagen.hpp), resumable, a progress line per sample. --skin-edge
+// remeshes the kit's outer wrap to that edge length first (needs a build with CGAL);
+// --linear-solver cholmod factors with CHOLMOD (needs a build with it).
 #include <simsr/scenario/scenario.hpp>
 #include <simsr/scenario/softdeca/softdeca_datagen.hpp>
 #include <simsr/scenario/softdeca/sphere_template.hpp>
+#if defined(SIMSR_HAVE_CGAL)
+#include "remeshed_wrap.hpp"
+#endif
+#if defined(SIMSR_HAVE_CHOLMOD)
+#include <simsr/physics/linear_solvers/cholmod_cholesky.hpp>
+#endif
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -41,8 +50,22 @@ struct DatagenArgs {
   // softdeca
   Index samples = 100, layers = 1, steps = 6, sphere_level = 3;
   std::optional<Index> active_expressions;
-  std::string solver = "local_global", softdeca_template = "ict";
+  std::string solver = "local_global", softdeca_template = "ict", linear_solver = "simplicial";
+  double skin_edge = 0;
 };
+
+/// The dataset with the linear solver --linear-solver names.
+template <class Template>
+nlohmann::ordered_json softdeca_dataset_with(const DatagenArgs& a, const Template& tpl, const std::string& name, const scenario::SoftDecaDatagenOptions& o,
+                                             const std::function<void(const std::string&)>& say) {
+  if (a.linear_solver == "simplicial") return scenario::generate_softdeca_dataset(exec::omp, tpl, name, o, a.out, say);
+  if (a.linear_solver != "cholmod") throw ArgumentError("--linear-solver: simplicial or cholmod (got '" + a.linear_solver + "')");
+#if defined(SIMSR_HAVE_CHOLMOD)
+  return scenario::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<physics::CholmodCholesky<>>>(exec::omp, tpl, name, o, a.out, say);
+#else
+  throw ArgumentError("--linear-solver cholmod: this simsr was built without CHOLMOD (configure with -DSIMSR_WITH_CHOLMOD=ON)");
+#endif
+}
 
 inline int datagen_softdeca(const DatagenArgs& a) {
   scenario::SoftDecaDatagenOptions o;
@@ -59,12 +82,27 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   if (a.softdeca_template == "ict") {
     scenario::SoftDecaTemplateOptions t;
     t.head.layers = a.layers;
+    const scenario::IctKit kit = scenario::read_ict_kit(a.kit);
+    scenario::IctOuterWrap wrap;
+    std::string name = "ict";
+    if (a.skin_edge > 0) {
+#if defined(SIMSR_HAVE_CGAL)
+      say("remeshing the kit's outer wrap to " + std::to_string(a.skin_edge) + " cm edges");
+      wrap = remeshed_outer_wrap(kit, a.skin_edge);
+      name = "ict remeshed to " + std::to_string(a.skin_edge) + " cm";
+#else
+      throw ArgumentError("--skin-edge: this simsr was built without CGAL (configure with -DSIMSR_WITH_CGAL=ON)");
+#endif
+    } else {
+      wrap = scenario::ict_outer_wrap(exec::omp, kit);
+    }
     say("building the layered template from " + a.kit + " (" + std::to_string(a.layers) + " layer(s) per shell)");
-    const scenario::IctTemplate tpl = scenario::softdeca_template(exec::omp, scenario::read_ict_kit(a.kit), t);
-    j = scenario::generate_softdeca_dataset(exec::omp, tpl, "ict", o, a.out, say);
+    const scenario::IctTemplate tpl = scenario::softdeca_template(exec::omp, kit, wrap, t);
+    j = softdeca_dataset_with(a, tpl, name, o, say);
   } else if (a.softdeca_template == "sphere") {
+    if (a.skin_edge > 0) throw ArgumentError("--skin-edge: only for --template ict (the sphere's resolution is --sphere-level)");
     const scenario::SoftDecaTemplate tpl = scenario::sphere_softdeca_template(exec::omp, a.sphere_level, a.layers);
-    j = scenario::generate_softdeca_dataset(exec::omp, tpl, "sphere level " + std::to_string(a.sphere_level), o, a.out, say);
+    j = softdeca_dataset_with(a, tpl, "sphere level " + std::to_string(a.sphere_level), o, say);
   } else {
     throw ArgumentError("--template: ict or sphere (got '" + a.softdeca_template + "')");
   }
@@ -115,6 +153,10 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--solver", a->solver, "softdeca: local_global (projective dynamics) or newton")->capture_default_str();
   cmd->add_option("--active-expressions", a->active_expressions, "softdeca: expressions mixed per sample (default 3, or all of a template with fewer)")
       ->check(CLI::Range(0, 100000));
+  cmd->add_option("--skin-edge", a->skin_edge, "softdeca --template ict: remesh the kit's outer wrap to this edge length in cm (0: the kit's triangles; needs CGAL)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--linear-solver", a->linear_solver, "softdeca: simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD)")->capture_default_str();
   cmd->add_option("--template", a->softdeca_template, "softdeca: ict (the layered head from --kit) or sphere (the stand-in ball with two expressions)")
       ->capture_default_str();
   cmd->add_option("--sphere-level", a->sphere_level, "softdeca --template sphere: icosphere level of the ball (2: 162 skin vertices, 3: 642)")

@@ -3,7 +3,9 @@
 /// SoftDECA's layered head template from the ICT face kit (softdeca supplement §3), in metres:
 ///
 ///  1. Outer wrap: the kit's closed head surface (skin + mouth and eye sockets, head_surface.hpp)
-///     without the neck cap, at the kit's neutral: open only at the neck cut.
+///     without the neck cap, at the kit's neutral: open only at the neck cut. Either the kit's own
+///     triangles (ict_outer_wrap) or those remeshed to one edge length (remeshed_wrap.hpp), the
+///     template's surface resolution.
 ///  2. Inward direction: the angle-weighted vertex normal, smoothed over the surface (a few
 ///     umbrella rounds), so neighbouring offsets stay nearly parallel; then turned, where needed,
 ///     until it points into the flesh across every triangle at the vertex (creases: the lips'
@@ -27,6 +29,7 @@
 ///     auto tpl = scenario::softdeca_template(exec::omp, kit, {.head = {.layers = 1}});
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -64,59 +67,93 @@ struct IctTemplate : SoftDecaTemplate {
   Index bone_vertices = 0, thin_vertices = 0, deep_vertices = 0;  ///< how step 3's march ended, per wrap vertex
 };
 
-/// Builds the template (see the file comment). Throws what head_surface, skull_surface and
-/// layered_head throw; ArgumentError for bad options.
+/// The outer wrap (step 1) before the inward march, in cm: the kit's closed head surface without
+/// the neck cap, or any surface laid over it (remeshed_wrap.hpp), with each triangle's part and
+/// each vertex's place on the kit as a barycentric point of three kit vertices (a kit vertex
+/// itself: corners (k, k, k), weights (1, 0, 0)), through which the expressions reach it.
+struct IctOuterWrap {
+  TriMesh<> mesh;
+  std::vector<HeadPart> part;  ///< per triangle: skin, mouth_socket or eye_socket
+  Tris kit_corners;            ///< per vertex: three kit vertices
+  Points<> kit_weights;        ///< per vertex: their barycentric weights (sum 1)
+};
+
+/// The kit's own outer wrap: the closed surface (head_surface.hpp) without the neck cap and the
+/// cap's centre, every vertex a kit vertex.
 template <exec::HostPolicy P>
-IctTemplate softdeca_template(P policy, const IctKit& kit, const SoftDecaTemplateOptions& opt = {}) {
+IctOuterWrap ict_outer_wrap(P policy, const IctKit& kit) {
+  const HeadSurface closed = head_surface(policy, kit, kit.neutral.V);
+  IctOuterWrap wrap;
+  std::vector<VIndex> map(static_cast<std::size_t>(closed.mesh.num_vertices()), -1);
+  std::vector<std::array<VIndex, 3>> tris;
+  std::vector<VIndex> used;
+  for (Index f = 0; f < closed.mesh.F.rows(); ++f) {
+    if (closed.part[std::size_t(f)] == HeadPart::neck_cap) continue;
+    std::array<VIndex, 3> t{};
+    for (int c = 0; c < 3; ++c) {
+      VIndex& m = map[std::size_t(closed.mesh.F(f, c))];
+      if (m < 0) {
+        m = VIndex(used.size());
+        used.push_back(closed.mesh.F(f, c));
+      }
+      t[std::size_t(c)] = m;
+    }
+    tris.push_back(t);
+    wrap.part.push_back(closed.part[std::size_t(f)]);
+  }
+  const Index nv = Index(used.size());
+  wrap.mesh.V.resize(nv, 3);
+  wrap.kit_corners.resize(nv, 3);
+  wrap.kit_weights.setZero(nv, 3);
+  for (Index i = 0; i < nv; ++i) {
+    wrap.mesh.V.row(i) = closed.mesh.V.row(used[std::size_t(i)]);
+    const VIndex k = closed.kit_vertex[used[std::size_t(i)]];
+    if (k < 0) throw ArgumentError("ict_outer_wrap: outer wrap vertex " + std::to_string(i) + " is no kit vertex");
+    wrap.kit_corners.row(i).setConstant(k);
+    wrap.kit_weights(i, 0) = 1;
+  }
+  wrap.mesh.F.resize(Index(tris.size()), 3);
+  for (std::size_t f = 0; f < tris.size(); ++f)
+    for (int c = 0; c < 3; ++c) wrap.mesh.F(Index(f), c) = tris[f][std::size_t(c)];
+  return wrap;
+}
+
+/// Builds the template on an outer wrap (steps 2–5 of the file comment). Throws what
+/// head_surface, skull_surface and layered_head throw; ArgumentError for bad options;
+/// ShapeError and ArgumentError for a wrap whose arrays disagree or whose kit places are not
+/// barycentric points of kit vertices. (The options have no default here, so that
+/// softdeca_template(policy, kit, {}) names the other overload.)
+template <exec::HostPolicy P>
+IctTemplate softdeca_template(P policy, const IctKit& kit, const IctOuterWrap& wrap, const SoftDecaTemplateOptions& opt) {
   if (!(opt.max_depth > 0) || !(opt.march_step > 0) || opt.march_step > opt.max_depth)
     throw ArgumentError("softdeca_template: need 0 < march_step <= max_depth");
   if (!(opt.cranium_weight_max >= 0 && opt.cranium_weight_max < opt.jaw_weight_min && opt.jaw_weight_min <= 1))
     throw ArgumentError("softdeca_template: need 0 <= cranium_weight_max < jaw_weight_min <= 1");
+  const Index nv = wrap.mesh.num_vertices(), nf = wrap.mesh.F.rows(), nk = kit.neutral.num_vertices();
+  if (Index(wrap.part.size()) != nf) throw ShapeError("softdeca_template: wrap parts", {nf}, {Index(wrap.part.size())});
+  if (wrap.kit_corners.rows() != nv) throw ShapeError("softdeca_template: wrap kit corners", {nv, 3}, {wrap.kit_corners.rows(), 3});
+  if (wrap.kit_weights.rows() != nv) throw ShapeError("softdeca_template: wrap kit weights", {nv, 3}, {wrap.kit_weights.rows(), 3});
+  for (Index i = 0; i < nv; ++i) {
+    if (!(wrap.kit_corners.row(i).minCoeff() >= 0 && wrap.kit_corners.row(i).maxCoeff() < nk))
+      throw ArgumentError("softdeca_template: wrap vertex " + std::to_string(i) + " names a kit vertex outside [0, " + std::to_string(nk) + ")");
+    if (!(wrap.kit_weights.row(i).minCoeff() >= -1e-12 && std::abs(wrap.kit_weights.row(i).sum() - 1) < 1e-9))
+      throw ArgumentError("softdeca_template: wrap vertex " + std::to_string(i) + "'s kit weights are not barycentric");
+  }
   constexpr double m_per_cm = 0.01;
   const Points<>& rest = kit.neutral.V;
   const HeadSurface closed = head_surface(policy, kit, rest);
   const FleshThickness depth_of = default_flesh_thickness(kit, rest, closed);
 
-  // 1. the outer wrap: the closed surface without the neck cap (and the cap's centre)
   IctTemplate tpl;
-  TriMesh<> outer;
+  const TriMesh<>& outer = wrap.mesh;
+  for (Index i = 0; i < nv; ++i) tpl.kit_vertex.push_back(wrap.kit_weights(i, 0) == 1 ? wrap.kit_corners(i, 0) : VIndex(-1));
   {
-    std::vector<VIndex> map(static_cast<std::size_t>(closed.mesh.num_vertices()), -1);
-    std::vector<std::array<VIndex, 3>> tris;
-    std::vector<VIndex> used;
-    std::vector<char> tri_skin;
-    for (Index f = 0; f < closed.mesh.F.rows(); ++f) {
-      if (closed.part[std::size_t(f)] == HeadPart::neck_cap) continue;
-      std::array<VIndex, 3> t{};
-      for (int c = 0; c < 3; ++c) {
-        VIndex& m = map[std::size_t(closed.mesh.F(f, c))];
-        if (m < 0) {
-          m = VIndex(used.size());
-          used.push_back(closed.mesh.F(f, c));
-        }
-        t[std::size_t(c)] = m;
-      }
-      tris.push_back(t);
-      tri_skin.push_back(closed.part[std::size_t(f)] == HeadPart::skin);
-    }
-    outer.V.resize(Index(used.size()), 3);
-    for (std::size_t i = 0; i < used.size(); ++i) {
-      outer.V.row(Index(i)) = closed.mesh.V.row(used[i]);
-      const VIndex k = closed.kit_vertex[used[i]];
-      if (k < 0) throw ArgumentError("softdeca_template: outer wrap vertex " + std::to_string(i) + " is no kit vertex");
-      tpl.kit_vertex.push_back(k);
-    }
-    outer.F.resize(Index(tris.size()), 3);
     Index skin_rows = 0;
-    for (std::size_t f = 0; f < tris.size(); ++f) {
-      for (int c = 0; c < 3; ++c) outer.F(Index(f), c) = tris[f][std::size_t(c)];
-      skin_rows += tri_skin[f];
-    }
+    for (HeadPart part : wrap.part) skin_rows += part == HeadPart::skin;
     tpl.skin_triangles.resize(skin_rows, 3);
-    for (std::size_t f = 0, r = 0; f < tris.size(); ++f)
-      if (tri_skin[f]) tpl.skin_triangles.row(Index(r++)) = outer.F.row(Index(f));
+    for (Index f = 0, r = 0; f < nf; ++f)
+      if (wrap.part[std::size_t(f)] == HeadPart::skin) tpl.skin_triangles.row(r++) = outer.F.row(f);
   }
-  const Index nv = outer.num_vertices();
 
   // 2. inward directions: smoothed normals
   Points<> n = vertex_normals(outer.V, outer.F, NormalWeighting::angle);
@@ -203,23 +240,33 @@ IctTemplate softdeca_template(P policy, const IctKit& kit, const SoftDecaTemplat
   ho.collapse_below *= m_per_cm;
   tpl.head = layered_head(policy, outer_m, inward, thickness * m_per_cm, bones, ho, jaw.hinge.point * m_per_cm);
 
-  // the skin and its expressions
-  const VertexRange face = kit.region("face"), scalp = kit.region("head_and_neck");
+  // the skin (every vertex of a skin triangle) and its expressions, through the kit places
+  std::vector<char> on_skin(static_cast<std::size_t>(nv), 0);
+  for (Index f = 0; f < tpl.skin_triangles.rows(); ++f)
+    for (int c = 0; c < 3; ++c) on_skin[std::size_t(tpl.skin_triangles(f, c))] = 1;
   std::vector<VIndex> skin;
-  for (Index i = 0; i < nv; ++i) {
-    const VIndex k = tpl.kit_vertex[std::size_t(i)];
-    if (face.contains(k) || scalp.contains(k)) skin.push_back(VIndex(i));
-  }
+  for (Index i = 0; i < nv; ++i)
+    if (on_skin[std::size_t(i)]) skin.push_back(VIndex(i));
   tpl.skin = Eigen::Map<const IndexVector>(skin.data(), Index(skin.size()));
   tpl.expression_names = kit.expression_names;
   const Index E = Index(kit.expression_names.size());
   tpl.expression_deltas.resize(E, 3 * tpl.skin.size());
   for (Index e = 0; e < E; ++e) {
     const Points<> d = kit.expression(kit.expression_names[std::size_t(e)]);
-    for (Index k = 0; k < tpl.skin.size(); ++k)
-      for (int c = 0; c < 3; ++c) tpl.expression_deltas(e, 3 * k + c) = d(tpl.kit_vertex[std::size_t(tpl.skin[k])], c) * m_per_cm;
+    for (Index k = 0; k < tpl.skin.size(); ++k) {
+      const Index i = tpl.skin[k];
+      Vec3<> delta = Vec3<>::Zero();
+      for (int c = 0; c < 3; ++c) delta += wrap.kit_weights(i, c) * d.row(wrap.kit_corners(i, c)).transpose();
+      tpl.expression_deltas.block<1, 3>(e, 3 * k) = m_per_cm * delta.transpose();
+    }
   }
   return tpl;
+}
+
+/// The template on the kit's own triangles (see the file comment).
+template <exec::HostPolicy P>
+IctTemplate softdeca_template(P policy, const IctKit& kit, const SoftDecaTemplateOptions& opt = {}) {
+  return softdeca_template(policy, kit, ict_outer_wrap(policy, kit), opt);
 }
 
 }  // namespace simsr::scenario

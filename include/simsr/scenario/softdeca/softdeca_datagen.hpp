@@ -106,8 +106,10 @@ inline std::string sample_file_name(Index i) {
 
 /// Runs (or resumes) a SoftDECA datagen on `tpl` into `dir` (see the file comment); `name`
 /// names the template in the JSON summary, `say` gets one progress line per sample. Returns the
-/// JSON summary it also writes.
-template <exec::HostPolicy P>
+/// JSON summary it also writes. `Simulator`: the SoftDecaSimulator, or BasicSoftDecaSimulator with
+/// another linear solver (physics::CholmodCholesky: the same results to round-off, faster at the
+/// ICT template's size).
+template <class Simulator = SoftDecaSimulator, exec::HostPolicy P>
 nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplate& tpl, const std::string& name, const SoftDecaDatagenOptions& o,
                                                  const std::filesystem::path& dir, const std::function<void(const std::string&)>& say = {}) {
   namespace fs = std::filesystem;
@@ -163,7 +165,7 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
     fp.add(r);
   const std::string print = fp.hex();
 
-  SoftDecaSimulator sim(tpl, o.stiffness);
+  Simulator sim(tpl, o.stiffness);
   Eigen::MatrixXd params(o.samples, SoftDecaParameters::size), expressions(o.samples, E);
   std::vector<Points<>> skins(static_cast<std::size_t>(o.samples)), rests(static_cast<std::size_t>(o.samples));
   nlohmann::ordered_json per_sample = nlohmann::ordered_json::array();
