@@ -9,7 +9,7 @@
 //
 // `simsr datagen --scenario softdeca --samples N --out DIR [--template ict|sphere] [--layers L]
 //  [--sphere-level K] [--seed S] [--steps K] [--solver local_global|newton] [--active-expressions A]
-//  [--skin-edge CM] [--linear-solver simplicial|cholmod]`:
+//  [--skin-edge CM] [--linear-solver simplicial|cholmod] [--max-iterations N]`:
 // SoftDECA's layered head template (from the same kit, or the sphere stand-in of
 // scenario/softdeca/sphere_template.hpp), N sampled parameter sets and expressions simulated on it
 // (scenario/softdeca/softdeca_datagen.hpp), resumable, a progress line per sample. --skin-edge
@@ -48,7 +48,7 @@ struct DatagenArgs {
   Index vtk_every = 10;
   Index unseen_frames = 40;
   // softdeca
-  Index samples = 100, layers = 1, steps = 6, sphere_level = 3;
+  Index samples = 100, layers = 1, steps = 6, sphere_level = 3, max_iterations = 5000;
   std::optional<Index> active_expressions;
   std::string solver = "local_global", softdeca_template = "ict", linear_solver = "simplicial";
   double skin_edge = 0;
@@ -73,6 +73,7 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   o.seed = a.seed;
   o.active_expressions = a.active_expressions;
   o.simulation.steps = a.steps;
+  o.simulation.max_iterations = a.max_iterations;
   if (a.solver == "newton")
     o.simulation.solver = scenario::SoftDecaSolver::newton;
   else if (a.solver != "local_global")
@@ -156,6 +157,10 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--skin-edge", a->skin_edge, "softdeca --template ict: remesh the kit's outer wrap to this edge length in cm (0: the kit's triangles; needs CGAL)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--max-iterations", a->max_iterations,
+                  "softdeca --solver local_global: iterations per solve before Newton finishes it from there (the sample's result is the same to the tolerance)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000000));
   cmd->add_option("--linear-solver", a->linear_solver, "softdeca: simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD)")->capture_default_str();
   cmd->add_option("--template", a->softdeca_template, "softdeca: ict (the layered head from --kit) or sphere (the stand-in ball with two expressions)")
       ->capture_default_str();

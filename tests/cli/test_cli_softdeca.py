@@ -3,9 +3,11 @@
 stand-in template (small enough for a test; the ICT head takes minutes per sample), its resume
 (a deleted sample is simulated again, bit for bit, the others reused), a sample file of another
 run refused, then `simsr train-surrogate` on the samples: the model, the report and the loss
-curve, and its errors.
+curve, and its errors. Then one sample on the ICT head remeshed to 2 cm edges with CHOLMOD
+(`--skin-edge`, `--linear-solver cholmod`: the tool built with CGAL and CHOLMOD, as the test run
+builds it) and the refusals of those options where they do not apply.
 
-    /usr/bin/python3 tests/cli/test_cli_softdeca.py SIMSR_EXE WORK_DIR
+    /usr/bin/python3 tests/cli/test_cli_softdeca.py SIMSR_EXE WORK_DIR ICT_KIT_DIR
 
 Exit 0: all checks passed; 1: a check failed; 77: numpy is missing (1 with SIMSR_REQUIRE_PEERS=1)."""
 import csv
@@ -23,7 +25,7 @@ except ImportError as e:  # peer missing: skip, do not pass silently
     print(f"MISSING (a failure under SIMSR_REQUIRE_PEERS=1, a skip otherwise): {e}")
     sys.exit(1 if os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0") else 77)
 
-SIMSR, WORK = sys.argv[1], sys.argv[2]
+SIMSR, WORK, KIT = sys.argv[1], sys.argv[2], sys.argv[3]
 shutil.rmtree(WORK, ignore_errors=True)
 os.makedirs(WORK)
 data = os.path.join(WORK, "data")
@@ -103,4 +105,20 @@ os.makedirs(os.path.join(WORK, "empty"), exist_ok=True)
 np.savez(os.path.join(WORK, "empty", "softdeca_samples.npz"), parameters=np.zeros((3, 20)))
 p = simsr("train-surrogate", "--data", os.path.join(WORK, "empty"), "--out", out, expect=1)
 check("parameter_names" in p.stderr, f"a dataset without its arrays is named: {p.stderr.strip()}")
+
+# --- the ICT head at one surface resolution, with CHOLMOD
+ict = os.path.join(WORK, "ict")
+p = simsr("datagen", "--scenario", "softdeca", "--template", "ict", "--kit", KIT, "--skin-edge", "2", "--linear-solver", "cholmod",
+          "--samples", "1", "--steps", "1", "--out", ict)
+summary = json.loads(p.stdout) if p.returncode == 0 else {}
+skin = summary.get("template", {}).get("skin_vertices", 0)
+check(100 < skin < 11248 // 4, f"remeshed to 2 cm: a few hundred skin vertices, far fewer than the kit's 11,248: {summary.get('template')}")
+check("remeshed to 2" in summary.get("template_name", ""), f"the summary names the resolution: {summary.get('template_name')}")
+if os.path.exists(os.path.join(ict, "softdeca_samples.npz")):
+    z = np.load(os.path.join(ict, "softdeca_samples.npz"))
+    check(z["skin"].shape == (1, skin, 3) and np.isfinite(z["skin"]).all(), f"one finite sample of the remeshed skin: {z['skin'].shape}")
+p = simsr("datagen", "--scenario", "softdeca", "--template", "sphere", "--skin-edge", "1", "--samples", "1", "--out", os.path.join(WORK, "y"), expect=1)
+check("--skin-edge" in p.stderr, f"--skin-edge on the sphere is refused: {p.stderr.strip()}")
+p = simsr("datagen", "--scenario", "softdeca", "--template", "sphere", "--linear-solver", "lu", "--samples", "1", "--out", os.path.join(WORK, "y"), expect=1)
+check("--linear-solver" in p.stderr, f"an unknown linear solver is named: {p.stderr.strip()}")
 finish()

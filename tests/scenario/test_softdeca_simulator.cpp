@@ -50,6 +50,28 @@ TEST_CASE("SoftDecaSimulator: local-global and Newton agree on sampled parameter
   }
 }
 
+TEST_CASE("SoftDecaSimulator: a local-global solve left unconverged is finished by Newton, or is an error when asked") {
+  const SoftDecaTemplate tpl = ball_template();
+  SoftDecaSimulator sim(tpl);
+  const VecX<> expression = (VecX<>(2) << 0.6, 0.3).finished();
+  SoftDecaParameters p = sample_softdeca_parameters(3, 0);
+  p.cranium_scale = p.jaw_scale = Vec3<>::Ones();
+  // 3 local-global iterations per solve: none of the 3 solves converges in them
+  const SoftDecaSimulationOptions capped{.solver = SoftDecaSolver::local_global, .steps = 2, .relative_tolerance = 1e-9, .max_iterations = 3};
+  SoftDecaSimulationOptions newton = capped;
+  newton.solver = SoftDecaSolver::newton;
+  const SoftDecaResult a = sim.simulate(exec::omp, p, expression, capped);
+  const SoftDecaResult b = sim.simulate(exec::omp, p, expression, newton);
+  CHECK(a.newton_fallbacks == 3);
+  CHECK(b.newton_fallbacks == 0);
+  for (Index its : a.iterations) CHECK(its > 3);  // 3 of local-global, then Newton's
+  const double moved = (b.skin - tpl.expression(VecX<>::Zero(2))).rowwise().norm().maxCoeff();
+  CHECK((a.skin - b.skin).rowwise().norm().maxCoeff() < 1e-6 * moved);
+  SoftDecaSimulationOptions strict = capped;
+  strict.newton_fallback = false;
+  CHECK_THROWS_AS(sim.simulate(exec::omp, p, expression, strict), ConvergenceError);
+}
+
 TEST_CASE("SoftDecaSimulator: gravity's sampled direction moves the soft skin along it") {
   const SoftDecaTemplate tpl = ball_template();
   SoftDecaSimulator sim(tpl);

@@ -7,7 +7,8 @@
 ///     DIR/template_skin.obj           the template's skin at rest (m)
 ///     DIR/template_soft_tissue.msh    the soft-tissue tets, DIR/template_muscle.msh the muscle tets
 ///     DIR/samples/sample_NNNNNN.npz   one sample: parameters (20, parameters.hpp), expression (E),
-///                                     skin and skin_at_rest (#skin×3), iterations, seconds
+///                                     skin and skin_at_rest (#skin×3), iterations, seconds,
+///                                     inverted_tets, newton_fallbacks
 ///     DIR/softdeca_samples.npz        all of them: parameters N×20, parameter_names, expressions
 ///                                     N×E, expression_names, skin and skin_at_rest N×#skin×3,
 ///                                     rest_skin #skin×3 (the template's), seconds N (each
@@ -209,15 +210,19 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
     z["iterations"] = io::make_npy<std::int64_t>({std::int64_t(its.size())}, its.data());
     z["seconds"] = io::make_npy<double>({}, &r.seconds);
     z["inverted_tets"] = io::make_npy<std::int64_t>({}, &r.inverted_tets);
+    z["newton_fallbacks"] = io::make_npy<std::int64_t>({}, &r.newton_fallbacks);
     z["fingerprint"] = io::make_npy(std::vector<std::string>{print});
     io::write_npz(file, z);
     ++simulated;
     sim_seconds += r.seconds;
-    per_sample.push_back({{"sample", i}, {"iterations", r.iterations}, {"seconds", r.seconds}, {"inverted_tets", r.inverted_tets}});
+    per_sample.push_back({{"sample", i}, {"iterations", r.iterations}, {"seconds", r.seconds}, {"inverted_tets", r.inverted_tets},
+                          {"newton_fallbacks", r.newton_fallbacks}});
     const double mean = sim_seconds / double(simulated);
     char line[256];
-    std::snprintf(line, sizeof line, "sample %lld/%lld: %lld iterations, %.1f s (%.1f s/sample, ETA %.0f s)", static_cast<long long>(i + 1),
-                  static_cast<long long>(o.samples), static_cast<long long>(r.total_iterations()), r.seconds, mean, mean * double(o.samples - i - 1));
+    std::snprintf(line, sizeof line, "sample %lld/%lld: %lld iterations%s, %.1f s (%.1f s/sample, ETA %.0f s)", static_cast<long long>(i + 1),
+                  static_cast<long long>(o.samples), static_cast<long long>(r.total_iterations()),
+                  r.newton_fallbacks > 0 ? (" (" + std::to_string(r.newton_fallbacks) + " solve(s) finished by Newton)").c_str() : "", r.seconds, mean,
+                  mean * double(o.samples - i - 1));
     tell(line);
   }
 

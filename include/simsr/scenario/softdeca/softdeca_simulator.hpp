@@ -61,13 +61,19 @@ struct SoftDecaSimulationOptions {
   double relative_tolerance = 1e-6;  ///< both solvers' gradient tolerance (NewtonOptions' meaning)
   Index max_iterations = 5000;  ///< local–global iterations per solve (Newton: 100)
   Index history = 5;            ///< local–global L-BFGS memory
+  /// Local–global only: a solve that stops without converging (max_iterations, or a line search
+  /// that finds no decrease) is finished by Newton from where it stopped. Some sampled weight
+  /// sets, 0.001 against 100, make the constant matrix a poor model and take thousands of
+  /// iterations; off, such a sample is a ConvergenceError.
+  bool newton_fallback = true;
 };
 
 /// What one sample gave.
 struct SoftDecaResult {
   Points<> skin;          ///< #skin×3 at the last step (m)
   Points<> skin_at_rest;  ///< #skin×3 after part 1
-  std::vector<Index> iterations;  ///< per solve (part 1, then each step)
+  std::vector<Index> iterations;  ///< per solve (part 1, then each step): local–global's, plus Newton's where it finished
+  Index newton_fallbacks = 0;     ///< solves that local–global left unconverged and Newton finished
   Index inverted_tets = 0;        ///< det F ≤ 0 at the last step
   double seconds = 0;
   Index total_iterations() const {
@@ -136,6 +142,7 @@ class BasicSoftDecaSimulator {
     check_expression(expression);
     const auto t0 = std::chrono::steady_clock::now();
     prepare(p);
+    fallbacks_ = 0;
     SoftDecaResult r;
     Points<> x;
     r.iterations.push_back(settle(policy, x, o));
@@ -145,6 +152,7 @@ class BasicSoftDecaSimulator {
     for (Index s = 1; s <= o.steps; ++s) r.iterations.push_back(step(policy, x, std::min(1.0, double(s) / ramp_steps) * expression, o));
     r.skin = skin_of(x);
     r.inverted_tets = volume_.count_inverted(policy, x);
+    r.newton_fallbacks = fallbacks_;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
   }
@@ -303,7 +311,14 @@ class BasicSoftDecaSimulator {
     pd.options().relative_tolerance = o.relative_tolerance;
     pd.options().max_iterations = o.max_iterations;
     pd.options().history = o.history;
-    return with_terms([&](const auto&... term) { return pd.solve(policy, x, bones, term...).iterations; });
+    try {
+      return with_terms([&](const auto&... term) { return pd.solve(policy, x, bones, term...).iterations; });
+    } catch (const ConvergenceError& e) {
+      if (!o.newton_fallback) throw;
+      ++fallbacks_;  // x holds local–global's last iterate
+      newton_.options().relative_tolerance = o.relative_tolerance;
+      return Index(e.iterations()) + with_terms([&](const auto&... term) { return newton_.solve(policy, x, bones, term...).iterations; });
+    }
   }
 
   const SoftDecaTemplate& tpl_;
@@ -323,6 +338,7 @@ class BasicSoftDecaSimulator {
   SoftDecaParameters p_;
   physics::DirichletBoundary<> bones_;
   std::vector<VIndex> loose_;
+  Index fallbacks_ = 0;  // of the current simulate()
 };
 
 /// The simulator with Eigen's simplicial LDLᵀ (no optional dependency).
