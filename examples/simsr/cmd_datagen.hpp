@@ -9,7 +9,7 @@
 //
 // `simsr datagen --scenario softdeca --samples N --out DIR [--template ict|sphere] [--layers L]
 //  [--sphere-level K] [--seed S] [--steps K] [--solver local_global|newton] [--active-expressions A]
-//  [--skin-edge CM] [--linear-solver simplicial|cholmod] [--max-iterations N]`:
+//  [--skin-edge CM] [--linear-solver simplicial|cholmod] [--max-iterations N] [--stop-on-unconverged]`:
 // SoftDECA's layered head template (from the same kit, or the sphere stand-in of
 // scenario/softdeca/sphere_template.hpp), N sampled parameter sets and expressions simulated on it
 // (scenario/softdeca/softdeca_datagen.hpp), resumable, a progress line per sample. --skin-edge
@@ -45,6 +45,7 @@ struct DatagenArgs {
   double lr_cell = 0, skull_lattice = 0, hr_max_volume = 0;
   Index checkpoint_every = 10;
   bool unseen_forces = true;
+  bool stop_on_unconverged = false;
   Index vtk_every = 10;
   Index unseen_frames = 40;
   // softdeca
@@ -74,6 +75,7 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   o.active_expressions = a.active_expressions;
   o.simulation.steps = a.steps;
   o.simulation.max_iterations = a.max_iterations;
+  o.skip_unconverged = !a.stop_on_unconverged;
   if (a.solver == "newton")
     o.simulation.solver = scenario::SoftDecaSolver::newton;
   else if (a.solver != "local_global")
@@ -161,6 +163,8 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
                   "softdeca --solver local_global: iterations per solve before Newton finishes it from there (the sample's result is the same to the tolerance)")
       ->capture_default_str()
       ->check(CLI::Range(1, 10000000));
+  cmd->add_flag("--stop-on-unconverged", a->stop_on_unconverged,
+               "softdeca: a sample no solver converges stops the run (default: it is left out, written to samples/*.failed.json and listed)");
   cmd->add_option("--linear-solver", a->linear_solver, "softdeca: simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD)")->capture_default_str();
   cmd->add_option("--template", a->softdeca_template, "softdeca: ict (the layered head from --kit) or sphere (the stand-in ball with two expressions)")
       ->capture_default_str();

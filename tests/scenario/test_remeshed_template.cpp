@@ -91,6 +91,20 @@ TEST_CASE("remeshed_outer_wrap: on the kit, parts kept, expressions carried exac
   CHECK(signed_volumes(exec::omp, tpl.head.mesh.V, tpl.head.mesh.T).minCoeff() > 0);
   CHECK(tpl.head.count(scenario::Bone::cranium) > 0);
   CHECK(tpl.head.count(scenario::Bone::jaw) > 0);
+
+  // a wrap whose arrays disagree or whose kit places are no barycentric points is refused
+  scenario::IctOuterWrap bad = wrap;
+  bad.part.pop_back();
+  CHECK_THROWS_AS(scenario::softdeca_template(exec::omp, kit, bad, {}), ShapeError);
+  bad = wrap;
+  bad.kit_weights(5, 0) += 0.5;
+  CHECK_THROWS_AS(scenario::softdeca_template(exec::omp, kit, bad, {}), ArgumentError);
+  bad = wrap;
+  bad.kit_corners(7, 2) = VIndex(kit.neutral.num_vertices());
+  CHECK_THROWS_AS(scenario::softdeca_template(exec::omp, kit, bad, {}), ArgumentError);
+  bad = wrap;
+  bad.kit_weights.conservativeResize(nv - 1, 3);
+  CHECK_THROWS_AS(scenario::softdeca_template(exec::omp, kit, bad, {}), ShapeError);
 }
 
 TEST_CASE("remeshed template: Newton settles a sample whose bending stalls on the kit's triangles, and local-global agrees") {

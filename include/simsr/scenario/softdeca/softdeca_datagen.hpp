@@ -9,10 +9,13 @@
 ///     DIR/samples/sample_NNNNNN.npz   one sample: parameters (20, parameters.hpp), expression (E),
 ///                                     skin and skin_at_rest (#skin×3), iterations, seconds,
 ///                                     inverted_tets, newton_fallbacks
+///     DIR/samples/sample_NNNNNN.failed.json  a sample no solver converged: left out, its
+///                                     parameters, expression and error (skip_unconverged)
 ///     DIR/softdeca_samples.npz        all of them: parameters N×20, parameter_names, expressions
 ///                                     N×E, expression_names, skin and skin_at_rest N×#skin×3,
 ///                                     rest_skin #skin×3 (the template's), seconds N (each
-///                                     sample's simulation), fingerprint
+///                                     sample's simulation), sample_index N (which samples),
+///                                     failed_samples (those left out), fingerprint
 ///     DIR/softdeca_data.json          template sizes, options, per-sample iterations and seconds
 ///
 /// read_softdeca_dataset() (softdeca_dataset.hpp) reads softdeca_samples.npz back (the surrogate's
@@ -42,6 +45,7 @@
 #include "../../core/fingerprint.hpp"
 #include "../../core/parallel.hpp"
 #include "../../io/atomic_file.hpp"
+#include "../../io/detail/text_reader.hpp"
 #include "../../io/mesh_io.hpp"
 #include "../../io/npz.hpp"
 #include "parameters.hpp"
@@ -60,6 +64,12 @@ struct SoftDecaDatagenOptions {
   SoftDecaSimulationOptions simulation;
   SoftDecaStiffness stiffness;
   SoftDecaRanges ranges;
+  /// A sample that neither solver brings to the tolerance (local–global, then Newton from where
+  /// it stopped: SoftDecaSimulationOptions::newton_fallback) is left out and reported: its
+  /// DIR/samples/sample_NNNNNN.failed.json holds the parameters and the error, the summary lists
+  /// it, and softdeca_samples.npz's `sample_index` names the samples it holds. False: such a
+  /// sample stops the run with the error.
+  bool skip_unconverged = true;
 };
 
 /// Expression weights of sample `index` (see the file comment): E weights, `active` of them in (0, 1].
@@ -98,9 +108,9 @@ inline nlohmann::ordered_json softdeca_template_sizes(const SoftDecaTemplate& tp
 }
 
 namespace detail {
-inline std::string sample_file_name(Index i) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "sample_%06lld.npz", static_cast<long long>(i));
+inline std::string sample_file_name(Index i, const char* suffix = ".npz") {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "sample_%06lld%s", static_cast<long long>(i), suffix);
   return buf;
 }
 }  // namespace detail
@@ -173,8 +183,9 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   VecX<> seconds(o.samples);
   Index simulated = 0, resumed = 0;
   double sim_seconds = 0;
+  std::vector<Index> kept, failed;
   for (Index i = 0; i < o.samples; ++i) {
-    const fs::path file = dir / "samples" / detail::sample_file_name(i);
+    const fs::path file = dir / "samples" / detail::sample_file_name(i), failed_file = dir / "samples" / detail::sample_file_name(i, ".failed.json");
     const SoftDecaParameters p = sample_softdeca_parameters(o.seed, std::uint64_t(i), o.ranges);
     const VecX<> w = sample_expression_weights(o.seed, std::uint64_t(i), E, active);
     params.row(i) = p.to_vector().transpose();
@@ -190,11 +201,36 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
       seconds[i] = z.at("seconds").item<double>();
       per_sample.push_back({{"sample", i}, {"resumed", true}, {"seconds", seconds[i]}});
       ++resumed;
+      kept.push_back(i);
+      continue;
+    }
+    if (fs::exists(failed_file)) {  // left out by an earlier run: the same again
+      nlohmann::json f;
+      try {
+        f = nlohmann::json::parse(io::detail::read_text_file(failed_file));
+      } catch (const nlohmann::json::exception& e) {
+        throw ParseError(failed_file.string(), 0, e.what());
+      }
+      if (!f.contains("fingerprint") || f["fingerprint"] != print)
+        throw Error("softdeca datagen: " + failed_file.string() + " is from another run (its template, options or seed differ): move it away or use another --out");
+      failed.push_back(i);
+      per_sample.push_back({{"sample", i}, {"resumed", true}, {"failed", f.value("error", "")}});
+      ++resumed;
       continue;
     }
     SoftDecaResult r;
     try {
       r = sim.simulate(policy, p, w, o.simulation);
+    } catch (const ConvergenceError& e) {
+      const std::string what = "softdeca datagen: sample " + std::to_string(i) + " (" + p.to_json().dump() + "): " + e.what();
+      if (!o.skip_unconverged) throw Error(what);
+      nlohmann::ordered_json f{{"sample", i}, {"parameters", p.to_json()}, {"expression", std::vector<double>(w.data(), w.data() + w.size())},
+                               {"error", e.what()}, {"fingerprint", print}};
+      io::write_file_atomic(failed_file, f.dump(2) + "\n");
+      failed.push_back(i);
+      per_sample.push_back({{"sample", i}, {"failed", e.what()}});
+      tell("sample " + std::to_string(i + 1) + "/" + std::to_string(o.samples) + ": no convergence, left out (" + failed_file.filename().string() + "): " + e.what());
+      continue;
     } catch (const Error& e) {
       throw Error("softdeca datagen: sample " + std::to_string(i) + " (" + p.to_json().dump() + "): " + e.what());
     }
@@ -213,6 +249,7 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
     z["newton_fallbacks"] = io::make_npy<std::int64_t>({}, &r.newton_fallbacks);
     z["fingerprint"] = io::make_npy(std::vector<std::string>{print});
     io::write_npz(file, z);
+    kept.push_back(i);
     ++simulated;
     sim_seconds += r.seconds;
     per_sample.push_back({{"sample", i}, {"iterations", r.iterations}, {"seconds", r.seconds}, {"inverted_tets", r.inverted_tets},
@@ -226,17 +263,35 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
     tell(line);
   }
 
+  if (kept.empty()) throw Error("softdeca datagen: no sample converged (" + std::to_string(failed.size()) + " left out: DIR/samples/*.failed.json)");
+  const Index K = Index(kept.size());
+  Eigen::MatrixXd kept_params(K, SoftDecaParameters::size), kept_expressions(K, E);
+  std::vector<Points<>> kept_skins, kept_rests;
+  VecX<> kept_seconds(K);
+  for (Index k = 0; k < K; ++k) {
+    const Index i = kept[std::size_t(k)];
+    kept_params.row(k) = params.row(i);
+    kept_expressions.row(k) = expressions.row(i);
+    kept_skins.push_back(std::move(skins[std::size_t(i)]));
+    kept_rests.push_back(std::move(rests[std::size_t(i)]));
+    kept_seconds[k] = seconds[i];
+  }
+  if (!failed.empty())
+    tell(std::to_string(failed.size()) + " of " + std::to_string(o.samples) + " samples did not converge and are left out (listed in softdeca_data.json)");
   io::NpzArrays all;
-  all["parameters"] = io::make_npy(params);
+  all["parameters"] = io::make_npy(kept_params);
   all["parameter_names"] = io::make_npy(SoftDecaParameters::names());
-  all["expressions"] = io::make_npy(expressions);
+  all["expressions"] = io::make_npy(kept_expressions);
   all["expression_names"] = io::make_npy(tpl.expression_names);
-  all["skin"] = io::make_npy_frames(skins);
-  all["skin_at_rest"] = io::make_npy_frames(rests);
+  all["skin"] = io::make_npy_frames(kept_skins);
+  all["skin_at_rest"] = io::make_npy_frames(kept_rests);
+  std::vector<std::int64_t> kept64(kept.begin(), kept.end()), failed64(failed.begin(), failed.end());
+  all["sample_index"] = io::make_npy<std::int64_t>({std::int64_t(K)}, kept64.data());
+  all["failed_samples"] = io::make_npy<std::int64_t>({std::int64_t(failed64.size())}, failed64.data());
   Points<> rest_skin(M, 3);
   for (Index k = 0; k < M; ++k) rest_skin.row(k) = h.mesh.V.row(tpl.skin[k]);
   all["rest_skin"] = io::make_npy(rest_skin);
-  all["seconds"] = io::make_npy(seconds);
+  all["seconds"] = io::make_npy(kept_seconds);
   all["fingerprint"] = io::make_npy(std::vector<std::string>{print});
   io::write_npz(dir / "softdeca_samples.npz", all);
 
@@ -247,6 +302,8 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   j["samples"] = o.samples;
   j["simulated"] = simulated;
   j["resumed"] = resumed;
+  j["kept"] = K;
+  j["failed_samples"] = failed;
   j["seed"] = o.seed;
   j["active_expressions"] = active;
   j["solver"] = o.simulation.solver == SoftDecaSolver::newton ? "newton" : "local_global";
