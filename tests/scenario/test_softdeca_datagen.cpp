@@ -17,7 +17,9 @@ using namespace simsr;
 using namespace simsr::scenario;
 namespace fs = std::filesystem;
 
-TEST_CASE("generate_softdeca_dataset: unconverged samples are left out and listed, the rest kept exactly") {
+// exec::seq throughout: the TSan build leaves it out (tests/CMakeLists.txt, "single-threaded").
+TEST_CASE("generate_softdeca_dataset: unconverged samples are left out and listed, the rest kept exactly" *
+          doctest::test_suite("single-threaded")) {
   const SoftDecaTemplate tpl = sphere_softdeca_template(exec::seq, 1, 1);
   SoftDecaDatagenOptions o;
   o.samples = 6;
