@@ -90,9 +90,11 @@ inline int datagen_softdeca(const DatagenArgs& a) {
     std::string name = "ict";
     if (a.skin_edge > 0) {
 #if defined(SIMSR_HAVE_CGAL)
-      say("remeshing the kit's outer wrap to " + std::to_string(a.skin_edge) + " cm edges");
+      char edge[32];
+      std::snprintf(edge, sizeof edge, "%g cm", a.skin_edge);
+      say(std::string("remeshing the kit's outer wrap to ") + edge + " edges");
       wrap = remeshed_outer_wrap(kit, a.skin_edge);
-      name = "ict remeshed to " + std::to_string(a.skin_edge) + " cm";
+      name = std::string("ict remeshed to ") + edge;
 #else
       throw ArgumentError("--skin-edge: this simsr was built without CGAL (configure with -DSIMSR_WITH_CGAL=ON)");
 #endif
