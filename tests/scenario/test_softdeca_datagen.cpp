@@ -22,9 +22,9 @@ TEST_CASE("generate_softdeca_dataset: unconverged samples are left out and liste
           doctest::test_suite("single-threaded")) {
   const SoftDecaTemplate tpl = sphere_softdeca_template(exec::seq, 1, 1);
   SoftDecaDatagenOptions o;
-  o.samples = 6;
+  o.samples = 4;
   o.seed = 4;
-  o.simulation.steps = 2;
+  o.simulation.steps = 1;
   o.simulation.newton_fallback = false;  // a capped local-global solve is then a ConvergenceError
   // each sample's largest local-global solve, uncapped; the cap is their median, so some pass and some fail
   std::vector<Index> largest;
