@@ -103,7 +103,7 @@ Scene<Sim>& scene(const std::string& name) {
   } else if (name == "ict_remeshed") {
 #if defined(SIMSR_HAVE_CGAL)
     const auto kit = read_ict_kit(std::filesystem::path(SIMSR_DATA_DIR) / "ict_face");
-    s.tpl = std::make_unique<SoftDecaTemplate>(softdeca_template(exec::omp, kit, cli::remeshed_outer_wrap(kit, 0.4), {}));
+    s.tpl = std::make_unique<SoftDecaTemplate>(softdeca_template(exec::omp, kit, cli::remeshed_outer_wrap(exec::omp, kit, 0.4), {}));
 #else
     s.error = "ict_remeshed: bench_softdeca was built without CGAL (-DSIMSR_WITH_CGAL=ON)";
     return scenes.emplace(name, std::move(s)).first->second;

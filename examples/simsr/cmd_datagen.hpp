@@ -93,7 +93,7 @@ inline int datagen_softdeca(const DatagenArgs& a) {
       char edge[32];
       std::snprintf(edge, sizeof edge, "%g cm", a.skin_edge);
       say(std::string("remeshing the kit's outer wrap to ") + edge + " edges");
-      wrap = remeshed_outer_wrap(kit, a.skin_edge);
+      wrap = remeshed_outer_wrap(exec::omp, kit, a.skin_edge);
       name = std::string("ict remeshed to ") + edge;
 #else
       throw ArgumentError("--skin-edge: this simsr was built without CGAL (configure with -DSIMSR_WITH_CGAL=ON)");

@@ -7,8 +7,8 @@
 
 namespace simsr::cli {
 
-scenario::IctOuterWrap remeshed_outer_wrap(const scenario::IctKit& kit, double edge_length) {
-  return scenario::remeshed_outer_wrap(exec::omp, kit, edge_length);
+scenario::IctOuterWrap remeshed_outer_wrap(exec::omp_t policy, const scenario::IctKit& kit, double edge_length) {
+  return scenario::remeshed_outer_wrap(policy, kit, edge_length);
 }
 
 }  // namespace simsr::cli

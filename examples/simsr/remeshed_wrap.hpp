@@ -4,7 +4,7 @@
 
 namespace simsr::cli {
 
-/// scenario::remeshed_outer_wrap under exec::omp.
-scenario::IctOuterWrap remeshed_outer_wrap(const scenario::IctKit& kit, double edge_length);
+/// scenario::remeshed_outer_wrap, instantiated here for exec::omp only.
+scenario::IctOuterWrap remeshed_outer_wrap(exec::omp_t policy, const scenario::IctKit& kit, double edge_length);
 
 }  // namespace simsr::cli

@@ -72,6 +72,7 @@ struct IctTemplate : SoftDecaTemplate {
 /// each vertex's place on the kit as a barycentric point of three kit vertices (a kit vertex
 /// itself: corners (k, k, k), weights (1, 0, 0)), through which the expressions reach it.
 struct IctOuterWrap {
+  HeadSurface closed;          ///< the kit's closed head surface it lies on (at the neutral): the inward march's distances
   TriMesh<> mesh;
   std::vector<HeadPart> part;  ///< per triangle: skin, mouth_socket or eye_socket
   Tris kit_corners;            ///< per vertex: three kit vertices
@@ -82,8 +83,9 @@ struct IctOuterWrap {
 /// cap's centre, every vertex a kit vertex.
 template <exec::HostPolicy P>
 IctOuterWrap ict_outer_wrap(P policy, const IctKit& kit) {
-  const HeadSurface closed = head_surface(policy, kit, kit.neutral.V);
   IctOuterWrap wrap;
+  wrap.closed = head_surface(policy, kit, kit.neutral.V);
+  const HeadSurface& closed = wrap.closed;
   std::vector<VIndex> map(static_cast<std::size_t>(closed.mesh.num_vertices()), -1);
   std::vector<std::array<VIndex, 3>> tris;
   std::vector<VIndex> used;
@@ -141,7 +143,8 @@ IctTemplate softdeca_template(P policy, const IctKit& kit, const IctOuterWrap& w
   }
   constexpr double m_per_cm = 0.01;
   const Points<>& rest = kit.neutral.V;
-  const HeadSurface closed = head_surface(policy, kit, rest);
+  if (wrap.closed.mesh.num_vertices() == 0) throw ArgumentError("softdeca_template: the wrap carries no closed head surface (ict_outer_wrap makes one)");
+  const HeadSurface& closed = wrap.closed;  // computed once, by ict_outer_wrap
   const FleshThickness depth_of = default_flesh_thickness(kit, rest, closed);
 
   IctTemplate tpl;

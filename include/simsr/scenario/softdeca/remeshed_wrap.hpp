@@ -38,6 +38,7 @@ IctOuterWrap remeshed_outer_wrap(P policy, const IctKit& kit, double edge_length
   for (std::size_t f = 0; f < patch.size(); ++f) patch[f] = int(source.part[f]);
   const RemeshedSurface r = isotropic_remesh(policy, source.mesh, patch, {.target_edge_length = edge_length, .iterations = iterations});
   IctOuterWrap wrap;
+  wrap.closed = source.closed;
   wrap.mesh.F = r.mesh.F;
   wrap.part.resize(r.patch.size());
   for (std::size_t f = 0; f < r.patch.size(); ++f) wrap.part[f] = HeadPart(r.patch[f]);

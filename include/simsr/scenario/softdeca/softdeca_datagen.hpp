@@ -184,6 +184,9 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   Index simulated = 0, resumed = 0;
   double sim_seconds = 0;
   std::vector<Index> kept, failed;
+  const auto foreign = [](const fs::path& f) {
+    throw Error("softdeca datagen: " + f.string() + " is from another run (its template, options or seed differ): move it away or use another --out");
+  };
   for (Index i = 0; i < o.samples; ++i) {
     const fs::path file = dir / "samples" / detail::sample_file_name(i), failed_file = dir / "samples" / detail::sample_file_name(i, ".failed.json");
     const SoftDecaParameters p = sample_softdeca_parameters(o.seed, std::uint64_t(i), o.ranges);
@@ -193,7 +196,7 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
     if (fs::exists(file)) {
       const io::NpzArrays z = io::read_npz(file);
       if (!z.contains("fingerprint") || z.at("fingerprint").to_strings() != std::vector<std::string>{print})
-        throw Error("softdeca datagen: " + file.string() + " is from another run (its template, options or seed differ): move it away or use another --out");
+        foreign(file);
       skins[std::size_t(i)] = z.at("skin").to_points();
       rests[std::size_t(i)] = z.at("skin_at_rest").to_points();
       if (skins[std::size_t(i)].rows() != M || rests[std::size_t(i)].rows() != M)
@@ -212,7 +215,7 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
         throw ParseError(failed_file.string(), 0, e.what());
       }
       if (!f.contains("fingerprint") || f["fingerprint"] != print)
-        throw Error("softdeca datagen: " + failed_file.string() + " is from another run (its template, options or seed differ): move it away or use another --out");
+        foreign(failed_file);
       failed.push_back(i);
       per_sample.push_back({{"sample", i}, {"resumed", true}, {"failed", f.value("error", "")}});
       ++resumed;
