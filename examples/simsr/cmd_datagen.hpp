@@ -9,7 +9,8 @@
 //
 // `simsr datagen --scenario softdeca --samples N --out DIR [--template ict|sphere] [--layers L]
 //  [--sphere-level K] [--seed S] [--steps K] [--solver local_global|newton] [--active-expressions A]
-//  [--skin-edge CM] [--linear-solver simplicial|cholmod] [--max-iterations N] [--stop-on-unconverged]`:
+//  [--skin-edge CM] [--linear-solver simplicial|cholmod] [--max-iterations N] [--newton-iterations N]
+//  [--stop-on-unconverged]`:
 // SoftDECA's layered head template (from the same kit, or the sphere stand-in of
 // scenario/softdeca/sphere_template.hpp), N sampled parameter sets and expressions simulated on it
 // (scenario/softdeca/softdeca_datagen.hpp), resumable, a progress line per sample. --skin-edge
@@ -49,7 +50,7 @@ struct DatagenArgs {
   Index vtk_every = 10;
   Index unseen_frames = 40;
   // softdeca
-  Index samples = 100, layers = 1, steps = 6, sphere_level = 3, max_iterations = 5000;
+  Index samples = 100, layers = 1, steps = 6, sphere_level = 3, max_iterations = 5000, newton_iterations = 100;
   std::optional<Index> active_expressions;
   std::string solver = "local_global", softdeca_template = "ict", linear_solver = "simplicial";
   double skin_edge = 0;
@@ -75,6 +76,7 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   o.active_expressions = a.active_expressions;
   o.simulation.steps = a.steps;
   o.simulation.max_iterations = a.max_iterations;
+  o.simulation.newton_iterations = a.newton_iterations;
   o.skip_unconverged = !a.stop_on_unconverged;
   if (a.solver == "newton")
     o.simulation.solver = scenario::SoftDecaSolver::newton;
@@ -163,6 +165,10 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--max-iterations", a->max_iterations,
                   "softdeca --solver local_global: iterations per solve before Newton finishes it from there (the sample's result is the same to the tolerance)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000000));
+  cmd->add_option("--newton-iterations", a->newton_iterations,
+                  "softdeca: Newton iterations per solve (--solver newton's own, or finishing a local-global solve); a sample not settled in them is left out")
       ->capture_default_str()
       ->check(CLI::Range(1, 10000000));
   cmd->add_flag("--stop-on-unconverged", a->stop_on_unconverged,

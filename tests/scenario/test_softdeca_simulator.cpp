@@ -1,6 +1,8 @@
 // SoftDECA's simulation on a small layered ball standing in for the head: the local-global and
 // the Newton solver agree on sampled parameters; gravity's direction and the skull's scaling act
 // visibly; the expression is reached.
+#include <algorithm>
+
 #include <simsr/scenario/softdeca/layered_head.hpp>
 #include <simsr/scenario/softdeca/softdeca_simulator.hpp>
 #include <simsr/scenario/softdeca/sphere_template.hpp>
@@ -70,6 +72,14 @@ TEST_CASE("SoftDecaSimulator: a local-global solve left unconverged is finished 
   SoftDecaSimulationOptions strict = capped;
   strict.newton_fallback = false;
   CHECK_THROWS_AS(sim.simulate(exec::omp, p, expression, strict), ConvergenceError);
+  // Newton's own cap: a solve that needed more Newton iterations than allowed is an error
+  const Index most = *std::max_element(a.iterations.begin(), a.iterations.end()) - 3;
+  REQUIRE(most >= 2);
+  SoftDecaSimulationOptions short_newton = capped;
+  short_newton.newton_iterations = most - 1;
+  CHECK_THROWS_AS(sim.simulate(exec::omp, p, expression, short_newton), ConvergenceError);
+  short_newton.newton_iterations = 0;
+  CHECK_THROWS_AS(sim.simulate(exec::omp, p, expression, short_newton), ArgumentError);
 }
 
 TEST_CASE("SoftDecaSimulator: gravity's sampled direction moves the soft skin along it") {

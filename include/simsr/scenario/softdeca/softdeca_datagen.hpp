@@ -312,6 +312,8 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   j["solver"] = o.simulation.solver == SoftDecaSolver::newton ? "newton" : "local_global";
   j["steps"] = o.simulation.steps;
   j["time_step"] = o.simulation.time_step;
+  j["max_iterations"] = o.simulation.max_iterations;
+  j["newton_iterations"] = o.simulation.newton_iterations;
   j["stiffness"] = o.stiffness.to_json();
   j["seconds_simulating"] = sim_seconds;
   j["seconds_total"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

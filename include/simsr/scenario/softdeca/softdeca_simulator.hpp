@@ -59,7 +59,12 @@ struct SoftDecaSimulationOptions {
   Index steps = 6;              ///< implicit steps from rest to the expression (≥ 1)
   double time_step = 1.0 / 30;  ///< h (s)
   double relative_tolerance = 1e-6;  ///< both solvers' gradient tolerance (NewtonOptions' meaning)
-  Index max_iterations = 5000;  ///< local–global iterations per solve (Newton: 100)
+  Index max_iterations = 5000;  ///< local–global iterations per solve
+  /// Newton iterations per solve: the Newton solver's own, and those finishing an unconverged
+  /// local–global solve. A sample that Newton has not settled in a few dozen is one of the
+  /// nonconvex ones (README, "SoftDECA": the exact Hessian indefinite at every iterate, linear
+  /// convergence under either definiteness fix), so a smaller cap fails it sooner.
+  Index newton_iterations = 100;
   Index history = 5;            ///< local–global L-BFGS memory
   /// Local–global only: a solve that stops without converging (max_iterations, or a line search
   /// that finds no decrease) is finished by Newton from where it stopped. Some sampled weight
@@ -139,6 +144,9 @@ class BasicSoftDecaSimulator {
   template <exec::HostPolicy P>
   SoftDecaResult simulate(P policy, const SoftDecaParameters& p, const VecX<>& expression, const SoftDecaSimulationOptions& o = {}) {
     if (o.steps < 1) throw ArgumentError("SoftDecaSimulator: steps must be >= 1, got " + std::to_string(o.steps));
+    if (o.max_iterations < 1 || o.newton_iterations < 1)
+      throw ArgumentError("SoftDecaSimulator: max_iterations and newton_iterations must be >= 1, got " + std::to_string(o.max_iterations) + " and " +
+                          std::to_string(o.newton_iterations));
     check_expression(expression);
     const auto t0 = std::chrono::steady_clock::now();
     prepare(p);
@@ -304,8 +312,9 @@ class BasicSoftDecaSimulator {
   template <class P>
   Index solve(P policy, physics::LocalGlobalSolver<Linear>& pd, Points<>& x, const SoftDecaSimulationOptions& o) {
     const physics::DirichletBoundary<>& bones = bones_;
+    newton_.options().relative_tolerance = o.relative_tolerance;
+    newton_.options().max_iterations = o.newton_iterations;
     if (o.solver == SoftDecaSolver::newton) {
-      newton_.options().relative_tolerance = o.relative_tolerance;
       return with_terms([&](const auto&... term) { return newton_.solve(policy, x, bones, term...).iterations; });
     }
     pd.options().relative_tolerance = o.relative_tolerance;
@@ -316,7 +325,6 @@ class BasicSoftDecaSimulator {
     } catch (const ConvergenceError& e) {
       if (!o.newton_fallback) throw;
       ++fallbacks_;  // x holds local–global's last iterate
-      newton_.options().relative_tolerance = o.relative_tolerance;
       return Index(e.iterations()) + with_terms([&](const auto&... term) { return newton_.solve(policy, x, bones, term...).iterations; });
     }
   }
