@@ -1,6 +1,6 @@
 #pragma once
 // `simsr train-surrogate --data DIR --out OUT [--epochs N] [--hidden 256,256,256] [--batch B]
-//  [--lr LR] [--held-out F] [--validation F] [--weight-decay W] [--seed S]`: SoftDECA's surrogate
+//  [--lr LR] [--held-out F] [--validation F] [--weight-decay W] [--linear-base] [--seed S]`: SoftDECA's surrogate
 // (nn/softdeca_surrogate.hpp, nn::train_softdeca_surrogate_files) trained on a
 // `simsr datagen --scenario softdeca` output. Writes OUT/surrogate.npz (the model),
 // OUT/surrogate_report.json (held-out error beside the mean and ridge baselines, inference and
@@ -45,6 +45,8 @@ inline void add_train_surrogate(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--validation", a->options.validation, "fraction of the training samples (their last ones) that picks the epoch kept (0: the last)")
       ->capture_default_str()->check(CLI::Range(0.0, 0.999));
   cmd->add_option("--weight-decay", a->options.weight_decay, "Adam's L2 weight decay")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--linear-base", a->options.linear_base,
+               "add a ridge map of the inputs fitted on the training samples; the network learns what it leaves (few samples, a near-linear skull trend)");
   cmd->add_option("--seed", a->options.seed, "initialization and batch-order seed")->capture_default_str();
   cmd->callback([a, &action] { action = [a] { return train_surrogate(*a); }; });
 }

@@ -12,6 +12,13 @@
 ///   hidden  FC widths (default 256, 256, 256), LeakyReLU(0.01) after each
 ///   output  FC to 3·#skin, the displacement standardized by the training mean displacement and
 ///           one global scale (so the loss weighs every vertex and axis alike, in metres)
+///   base    optional (`SoftDecaSurrogateOptions::linear_base`): a ridge map of the same
+///           standardized inputs, fitted in closed form on the training samples, added to the
+///           output; the network then learns only what the linear map leaves (the residual
+///           composition of the core paper's §3.3, with the best linear map as its base). Why:
+///           the skull's per-axis scaling moves the skin nearly linearly by centimetres, and with
+///           the tens of samples a head affords the network learns that trend worse than a
+///           closed-form fit does, and the nonlinear rest not at all (README, "SoftDECA").
 ///
 /// Why these dimensions: the supplement's figure gives only the kind of layer; the inputs are few
 /// (E + 20) and smooth in their effect, while the output is a whole skin, so a few hundred hidden
@@ -78,7 +85,10 @@ struct SoftDecaSurrogateOptions {
   /// of the epoch with the least validation loss (early stopping; 0: the last epoch's).
   double validation = 0.15;
   double weight_decay = 0;    ///< Adam's L2 weight decay
-  double ridge_lambda = 1e-3; ///< the ridge baseline's regularization (on standardized inputs)
+  double ridge_lambda = 1e-3; ///< the ridge baseline's (and the linear base's) regularization (on standardized inputs)
+  /// Add a ridge map of the inputs, fitted on the training samples (not the validation ones), and
+  /// train the network on what it leaves (see the file comment).
+  bool linear_base = false;
   std::uint64_t seed = 1;     ///< batch order
   std::function<void(Index epoch, double train_loss)> progress = {};
 };
@@ -114,7 +124,8 @@ class SoftDecaSurrogate {
   ParameterStore<float>& store() { return *store_; }
   Mlp<float>& mlp() { return *mlp_; }
 
-  /// Fits the standardization to training inputs (N × inputs) and displacements (N × 3M).
+  /// Fits the standardization to training inputs (N × inputs) and displacements (N × 3M): of the
+  /// displacements themselves, or, with a linear base, of what the base leaves of them.
   void fit_normalization(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements) {
     check_inputs("fit_normalization", inputs_);
     if (displacements.rows() != inputs_.rows() || displacements.cols() != 3 * M_)
@@ -122,9 +133,43 @@ class SoftDecaSurrogate {
     in_mean_ = inputs_.colwise().mean().transpose();
     const VecX<> sd = ((inputs_.rowwise() - in_mean_.transpose()).array().square().colwise().mean()).sqrt().transpose();
     in_scale_ = sd.unaryExpr([](double s) { return s > 1e-12 ? s : 1.0; });  // a constant feature stays as it is
-    out_mean_ = displacements.colwise().mean().transpose();
-    const double spread = std::sqrt((displacements.rowwise() - out_mean_.transpose()).array().square().mean());
-    out_scale_ = spread > 0 ? spread : 1.0;
+    fit_output_normalization(inputs_, displacements);
+  }
+
+  /// The linear base (see the file comment): W = argmin ‖[1, z] W − Y‖² + λN‖W without its
+  /// intercept row‖² over the standardized inputs z of `inputs_` (fit_normalization first), then
+  /// the output standardization refitted to what it leaves. λ > 0.
+  void fit_linear_base(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements, double lambda) {
+    check_inputs("fit_linear_base", inputs_);
+    if (displacements.rows() != inputs_.rows() || displacements.cols() != 3 * M_)
+      throw ShapeError("SoftDecaSurrogate::fit_linear_base: displacements", {inputs_.rows(), 3 * M_}, {displacements.rows(), displacements.cols()});
+    if (!(lambda > 0)) throw ArgumentError("SoftDecaSurrogate::fit_linear_base: lambda must be > 0");
+    base_ = ridge_fit(with_intercept(inputs_), displacements, lambda);
+    fit_output_normalization(inputs_, displacements);
+  }
+  /// The linear base ((inputs + 1) × 3M: intercept row first), empty without one.
+  const Eigen::MatrixXd& linear_base() const { return base_; }
+  /// No linear base: the network alone (call fit_normalization again).
+  void clear_linear_base() { base_.resize(0, 0); }
+
+  /// The ridge solution of [1, z] W ≈ Y (the intercept not regularized), z standardized.
+  static Eigen::MatrixXd ridge_fit(const Eigen::MatrixXd& A, const Eigen::MatrixXd& Y, double lambda) {
+    Eigen::MatrixXd G = A.transpose() * A;
+    G.diagonal().tail(A.cols() - 1).array() += lambda * double(A.rows());
+    return G.ldlt().solve(A.transpose() * Y);
+  }
+  /// [1, standardized inputs] (N × (inputs + 1)), in double.
+  Eigen::MatrixXd with_intercept(const Eigen::MatrixXd& inputs_) const {
+    check_inputs("with_intercept", inputs_);
+    Eigen::MatrixXd A(inputs_.rows(), inputs() + 1);
+    A.col(0).setOnes();
+    A.rightCols(inputs()) = (inputs_.rowwise() - in_mean_.transpose()).array().rowwise() / in_scale_.transpose().array();
+    return A;
+  }
+  /// What the network is trained to output for these displacements: with a base, what it leaves.
+  Eigen::MatrixXd network_part(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements) const {
+    if (base_.size() == 0) return displacements;
+    return displacements - with_intercept(inputs_) * base_;
   }
 
   /// [expression weights, parameters] per row (N × inputs()).
@@ -161,6 +206,13 @@ class SoftDecaSurrogate {
     mlp_->forward(policy, Mode::eval, in_, out_);
     displacements.resize(out_.rows(), out_.cols());
     displacements.noalias() = (out_.cast<double>() * out_scale_).rowwise() + out_mean_.transpose();
+    if (base_.size() != 0) {  // + [1, z] W, z in double
+      z_.resize(parameters.rows(), inputs() + 1);
+      z_.col(0).setOnes();
+      z_.middleCols(1, E) = (expressions.rowwise() - in_mean_.head(E).transpose()).array().rowwise() / in_scale_.head(E).transpose().array();
+      z_.rightCols(K) = (parameters.rowwise() - in_mean_.tail(K).transpose()).array().rowwise() / in_scale_.tail(K).transpose().array();
+      displacements.noalias() += z_ * base_;
+    }
   }
   template <exec::HostPolicy P>
   Eigen::MatrixXd predict(P policy, const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions) {
@@ -177,7 +229,9 @@ class SoftDecaSurrogate {
     z["in_scale"] = io::make_npy(in_scale_);
     z["out_mean"] = io::make_npy(out_mean_);
     z["out_scale"] = io::make_npy<double>({}, &out_scale_);
-    nlohmann::ordered_json j = {{"kind", "simsr softdeca surrogate"}, {"expressions", E_}, {"skin_vertices", M_}, {"hidden", hidden_}};
+    if (base_.size() != 0) z["linear_base"] = io::make_npy(base_);
+    nlohmann::ordered_json j = {{"kind", "simsr softdeca surrogate"}, {"expressions", E_}, {"skin_vertices", M_}, {"hidden", hidden_},
+                                {"linear_base", base_.size() != 0}};
     j["meta"] = meta;
     z["config"] = io::make_npy(std::vector<std::string>{j.dump()});
     io::write_npz(path, z);  // atomic (npz.hpp)
@@ -196,6 +250,12 @@ class SoftDecaSurrogate {
     s.in_scale_ = z.at("in_scale").to_matrix<double>().reshaped();
     s.out_mean_ = z.at("out_mean").to_matrix<double>().reshaped();
     s.out_scale_ = z.at("out_scale").item<double>();
+    if (j.value("linear_base", false)) {
+      if (!z.contains("linear_base")) throw Error("SoftDecaSurrogate::load: " + path.string() + ": its config names a linear base the file does not hold");
+      s.base_ = z.at("linear_base").to_matrix<double>();
+      if (s.base_.rows() != s.inputs() + 1 || s.base_.cols() != 3 * s.M_ || !s.base_.allFinite())
+        throw Error("SoftDecaSurrogate::load: " + path.string() + ": the linear base must be a finite (inputs + 1) x 3M matrix");
+    }
     if (s.in_mean_.size() != s.inputs() || s.in_scale_.size() != s.inputs() || s.out_mean_.size() != 3 * s.M_)
       throw Error("SoftDecaSurrogate::load: " + path.string() + ": standardization arrays do not match the dimensions in its config");
     if (!s.in_mean_.allFinite() || !s.out_mean_.allFinite() || !(s.in_scale_.array() > 0).all() || !(s.out_scale_ > 0))
@@ -210,6 +270,12 @@ class SoftDecaSurrogate {
       throw ShapeError("SoftDecaSurrogate: parameters (N x 20) and expressions (N x E)", {parameters.rows(), K + E_},
                        {expressions.rows(), parameters.cols() + expressions.cols()});
   }
+  void fit_output_normalization(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements) {
+    const Eigen::MatrixXd y = network_part(inputs_, displacements);
+    out_mean_ = y.colwise().mean().transpose();
+    const double spread = std::sqrt((y.rowwise() - out_mean_.transpose()).array().square().mean());
+    out_scale_ = spread > 0 ? spread : 1.0;
+  }
   void check_inputs(const char* what, const Eigen::MatrixXd& x) const {
     if (x.cols() != inputs()) throw ShapeError(std::string("SoftDecaSurrogate::") + what + ": inputs", {x.rows(), inputs()}, {x.rows(), x.cols()});
     if (!x.allFinite()) throw ArgumentError(std::string("SoftDecaSurrogate::") + what + ": non-finite input");
@@ -222,7 +288,9 @@ class SoftDecaSurrogate {
   std::unique_ptr<Mlp<float>> mlp_;
   VecX<> in_mean_, in_scale_, out_mean_;
   double out_scale_ = 1;
+  Eigen::MatrixXd base_;    // the linear base, empty without one
   Matrix<float> in_, out_;  // predict's buffers
+  Eigen::MatrixXd z_;
 };
 
 /// Errors of one predictor on a set of samples (per skin vertex, Euclidean, m).
@@ -309,8 +377,10 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const scenario::SoftD
   const Eigen::MatrixXd X = net.join(data.parameters, data.expressions);
   const Eigen::MatrixXd Xtr = X.topRows(train), Xte = X.bottomRows(test);
   const Eigen::MatrixXd Ytr = data.displacements.topRows(train), Yte = data.displacements.bottomRows(test);
+  net.clear_linear_base();  // a network trained before starts from its standardization alone
   net.fit_normalization(Xtr, Ytr);
-  const Matrix<float> in = net.standardize(Xtr), target = net.standardize_output(Ytr);
+  if (o.linear_base) net.fit_linear_base(Xtr.topRows(fit), Ytr.topRows(fit), o.ridge_lambda);  // not on the validation samples
+  const Matrix<float> in = net.standardize(Xtr), target = net.standardize_output(net.network_part(Xtr, Ytr));
 
   Adam<float> adam(net.store(), {.lr = o.lr, .weight_decay = o.weight_decay});
   Rng rng(o.seed);
@@ -363,16 +433,8 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const scenario::SoftD
   r.train = surrogate_errors(net.predict(policy, data.parameters.topRows(train), data.expressions.topRows(train)), Ytr, mean);
   r.held_out = surrogate_errors(net.predict(policy, data.parameters.bottomRows(test), data.expressions.bottomRows(test)), Yte, mean);
   r.mean_baseline = surrogate_errors(Eigen::MatrixXd(mean.transpose().replicate(test, 1)), Yte, mean);
-  {  // ridge on the same standardized inputs: [1, x] → y
-    const Eigen::MatrixXd Z = net.standardize(Xtr).cast<double>(), Zte = net.standardize(Xte).cast<double>();
-    Eigen::MatrixXd A(train, Z.cols() + 1), Ate(test, Z.cols() + 1);
-    A << Eigen::VectorXd::Ones(train), Z;
-    Ate << Eigen::VectorXd::Ones(test), Zte;
-    Eigen::MatrixXd G = A.transpose() * A;
-    G.diagonal().tail(Z.cols()).array() += o.ridge_lambda * double(train);
-    const Eigen::MatrixXd W = G.ldlt().solve(A.transpose() * Ytr);
-    r.ridge_baseline = surrogate_errors(Ate * W, Yte, mean);
-  }
+  // ridge on the same standardized inputs, [1, z] → y, fitted on every training sample
+  r.ridge_baseline = surrogate_errors(net.with_intercept(Xte) * SoftDecaSurrogate::ridge_fit(net.with_intercept(Xtr), Ytr, o.ridge_lambda), Yte, mean);
   // speed: one sample at a time, as a solver would be asked
   {
     const Eigen::MatrixXd p1 = data.parameters.bottomRows(1), e1 = data.expressions.bottomRows(1);
@@ -423,6 +485,7 @@ nlohmann::ordered_json train_softdeca_surrogate_files(P policy, const std::files
   j["batch"] = o.batch;
   j["lr"] = o.lr;
   j["weight_decay"] = o.weight_decay;
+  j["linear_base"] = o.linear_base;
   j["seed"] = o.seed;
   io::write_file_atomic(out / "surrogate_report.json", j.dump(2) + "\n");
   std::string csv = "epoch,train_loss,validation_loss\n";
