@@ -12,13 +12,16 @@
 ///   hidden  FC widths (default 256, 256, 256), LeakyReLU(0.01) after each
 ///   output  FC to 3·#skin, the displacement standardized by the training mean displacement and
 ///           one global scale (so the loss weighs every vertex and axis alike, in metres)
-///   base    optional (`SoftDecaSurrogateOptions::linear_base`): a ridge map of the same
-///           standardized inputs, fitted in closed form on the training samples, added to the
+///   base    optional (`SoftDecaSurrogateOptions::linear_base`): a ridge map of the 20
+///           standardized simulation parameters (not the expression weights), fitted in closed
+///           form on the training samples, its λ picked on the validation samples, added to the
 ///           output; the network then learns only what the linear map leaves (the residual
-///           composition of the core paper's §3.3, with the best linear map as its base). Why:
-///           the skull's per-axis scaling moves the skin nearly linearly by centimetres, and with
-///           the tens of samples a head affords the network learns that trend worse than a
-///           closed-form fit does, and the nonlinear rest not at all (README, "SoftDECA").
+///           composition of the core paper's §3.3, with a linear map as its base). Why: the
+///           skull's per-axis scaling moves the whole skin nearly linearly by centimetres, and
+///           with the tens of samples a head affords the network learns that trend worse than a
+///           closed-form fit does; the expressions act locally (below a millimetre over the whole
+///           skin on the 1.2 cm head), and a linear map of 57 sparse weights from tens of samples
+///           only fits noise (README, "SoftDECA").
 ///
 /// Why these dimensions: the supplement's figure gives only the kind of layer; the inputs are few
 /// (E + 20) and smooth in their effect, while the output is a whole skin, so a few hundred hidden
@@ -85,10 +88,12 @@ struct SoftDecaSurrogateOptions {
   /// of the epoch with the least validation loss (early stopping; 0: the last epoch's).
   double validation = 0.15;
   double weight_decay = 0;    ///< Adam's L2 weight decay
-  double ridge_lambda = 1e-3; ///< the ridge baseline's (and the linear base's) regularization (on standardized inputs)
-  /// Add a ridge map of the inputs, fitted on the training samples (not the validation ones), and
-  /// train the network on what it leaves (see the file comment).
+  double ridge_lambda = 1e-3; ///< the ridge baseline's regularization (on standardized inputs)
+  /// Add a ridge map of the parameters, fitted on the training samples (not the validation ones),
+  /// and train the network on what it leaves (see the file comment). Its λ is the one of
+  /// `base_lambdas` with the least validation error (ridge_lambda without validation samples).
   bool linear_base = false;
+  std::vector<double> base_lambdas = {1e-4, 1e-3, 1e-2, 1e-1, 1, 10};
   std::uint64_t seed = 1;     ///< batch order
   std::function<void(Index epoch, double train_loss)> progress = {};
 };
@@ -137,15 +142,28 @@ class SoftDecaSurrogate {
   }
 
   /// The linear base (see the file comment): W = argmin ‖[1, z] W − Y‖² + λN‖W without its
-  /// intercept row‖² over the standardized inputs z of `inputs_` (fit_normalization first), then
-  /// the output standardization refitted to what it leaves. λ > 0.
+  /// intercept row‖² over the standardized parameters z of `inputs_` (fit_normalization first),
+  /// stored with zero rows for the expression weights, then the output standardization refitted
+  /// to what it leaves. λ > 0.
   void fit_linear_base(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements, double lambda) {
+    base_ = parameter_ridge(inputs_, displacements, lambda);
+    fit_output_normalization(inputs_, displacements);
+  }
+  /// The base fit_linear_base() would set, without setting it ((inputs + 1) × 3M).
+  Eigen::MatrixXd parameter_ridge(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements, double lambda) const {
     check_inputs("fit_linear_base", inputs_);
     if (displacements.rows() != inputs_.rows() || displacements.cols() != 3 * M_)
       throw ShapeError("SoftDecaSurrogate::fit_linear_base: displacements", {inputs_.rows(), 3 * M_}, {displacements.rows(), displacements.cols()});
     if (!(lambda > 0)) throw ArgumentError("SoftDecaSurrogate::fit_linear_base: lambda must be > 0");
-    base_ = ridge_fit(with_intercept(inputs_), displacements, lambda);
-    fit_output_normalization(inputs_, displacements);
+    const Index K = scenario::SoftDecaParameters::size;
+    const Eigen::MatrixXd A = with_intercept(inputs_);
+    Eigen::MatrixXd Ap(A.rows(), K + 1);
+    Ap << A.col(0), A.rightCols(K);
+    const Eigen::MatrixXd Wp = ridge_fit(Ap, displacements, lambda);
+    Eigen::MatrixXd W = Eigen::MatrixXd::Zero(inputs() + 1, 3 * M_);
+    W.row(0) = Wp.row(0);
+    W.bottomRows(K) = Wp.bottomRows(K);
+    return W;
   }
   /// The linear base ((inputs + 1) × 3M: intercept row first), empty without one.
   const Eigen::MatrixXd& linear_base() const { return base_; }
@@ -306,7 +324,9 @@ struct SoftDecaSurrogateReport {
   std::vector<double> loss;             ///< per epoch, the mean training loss (standardized MSE)
   std::vector<double> validation_loss;  ///< per epoch, on the validation samples (empty without)
   Index best_epoch = 0;                 ///< the epoch whose weights were kept (0-based)
+  double base_lambda = 0;               ///< the linear base's λ (0: no base)
   SurrogateErrors train, held_out, mean_baseline, ridge_baseline;  ///< the last three on the held-out samples
+  SurrogateErrors base_alone;  ///< the linear base without the network, on the held-out samples (with a base)
   double train_seconds = 0;
   double inference_seconds = 0;  ///< one sample (batch of 1), median of repeated calls, the policy's threads
   double solver_seconds = 0;     ///< mean simulation time of the held-out samples (from the dataset)
@@ -316,6 +336,7 @@ struct SoftDecaSurrogateReport {
             {"held_out_samples", held_out_samples},
             {"epochs", epochs},
             {"best_epoch", best_epoch + 1},
+            {"linear_base_lambda", base_lambda},
             {"network_parameters", parameters},
             {"final_train_loss", loss.empty() ? 0.0 : loss.back()},
             {"best_validation_loss", validation_loss.empty() ? 0.0 : validation_loss[std::size_t(best_epoch)]},
@@ -323,6 +344,7 @@ struct SoftDecaSurrogateReport {
             {"held_out", held_out.to_json()},
             {"held_out_mean_baseline", mean_baseline.to_json()},
             {"held_out_ridge_baseline", ridge_baseline.to_json()},
+            {"held_out_linear_base_alone", base_lambda > 0 ? base_alone.to_json() : nlohmann::ordered_json()},
             {"train_seconds", train_seconds},
             {"inference_seconds_per_sample", inference_seconds},
             {"solver_seconds_per_sample", solver_seconds},
@@ -379,7 +401,17 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const scenario::SoftD
   const Eigen::MatrixXd Ytr = data.displacements.topRows(train), Yte = data.displacements.bottomRows(test);
   net.clear_linear_base();  // a network trained before starts from its standardization alone
   net.fit_normalization(Xtr, Ytr);
-  if (o.linear_base) net.fit_linear_base(Xtr.topRows(fit), Ytr.topRows(fit), o.ridge_lambda);  // not on the validation samples
+  if (o.linear_base) {  // fitted on the fit samples, its λ picked on the validation ones
+    double lambda = o.ridge_lambda, least = std::numeric_limits<double>::infinity();
+    if (val > 0)
+      for (double l : o.base_lambdas) {
+        const Eigen::MatrixXd W = net.parameter_ridge(Xtr.topRows(fit), Ytr.topRows(fit), l);
+        const double e = (net.with_intercept(Xtr.bottomRows(val)) * W - Ytr.bottomRows(val)).squaredNorm();
+        if (e < least) least = e, lambda = l;
+      }
+    net.fit_linear_base(Xtr.topRows(fit), Ytr.topRows(fit), lambda);
+    r.base_lambda = lambda;
+  }
   const Matrix<float> in = net.standardize(Xtr), target = net.standardize_output(net.network_part(Xtr, Ytr));
 
   Adam<float> adam(net.store(), {.lr = o.lr, .weight_decay = o.weight_decay});
@@ -433,6 +465,7 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const scenario::SoftD
   r.train = surrogate_errors(net.predict(policy, data.parameters.topRows(train), data.expressions.topRows(train)), Ytr, mean);
   r.held_out = surrogate_errors(net.predict(policy, data.parameters.bottomRows(test), data.expressions.bottomRows(test)), Yte, mean);
   r.mean_baseline = surrogate_errors(Eigen::MatrixXd(mean.transpose().replicate(test, 1)), Yte, mean);
+  if (o.linear_base) r.base_alone = surrogate_errors(net.with_intercept(Xte) * net.linear_base(), Yte, mean);
   // ridge on the same standardized inputs, [1, z] → y, fitted on every training sample
   r.ridge_baseline = surrogate_errors(net.with_intercept(Xte) * SoftDecaSurrogate::ridge_fit(net.with_intercept(Xtr), Ytr, o.ridge_lambda), Yte, mean);
   // speed: one sample at a time, as a solver would be asked
