@@ -46,7 +46,7 @@ inline void add_train_surrogate(CLI::App& app, std::function<int()>& action) {
       ->capture_default_str()->check(CLI::Range(0.0, 0.999));
   cmd->add_option("--weight-decay", a->options.weight_decay, "Adam's L2 weight decay")->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_flag("--linear-base", a->options.linear_base,
-               "add a ridge map of the inputs fitted on the training samples; the network learns what it leaves (few samples, a near-linear skull trend)");
+               "add a ridge map of the 20 parameters fitted on the training samples (lambda picked on the validation ones); the network learns what it leaves");
   cmd->add_option("--seed", a->options.seed, "initialization and batch-order seed")->capture_default_str();
   cmd->callback([a, &action] { action = [a] { return train_surrogate(*a); }; });
 }

@@ -308,7 +308,7 @@ class SoftDecaSurrogate {
   double out_scale_ = 1;
   Eigen::MatrixXd base_;    // the linear base, empty without one
   Matrix<float> in_, out_;  // predict's buffers
-  Eigen::MatrixXd z_;
+  Eigen::MatrixXd z_;       // predict's [1, z] for the linear base
 };
 
 /// Errors of one predictor on a set of samples (per skin vertex, Euclidean, m).
