@@ -1,5 +1,7 @@
 """The CLI tests' assertion counter: check() records and prints a failure without stopping the
-script, finish() prints the tally and exits 0 (all passed) or 1."""
+script, finish() prints the tally and exits 0 (all passed) or 1; missing_peer() ends a script
+whose peer (a Python package, a tool's optional component) is absent."""
+import os
 import sys
 
 failures = []
@@ -17,3 +19,12 @@ def check(cond, what):
 def finish():
     print(f"{count - len(failures)}/{count} checks passed")
     sys.exit(1 if failures else 0)
+
+
+def missing_peer(reason):
+    """A peer is missing: a failure under SIMSR_REQUIRE_PEERS=1 (the README test command, CI) or
+    after a failed check, otherwise exit 77 (ctest's skip: the checks so far passed, the rest
+    could not run)."""
+    print(f"MISSING (a failure under SIMSR_REQUIRE_PEERS=1, a skip otherwise): {reason}")
+    required = os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0")
+    sys.exit(1 if required or failures else 77)

@@ -16,7 +16,7 @@ import shutil
 import subprocess
 import sys
 
-from checks import check, finish
+from checks import check, finish, missing_peer
 
 SIMSR, WORK, DATA, REPO, NODE, MODULES = sys.argv[1:7]
 REQUIRE = os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0")
@@ -25,11 +25,9 @@ try:
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
 except ImportError as e:
-    print(f"MISSING (a failure under SIMSR_REQUIRE_PEERS=1, a skip otherwise): {e}")
-    sys.exit(1 if os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0") else 77)
+    missing_peer(e)
 if not os.path.exists(os.path.join(DATA, "bunny", "train_frames.npz")):
-    print(f"MISSING: {DATA}/bunny/train_frames.npz")
-    sys.exit(1 if os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0") else 77)
+    missing_peer(f"{DATA}/bunny/train_frames.npz (the data folder)")
 
 out = os.path.join(WORK, "demo")
 shutil.rmtree(out, ignore_errors=True)

@@ -17,13 +17,12 @@ import shutil
 import subprocess
 import sys
 
-from checks import check, failures, finish
+from checks import check, finish, missing_peer
 
 try:
     import numpy as np
 except ImportError as e:  # peer missing: skip, do not pass silently
-    print(f"MISSING (a failure under SIMSR_REQUIRE_PEERS=1, a skip otherwise): {e}")
-    sys.exit(1 if os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0") else 77)
+    missing_peer(e)
 
 SIMSR, WORK, KIT = sys.argv[1], sys.argv[2], sys.argv[3]
 shutil.rmtree(WORK, ignore_errors=True)
@@ -111,13 +110,8 @@ ict = os.path.join(WORK, "ict")
 args = [SIMSR, "datagen", "--scenario", "softdeca", "--template", "ict", "--kit", KIT, "--skin-edge", "2", "--linear-solver", "cholmod",
         "--samples", "1", "--steps", "1", "--out", ict]
 p = subprocess.run(args, capture_output=True, text=True)
-if p.returncode != 0 and "was built without" in p.stderr:  # a tool configured without CGAL or CHOLMOD: a missing peer
-    required = os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0")
-    print(f"MISSING (a failure under SIMSR_REQUIRE_PEERS=1, a skip otherwise): {p.stderr.strip()}")
-    check(not required, "the tool has CGAL and CHOLMOD (scripts/test.sh configures both)")
-    if not required:
-        sys.exit(77 if not failures else 1)  # the rest passed; this part could not run
-    finish()
+if p.returncode != 0 and "was built without" in p.stderr:  # a tool configured without CGAL or CHOLMOD
+    missing_peer(p.stderr.strip() + " (scripts/test.sh configures both)")
 check(p.returncode == 0, f"the remeshed ICT sample: exit {p.returncode}; stderr: {p.stderr.strip()[-400:]}")
 summary = json.loads(p.stdout) if p.returncode == 0 else {}
 skin = summary.get("template", {}).get("skin_vertices", 0)

@@ -10,15 +10,14 @@ import os
 import subprocess
 import sys
 
-from checks import check, finish
+from checks import check, finish, missing_peer
 
 try:
     import numpy as np
     import meshio
     import vtk
 except ImportError as e:
-    print(f"MISSING (a failure under SIMSR_REQUIRE_PEERS=1, a skip otherwise): {e}")
-    sys.exit(1 if os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0") else 77)
+    missing_peer(e)
 
 REPO, WORK = sys.argv[1], sys.argv[2]
 series = os.path.join(WORK, "series")

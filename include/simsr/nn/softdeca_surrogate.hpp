@@ -152,11 +152,15 @@ class SoftDecaSurrogate {
   /// The base fit_linear_base() would set, without setting it ((inputs + 1) × 3M).
   Eigen::MatrixXd parameter_ridge(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements, double lambda) const {
     check_inputs("fit_linear_base", inputs_);
-    if (displacements.rows() != inputs_.rows() || displacements.cols() != 3 * M_)
-      throw ShapeError("SoftDecaSurrogate::fit_linear_base: displacements", {inputs_.rows(), 3 * M_}, {displacements.rows(), displacements.cols()});
+    return parameter_ridge_of(with_intercept(inputs_), displacements, lambda);
+  }
+  /// parameter_ridge() of inputs already given as with_intercept() (a λ search fits several).
+  Eigen::MatrixXd parameter_ridge_of(const Eigen::MatrixXd& A, const Eigen::MatrixXd& displacements, double lambda) const {
+    if (A.cols() != inputs() + 1) throw ShapeError("SoftDecaSurrogate::parameter_ridge_of: [1, z]", {A.rows(), inputs() + 1}, {A.rows(), A.cols()});
+    if (displacements.rows() != A.rows() || displacements.cols() != 3 * M_)
+      throw ShapeError("SoftDecaSurrogate::fit_linear_base: displacements", {A.rows(), 3 * M_}, {displacements.rows(), displacements.cols()});
     if (!(lambda > 0)) throw ArgumentError("SoftDecaSurrogate::fit_linear_base: lambda must be > 0");
     const Index K = scenario::SoftDecaParameters::size;
-    const Eigen::MatrixXd A = with_intercept(inputs_);
     Eigen::MatrixXd Ap(A.rows(), K + 1);
     Ap << A.col(0), A.rightCols(K);
     const Eigen::MatrixXd Wp = ridge_fit(Ap, displacements, lambda);
@@ -179,9 +183,8 @@ class SoftDecaSurrogate {
   /// [1, standardized inputs] (N × (inputs + 1)), in double.
   Eigen::MatrixXd with_intercept(const Eigen::MatrixXd& inputs_) const {
     check_inputs("with_intercept", inputs_);
-    Eigen::MatrixXd A(inputs_.rows(), inputs() + 1);
-    A.col(0).setOnes();
-    A.rightCols(inputs()) = (inputs_.rowwise() - in_mean_.transpose()).array().rowwise() / in_scale_.transpose().array();
+    Eigen::MatrixXd A;
+    standardize_into(inputs_.leftCols(E_), inputs_.rightCols(scenario::SoftDecaParameters::size), A);
     return A;
   }
   /// What the network is trained to output for these displacements: with a base, what it leaves.
@@ -199,10 +202,7 @@ class SoftDecaSurrogate {
   }
 
   /// Standardized network input of raw inputs (N × inputs()), as float.
-  Matrix<float> standardize(const Eigen::MatrixXd& inputs_) const {
-    check_inputs("standardize", inputs_);
-    return ((inputs_.rowwise() - in_mean_.transpose()).array().rowwise() / in_scale_.transpose().array()).matrix().cast<float>();
-  }
+  Matrix<float> standardize(const Eigen::MatrixXd& inputs_) const { return with_intercept(inputs_).rightCols(inputs()).cast<float>(); }
   /// Standardized displacements (the training target).
   Matrix<float> standardize_output(const Eigen::MatrixXd& displacements) const {
     return ((displacements.rowwise() - out_mean_.transpose()) / out_scale_).cast<float>();
@@ -215,22 +215,12 @@ class SoftDecaSurrogate {
   void predict(P policy, const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions, Eigen::MatrixXd& displacements) {
     check_pair(parameters, expressions);
     if (!parameters.allFinite() || !expressions.allFinite()) throw ArgumentError("SoftDecaSurrogate::predict: non-finite input");
-    in_.resize(parameters.rows(), inputs());
-    const Index E = E_, K = scenario::SoftDecaParameters::size;
-    in_.leftCols(E) = ((expressions.rowwise() - in_mean_.head(E).transpose()).array().rowwise() / in_scale_.head(E).transpose().array())
-                          .matrix().cast<float>();
-    in_.rightCols(K) = ((parameters.rowwise() - in_mean_.tail(K).transpose()).array().rowwise() / in_scale_.tail(K).transpose().array())
-                           .matrix().cast<float>();
+    standardize_into(expressions, parameters, z_);
+    in_ = z_.rightCols(inputs()).cast<float>();
     mlp_->forward(policy, Mode::eval, in_, out_);
     displacements.resize(out_.rows(), out_.cols());
     displacements.noalias() = (out_.cast<double>() * out_scale_).rowwise() + out_mean_.transpose();
-    if (base_.size() != 0) {  // + [1, z] W, z in double
-      z_.resize(parameters.rows(), inputs() + 1);
-      z_.col(0).setOnes();
-      z_.middleCols(1, E) = (expressions.rowwise() - in_mean_.head(E).transpose()).array().rowwise() / in_scale_.head(E).transpose().array();
-      z_.rightCols(K) = (parameters.rowwise() - in_mean_.tail(K).transpose()).array().rowwise() / in_scale_.tail(K).transpose().array();
-      displacements.noalias() += z_ * base_;
-    }
+    if (base_.size() != 0) displacements.noalias() += z_ * base_;  // + [1, z] W, z in double
   }
   template <exec::HostPolicy P>
   Eigen::MatrixXd predict(P policy, const Eigen::MatrixXd& parameters, const Eigen::MatrixXd& expressions) {
@@ -288,6 +278,16 @@ class SoftDecaSurrogate {
       throw ShapeError("SoftDecaSurrogate: parameters (N x 20) and expressions (N x E)", {parameters.rows(), K + E_},
                        {expressions.rows(), parameters.cols() + expressions.cols()});
   }
+  /// z = [1, standardized expression weights, standardized parameters] (N × (inputs + 1)): the one
+  /// standardization of the network's input (as float) and the linear base's (resized only when N changes).
+  void standardize_into(const Eigen::Ref<const Eigen::MatrixXd>& expressions, const Eigen::Ref<const Eigen::MatrixXd>& parameters,
+                        Eigen::MatrixXd& z) const {
+    const Index E = E_, K = scenario::SoftDecaParameters::size;
+    z.resize(parameters.rows(), inputs() + 1);
+    z.col(0).setOnes();
+    z.middleCols(1, E) = (expressions.rowwise() - in_mean_.head(E).transpose()).array().rowwise() / in_scale_.head(E).transpose().array();
+    z.rightCols(K) = (parameters.rowwise() - in_mean_.tail(K).transpose()).array().rowwise() / in_scale_.tail(K).transpose().array();
+  }
   void fit_output_normalization(const Eigen::MatrixXd& inputs_, const Eigen::MatrixXd& displacements) {
     const Eigen::MatrixXd y = network_part(inputs_, displacements);
     out_mean_ = y.colwise().mean().transpose();
@@ -308,7 +308,7 @@ class SoftDecaSurrogate {
   double out_scale_ = 1;
   Eigen::MatrixXd base_;    // the linear base, empty without one
   Matrix<float> in_, out_;  // predict's buffers
-  Eigen::MatrixXd z_;       // predict's [1, z] for the linear base
+  Eigen::MatrixXd z_;       // predict's [1, z] (standardize_into)
 };
 
 /// Errors of one predictor on a set of samples (per skin vertex, Euclidean, m).
@@ -403,12 +403,13 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const scenario::SoftD
   net.fit_normalization(Xtr, Ytr);
   if (o.linear_base) {  // fitted on the fit samples, its λ picked on the validation ones
     double lambda = o.ridge_lambda, least = std::numeric_limits<double>::infinity();
-    if (val > 0)
+    if (val > 0) {
+      const Eigen::MatrixXd Afit = net.with_intercept(Xtr.topRows(fit)), Aval = net.with_intercept(Xtr.bottomRows(val));
       for (double l : o.base_lambdas) {
-        const Eigen::MatrixXd W = net.parameter_ridge(Xtr.topRows(fit), Ytr.topRows(fit), l);
-        const double e = (net.with_intercept(Xtr.bottomRows(val)) * W - Ytr.bottomRows(val)).squaredNorm();
+        const double e = (Aval * net.parameter_ridge_of(Afit, Ytr.topRows(fit), l) - Ytr.bottomRows(val)).squaredNorm();
         if (e < least) least = e, lambda = l;
       }
+    }
     net.fit_linear_base(Xtr.topRows(fit), Ytr.topRows(fit), lambda);
     r.base_lambda = lambda;
   }

@@ -144,9 +144,6 @@ class BasicSoftDecaSimulator {
   template <exec::HostPolicy P>
   SoftDecaResult simulate(P policy, const SoftDecaParameters& p, const VecX<>& expression, const SoftDecaSimulationOptions& o = {}) {
     if (o.steps < 1) throw ArgumentError("SoftDecaSimulator: steps must be >= 1, got " + std::to_string(o.steps));
-    if (o.max_iterations < 1 || o.newton_iterations < 1)
-      throw ArgumentError("SoftDecaSimulator: max_iterations and newton_iterations must be >= 1, got " + std::to_string(o.max_iterations) + " and " +
-                          std::to_string(o.newton_iterations));
     check_expression(expression);
     const auto t0 = std::chrono::steady_clock::now();
     prepare(p);
@@ -312,6 +309,10 @@ class BasicSoftDecaSimulator {
   template <class P>
   Index solve(P policy, physics::LocalGlobalSolver<Linear>& pd, Points<>& x, const SoftDecaSimulationOptions& o) {
     const physics::DirichletBoundary<>& bones = bones_;
+    // here, where every solve (simulate's, settle()'s and step()'s) takes its options
+    if (o.max_iterations < 1 || o.newton_iterations < 1)
+      throw ArgumentError("SoftDecaSimulator: max_iterations and newton_iterations must be >= 1, got " + std::to_string(o.max_iterations) + " and " +
+                          std::to_string(o.newton_iterations));
     newton_.options().relative_tolerance = o.relative_tolerance;
     newton_.options().max_iterations = o.newton_iterations;
     if (o.solver == SoftDecaSolver::newton) {
