@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Umbrella header: every area of simsr, in the order data flows through them
-/// (core → mesh/io → discretize → physics → neighbors → data → scenario | nn → interp → eval → pipeline).
+/// (core → mesh/io → discretize → physics → neighbors → data → scenario | nn → interp | shell → eval →
+/// pipeline).
 /// Include single areas (simsr/mesh/mesh.hpp, simsr/interp/interp.hpp, ...) to keep compile
 /// times short.
 
@@ -17,3 +18,4 @@
 #include "physics/physics.hpp"
 #include "pipeline/pipeline.hpp"
 #include "scenario/scenario.hpp"
+#include "shell/shell.hpp"

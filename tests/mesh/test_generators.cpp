@@ -132,22 +132,54 @@ TEST_CASE("ellipsoid_surface: exact vertex count, closed sphere, outward, O(1/nv
   CHECK_THROWS_AS(ellipsoid_surface(100, a, -1.0, c), ArgumentError);
 }
 
+namespace {
+/// Area of a mesh in the plane z = 0, checking that every triangle is counter-clockwise from +z.
+double ccw_area_in_plane(const TriMesh<>& m) {
+  double area = 0;
+  for (Index f = 0; f < m.F.rows(); ++f) {
+    const Vec3<> p = m.V.row(m.F(f, 0)), q = m.V.row(m.F(f, 1)), r = m.V.row(m.F(f, 2));
+    const double z = (q - p).cross(r - p)[2];
+    CHECK(z > 0);
+    area += z / 2;
+  }
+  return area;
+}
+}  // namespace
+
 TEST_CASE("disk_surface: counter-clockwise, area converges to pi r^2") {
   for (const Index n : {1, 3, 9}) {
     const auto d = disk_surface(1.5, n);
     CHECK(d.V.rows() == 1 + 3 * n * (n + 1));
     CHECK(d.F.rows() == 6 * n * n);
-    double area = 0;
-    for (Index f = 0; f < d.F.rows(); ++f) {
-      const Vec3<> p = d.V.row(d.F(f, 0)), q = d.V.row(d.F(f, 1)), r = d.V.row(d.F(f, 2));
-      const double z = (q - p).cross(r - p)[2];
-      CHECK(z > 0);
-      area += z / 2;
-    }
+    const double area = ccw_area_in_plane(d);
     const double N = 6.0 * double(n);
     CHECK(area == doctest::Approx(0.5 * N * 2.25 * std::sin(2 * std::numbers::pi / N)).epsilon(1e-12));
     CHECK(boundary_loops(d.F).size() == 1);
   }
+}
+
+TEST_CASE("square_sheet: counts, counter-clockwise, exact area, one boundary loop, alternating diagonals") {
+  for (const Index n : {1, 2, 8}) {
+    const auto s = square_sheet(2.0, n);
+    CHECK(s.V.rows() == (n + 1) * (n + 1));
+    CHECK(s.F.rows() == 2 * n * n);
+    const double area = ccw_area_in_plane(s);
+    CHECK(area == doctest::Approx(4.0).epsilon(1e-14));
+    CHECK(boundary_loops(s.F).size() == 1);
+    CHECK(unique_edges(s.F).rows() == 2 * n * (n + 1) + n * n);  // axis edges + one diagonal per cell
+  }
+  // 8 cells: the SHEET scene's 81 coarse vertices; neighbouring cells carry crossing diagonals
+  const auto s = square_sheet(1.0, 8);
+  CHECK(s.V.rows() == 81);
+  const Edges E = unique_edges(s.F);
+  auto has = [&](VIndex a, VIndex b) {
+    for (Index e = 0; e < E.rows(); ++e)
+      if (E(e, 0) == std::min(a, b) && E(e, 1) == std::max(a, b)) return true;
+    return false;
+  };
+  CHECK(has(0, 10));   // cell (0, 0): diagonal from (0, 0) to (1, 1)
+  CHECK(has(2, 10));   // cell (1, 0): diagonal from (2, 0) to (1, 1)
+  CHECK(!has(1, 9));
 }
 
 }  // namespace mesh_test_generators

@@ -17,4 +17,16 @@ std::string error_of(F&& f) {
   return "";
 }
 
+/// The message of the exception of type E that `f` throws, "" when it throws none; an exception
+/// of another type escapes (and fails the test): for checks that the error is the right type.
+template <class E, class F>
+std::string typed_error_of(F&& f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  return "";
+}
+
 }  // namespace simsr::test

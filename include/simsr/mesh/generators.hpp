@@ -2,12 +2,14 @@
 /// \file
 /// Meshes of simple solids and closed surfaces at any resolution, for tests, benchmarks and
 /// examples. Every tet mesh is conforming (neighbouring tets share whole faces) and positively
-/// oriented; every surface is closed and counter-clockwise seen from outside.
+/// oriented; every closed surface is counter-clockwise seen from outside (the disk and the sheet are
+/// open, in z = 0, counter-clockwise seen from +z).
 ///
 ///     auto box = simsr::box_tet_mesh(10, 10, 10);                  // unit cube, 6000 Kuhn tets
 ///     auto cyl = simsr::cylinder_tet_mesh(1.0, 2.0, 8, 12);        // r = 1, height 2
 ///     auto shell = simsr::sphere_shell_tet_mesh(0.5, 1.0, 3, 4);   // icosphere level 3, 4 layers
 ///     auto face = simsr::ellipsoid_surface(35637, 1.0, 0.8, 0.6);  // exactly 35,637 vertices
+///     auto sheet = simsr::square_sheet(1.0, 8);                    // 81 vertices, 128 triangles
 ///
 /// Curved boundaries are inscribed polyhedra: volumes converge to the analytic value as O(ℓ²)
 /// in the boundary edge length ℓ.
@@ -141,6 +143,36 @@ TetMesh<S> box_tet_mesh(Index nx, Index ny, Index nz, const Vec3<S>& lo = Vec3<S
       }
   m.T.resize(Index(tets.size()), 4);
   detail::fill_rows(m.T, tets);
+  return m;
+}
+
+/// Square sheet [0, size]² in the plane z = 0 as cells×cells squares, each cut along a diagonal
+/// that alternates with the cell's parity (i + j), so that no direction is favoured (a cloth
+/// sheet's usual "criss-cross" triangulation). Vertex (i, j) of the (cells+1)² grid has index
+/// i + (cells+1)·j. 2·cells² triangles, counter-clockwise seen from +z. cells = 8 gives the
+/// 81-vertex coarse sheet of Chen et al. 2023's SHEET scene.
+template <class S = Scalar>
+TriMesh<S> square_sheet(S size, Index cells) {
+  detail::require_positive("square_sheet: size", double(size));
+  detail::require_at_least("square_sheet: cells", cells, 1);
+  const Index n = cells + 1;
+  TriMesh<S> m;
+  m.V.resize(n * n, 3);
+  for (Index j = 0; j < n; ++j)
+    for (Index i = 0; i < n; ++i) m.V.row(i + n * j) << size * S(i) / S(cells), size * S(j) / S(cells), S(0);
+  m.F.resize(2 * cells * cells, 3);
+  Index f = 0;
+  for (Index j = 0; j < cells; ++j)
+    for (Index i = 0; i < cells; ++i) {
+      const VIndex a = VIndex(i + n * j), b = VIndex(a + 1), c = VIndex(a + n), d = VIndex(a + n + 1);
+      if ((i + j) % 2 == 0) {  // diagonal a–d
+        m.F.row(f++) << a, b, d;
+        m.F.row(f++) << a, d, c;
+      } else {  // diagonal b–c
+        m.F.row(f++) << a, b, c;
+        m.F.row(f++) << b, d, c;
+      }
+    }
   return m;
 }
 

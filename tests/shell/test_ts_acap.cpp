@@ -1,0 +1,164 @@
+#include <doctest/doctest.h>
+
+#include <simsr/mesh/generators.hpp>
+#include <simsr/shell/ts_acap.hpp>
+
+#include <numbers>
+#include <random>
+
+#include "../support/error_of.hpp"
+
+namespace shell_test_ts_acap {
+
+using namespace simsr;
+constexpr double pi = std::numbers::pi;
+
+namespace {
+
+/// The Poisson energy the decoder minimizes, Σ_i Σ_j w_ij ‖(p_i − p_j) − T_i (q_i − q_j)‖².
+double poisson_energy(const TsAcap<double>& acap, const std::vector<Mat3<>>& T, const Points<>& p) {
+  const Adjacency& A = acap.fit().adjacency();
+  const Points<>& q = acap.fit().rest();
+  double E = 0;
+  for (Index i = 0; i < p.rows(); ++i)
+    for (Index k = A.offsets[i]; k < A.offsets[i + 1]; ++k) {
+      const Index j = A.neighbors[k];
+      E += acap.fit().weights()[k] *
+           (Vec3<>(p.row(i) - p.row(j)) - T[i] * Vec3<>(q.row(i) - q.row(j))).squaredNorm();
+    }
+  return E;
+}
+
+Vec3<> centroid(const Points<>& V) { return V.colwise().mean().transpose(); }
+
+/// A sheet rolled (isometrically, as cloth bends) around an axis along y with curvature κ, then
+/// turned by `spin` about a tilted axis.
+Points<> roll(const Points<>& X, double kappa, double spin) {
+  const Mat3<> R = Eigen::AngleAxisd(spin, Vec3<>(0.2, 1.0, 0.4).normalized()).toRotationMatrix();
+  Points<> V(X.rows(), 3);
+  for (Index i = 0; i < X.rows(); ++i) {
+    const double x = X(i, 0), y = X(i, 1);
+    const Vec3<> p = kappa > 1e-12 ? Vec3<>(std::sin(kappa * x) / kappa, y, (1 - std::cos(kappa * x)) / kappa) : Vec3<>(x, y, 0);
+    V.row(i) = (R * p).transpose();
+  }
+  return V;
+}
+
+/// Encodes roll(κ = 0.2·t, spin = 0.22·t) for t = 0, 1/sub, …, 20 on a cells×cells sheet.
+/// Returns the largest change of any feature between consecutive frames; `decode_error` gets the
+/// largest distance of a decoded vertex from its input (at integer t), `max_angle` the largest |Φ|.
+double roll_sequence(int cells, int sub, double& decode_error, double& max_angle) {
+  const TriMesh<> m = square_sheet(1.0, cells);
+  const TsAcap<double> acap(exec::seq, m.V, m.F);
+  TsAcapState<double> state;
+  TsAcapFeatures<double> previous;
+  double jump = 0;
+  decode_error = max_angle = 0;
+  for (int k = 0; k <= 20 * sub; ++k) {
+    const Points<> V = roll(m.V, 0.2 * k / sub, 0.22 * k / sub);
+    const TsAcapFeatures<double> f = acap.encode(exec::seq, V, state);
+    max_angle = std::max(max_angle, state.angle.cwiseAbs().maxCoeff());
+    if (k % sub == 0)
+      decode_error = std::max(decode_error, (acap.decode(exec::seq, f, centroid(V)) - V).rowwise().norm().maxCoeff());
+    if (k > 0) jump = std::max(jump, (f - previous).cwiseAbs().maxCoeff());
+    previous = f;
+  }
+  return jump;
+}
+
+}  // namespace
+
+TEST_CASE("TsAcap: the rest frame's features are [0 0 0, 1 0 0 1 0 1]") {
+  const TriMesh<> m = square_sheet(1.0, 8);
+  const TsAcap<double> acap(exec::seq, m.V, m.F);
+  TsAcapState<double> state;
+  const TsAcapFeatures<double> f = acap.encode(exec::seq, m.V, state);
+  Eigen::Matrix<double, 1, 9> rest;
+  rest << 0, 0, 0, 1, 0, 0, 1, 0, 1;
+  for (Index i = 0; i < f.rows(); ++i) CHECK((f.row(i) - rest).norm() < 1e-12);
+}
+
+TEST_CASE("TsAcap: a sheet spinning through 3.3 turns keeps continuous rotation vectors and round-trips to 1e-8") {
+  const TriMesh<> m = square_sheet(1.0, 8);
+  const TsAcap<double> acap(exec::seq, m.V, m.F);
+  const Vec3<> axis = Vec3<>(0.3, -0.5, 1.0).normalized();
+  TsAcapState<double> state;
+  for (int k = 0; k <= 60; ++k) {
+    const double angle = 0.35 * k, scale = 1 + 0.01 * k;  // up to 21 rad
+    const Mat3<> R = Eigen::AngleAxisd(angle, axis).toRotationMatrix();
+    Points<> V = (scale * m.V * R.transpose()).eval();
+    V.rowwise() += Eigen::RowVector3d(0.1 * k, -0.2 * k, 3.0);
+    TsAcapFrameReport report;
+    const TsAcapFeatures<double> f = acap.encode(exec::seq, V, state, &report);
+    for (Index i = 0; i < f.rows(); ++i) {
+      CHECK((f.row(i).head<3>().transpose() - angle * axis).norm() < 1e-9);  // the unwrapped angle, not mod 2π
+      CHECK(f(i, 3) == doctest::Approx(scale).epsilon(1e-10));
+    }
+    const Points<> back = acap.decode(exec::seq, f, centroid(V));
+    CHECK((back - V).cwiseAbs().maxCoeff() < 1e-8);
+  }
+}
+
+TEST_CASE("TsAcap: decoding returns the least-squares positions of the fitted gradients (energy checks)") {
+  const TriMesh<> m = square_sheet(1.0, 10);
+  const TsAcap<double> acap(exec::seq, m.V, m.F);
+  TsAcapState<double> state, state_omp;
+  for (int k = 0; k <= 20; k += 4) {
+    const Points<> V = roll(m.V, 0.2 * k, 0.22 * k);
+    const TsAcapFeatures<double> f = acap.encode(exec::seq, V, state);
+    CHECK(f == acap.encode(exec::omp, V, state_omp));  // seq and omp bitwise equal
+    const Points<> back = acap.decode(exec::omp, f, centroid(V));
+    const std::vector<Mat3<>> T = acap.gradients_from_features(exec::seq, f);
+    // the decoded positions minimize the Poisson energy: no higher than at the input positions
+    // (one feasible answer) and stationary (no random single-vertex move lowers it)
+    const double E = poisson_energy(acap, T, back);
+    CHECK(E <= poisson_energy(acap, T, V) * (1 + 1e-12) + 1e-15);
+    std::mt19937 rng(k);
+    std::normal_distribution<double> g;
+    for (int t = 0; t < 5; ++t) {
+      Points<> moved = back;
+      moved.row(rng() % moved.rows()) += 1e-4 * Eigen::RowVector3d(g(rng), g(rng), g(rng));
+      CHECK(poisson_energy(acap, T, moved) >= E);
+    }
+    CHECK((centroid(back) - centroid(V)).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("TsAcap: a rolling, turning sheet: features continuous in time past π, decoding error O(h²)") {
+  double e6 = 0, e12 = 0, e24 = 0, angle = 0;
+  const double jump = roll_sequence(12, 1, e12, angle);
+  const double jump_fine = roll_sequence(12, 4, e12, angle);
+  roll_sequence(6, 1, e6, angle);
+  roll_sequence(24, 1, e24, angle);
+  MESSAGE("rolling sheet: largest |angle| " << angle << " rad; largest feature change per frame " << jump << " (step 1), "
+                                            << jump_fine << " (step 1/4); worst decoded vertex off by " << e6 << " / " << e12
+                                            << " / " << e24 << " at 6 / 12 / 24 cells");
+  CHECK(angle > 4.0);                      // well past π: the unwrapping is exercised
+  CHECK(jump_fine < 0.3 * jump);           // a 4× finer step changes the features 4× less: no 2π jumps
+  CHECK(e6 / e12 > 3.0);                   // the fit's error is the discretization's, halving with h²
+  CHECK(e12 / e24 > 3.0);
+  CHECK(e24 < 0.003);
+}
+
+TEST_CASE("TsAcap: bad input is a typed error") {
+  TriMesh<> two = square_sheet(1.0, 2);
+  const Index n = two.V.rows();
+  Points<> V2(2 * n, 3);
+  V2 << two.V, two.V.rowwise() + Eigen::RowVector3d(5, 0, 0);
+  Tris F2(2 * two.F.rows(), 3);
+  F2 << two.F, two.F.array() + VIndex(n);
+  CHECK(test::typed_error_of<MeshError>([&] { TsAcap<double>(exec::seq, V2, F2); }).find("connected") != std::string::npos);
+  const TsAcap<double> acap(exec::seq, two.V, two.F);
+  TsAcapFeatures<double> f = TsAcapFeatures<double>::Zero(n - 1, 9);
+  CHECK(!test::typed_error_of<ShapeError>([&] { acap.decode(exec::seq, f, Vec3<>::Zero()); }).empty());
+  f = TsAcapFeatures<double>::Zero(n, 9);
+  f(2, 4) = std::nan("");
+  CHECK(!test::typed_error_of<ArgumentError>([&] { acap.decode(exec::seq, f, Vec3<>::Zero()); }).empty());
+  TsAcapState<double> state;
+  state.axis = Points<>::Zero(3, 3);
+  state.angle = VecX<>::Zero(3);
+  state.principal_angle = VecX<>::Zero(3);
+  CHECK(!test::typed_error_of<ShapeError>([&] { acap.encode(exec::seq, two.V, state); }).empty());
+}
+
+}  // namespace shell_test_ts_acap
