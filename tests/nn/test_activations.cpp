@@ -35,6 +35,16 @@ TEST_CASE("nn::Sine: sin(ω₀x) and its gradient") {
   }
 }
 
+TEST_CASE("nn::Tanh: tanh and its gradient") {
+  std::mt19937_64 rng(36);
+  nn::Tanh<double> t;
+  const Matrix<double> x = random_matrix(rng, 9, 4, -2, 2);
+  Matrix<double> y;
+  t.forward(exec::seq, nn::Mode::eval, x, y);
+  for (Index i = 0; i < x.size(); ++i) CHECK(y.data()[i] == std::tanh(x.data()[i]));
+  test::check_gradients(test::layer_gradient_check(t, nullptr, x, nn::Mode::train, rng));
+}
+
 TEST_CASE("nn::siren_init: first layer U(±1/fan_in), later U(±√(6/fan_in)/ω₀), biases likewise") {
   nn::Rng rng(33);
   nn::ParameterStore<float> store;

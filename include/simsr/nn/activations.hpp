@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// Elementwise activations (no parameters): LeakyReLU (slope 0.2 in the feature embedding, SPEC §7)
-/// and Sine, sin(ω₀·x), of SIREN (the upsampling weight network and the decoder), with the SIREN
+/// Elementwise activations (no parameters): LeakyReLU (slope 0.2 in the feature embedding, SPEC §7),
+/// Tanh (the thin-shell encoders) and Sine, sin(ω₀·x), of SIREN (the upsampling weight network and the decoder), with the SIREN
 /// initialization of the Linear layer before a Sine.
 ///
 ///     nn::Linear<float> l0(store, "net_decoder.decoder.layers.0.fc", 227, 256, rng);
@@ -76,6 +76,29 @@ class LeakyReLU {
   S slope_;
 };
 static_assert(assert_layer<LeakyReLU<float>>());
+
+/// tanh (the activation of Chen et al. 2023's mesh encoders, supplement §3). `out` must not
+/// alias `in`.
+template <class S = float>
+class Tanh {
+ public:
+  using scalar_type = S;
+  Index out_features(Index in_cols) const { return in_cols; }
+
+  template <exec::HostPolicy Policy>
+  void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
+    detail::map_rows<S>(policy, in, out, [](S x) { return std::tanh(x); });
+  }
+  template <exec::HostPolicy Policy>
+  void backward(Policy policy, const ConstView<S>& in, const ConstView<S>&, const ConstView<S>& d_out, Matrix<S>* d_in) {
+    if (!d_in) return;
+    detail::map_rows_backward<S>(policy, in, d_out, *d_in, "nn::Tanh", [](S x) {
+      const S t = std::tanh(x);
+      return S(1) - t * t;
+    });
+  }
+};
+static_assert(assert_layer<Tanh<float>>());
 
 /// Sine activation sin(ω₀·x) (SIREN, Sitzmann et al. 2020; the reference's `Sine(w0)`).
 /// `out` must not alias `in`.
