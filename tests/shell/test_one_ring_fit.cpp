@@ -11,6 +11,7 @@
 namespace shell_test_one_ring_fit {
 
 using namespace simsr;
+using namespace simsr::shell;
 
 namespace {
 

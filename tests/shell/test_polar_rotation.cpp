@@ -9,6 +9,7 @@
 namespace shell_test_polar_rotation {
 
 using namespace simsr;
+using namespace simsr::shell;
 
 TEST_CASE("polar_decomposition: T = R S, R a proper rotation, S symmetric, over random T of both signs") {
   std::mt19937 rng(1);

@@ -15,6 +15,7 @@
 namespace shell_test_rotation_consistency {
 
 using namespace simsr;
+using namespace simsr::shell;
 constexpr double pi = std::numbers::pi;
 
 namespace {

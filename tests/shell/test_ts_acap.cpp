@@ -11,6 +11,7 @@
 namespace shell_test_ts_acap {
 
 using namespace simsr;
+using namespace simsr::shell;
 constexpr double pi = std::numbers::pi;
 
 namespace {

@@ -30,7 +30,7 @@
 #include "../mesh/normals.hpp"
 #include "../mesh/topology.hpp"
 
-namespace simsr {
+namespace simsr::shell {
 
 /// The edge weights w_ij of Eq. 1 (the rest mesh's; the same in the fit and in the inverse solve).
 enum class OneRingWeights {
@@ -61,7 +61,7 @@ class OneRingFit {
   template <exec::HostPolicy P>
   OneRingFit(P policy, const Points<S>& rest, const Tris& F, OneRingFitOptions options = {})
       : options_(options), F_(F), rest_(rest) {
-    detail::require_cols("OneRingFit: F", F, 3);
+    simsr::detail::require_cols("OneRingFit: F", F, 3);
     if (!(options.normal_scale > 0)) throw ArgumentError("OneRingFit: normal_scale must be > 0");
     if (!rest.allFinite()) throw ArgumentError("OneRingFit: rest positions contain NaN or Inf");
     adjacency_ = vertex_adjacency(F, rest.rows());
@@ -78,15 +78,15 @@ class OneRingFit {
     rest_inverse_.resize(static_cast<std::size_t>(n));
     std::vector<std::string> problems(static_cast<std::size_t>(n));
     exec::parallel_for(policy, n, [&](Index i) {
-      const Vec3<S> q = detail::point(rest, i);
+      const Vec3<S> q = simsr::detail::point(rest, i);
       Mat3<S> M = Mat3<S>::Zero();
       S length = 0;
       for (Index k = adjacency_.offsets[i]; k < adjacency_.offsets[i + 1]; ++k) {
-        const Vec3<S> e = q - detail::point(rest, adjacency_.neighbors[k]);
+        const Vec3<S> e = q - simsr::detail::point(rest, adjacency_.neighbors[k]);
         M += weights_[k] * e * e.transpose();
         length += e.norm();
       }
-      const Vec3<S> nrm = S(options_.normal_scale) * length / S(adjacency_.degree(i)) * detail::point(N, i);
+      const Vec3<S> nrm = S(options_.normal_scale) * length / S(adjacency_.degree(i)) * simsr::detail::point(N, i);
       rest_normal_scaled_.row(i) = nrm.transpose();
       M += nrm * nrm.transpose();
       // Well-posed when M is far from singular relative to its own scale.
@@ -125,16 +125,16 @@ class OneRingFit {
     const Points<S> N = vertex_normals(V, F_);
     T.resize(static_cast<std::size_t>(V.rows()));
     exec::parallel_for(policy, V.rows(), [&](Index i) {
-      const Vec3<S> p = detail::point(V, i), q = detail::point(rest_, i);
+      const Vec3<S> p = simsr::detail::point(V, i), q = simsr::detail::point(rest_, i);
       Mat3<S> D = Mat3<S>::Zero();
       S length = 0;
       for (Index k = adjacency_.offsets[i]; k < adjacency_.offsets[i + 1]; ++k) {
         const Index j = adjacency_.neighbors[k];
-        const Vec3<S> d = p - detail::point(V, j);
-        D += weights_[k] * d * (q - detail::point(rest_, j)).transpose();
+        const Vec3<S> d = p - simsr::detail::point(V, j);
+        D += weights_[k] * d * (q - simsr::detail::point(rest_, j)).transpose();
         length += d.norm();
       }
-      const Vec3<S> nrm = S(options_.normal_scale) * length / S(adjacency_.degree(i)) * detail::point(N, i);
+      const Vec3<S> nrm = S(options_.normal_scale) * length / S(adjacency_.degree(i)) * simsr::detail::point(N, i);
       D += nrm * rest_normal_scaled_.row(i);
       T[static_cast<std::size_t>(i)] = D * rest_inverse_[static_cast<std::size_t>(i)];
     });
@@ -164,4 +164,4 @@ class OneRingFit {
   std::vector<Mat3<S>> rest_inverse_;
 };
 
-}  // namespace simsr
+}  // namespace simsr::shell

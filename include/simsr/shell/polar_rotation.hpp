@@ -13,7 +13,7 @@
 
 #include "../core/types.hpp"
 
-namespace simsr {
+namespace simsr::shell {
 
 /// T = R S, R a proper rotation, S symmetric (positive definite when det T > 0; when det T < 0,
 /// an inverted one-ring, S has one negative eigenvalue so that R stays a rotation).
@@ -64,4 +64,4 @@ Mat3<S> rotation_from_vector(const Vec3<S>& rho) {
   return Eigen::AngleAxis<S>(t, rho / t).toRotationMatrix();
 }
 
-}  // namespace simsr
+}  // namespace simsr::shell

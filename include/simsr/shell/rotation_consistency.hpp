@@ -35,7 +35,7 @@
 #include "../core/types.hpp"
 #include "../mesh/topology.hpp"
 
-namespace simsr {
+namespace simsr::shell {
 
 /// ε₁ and ε₂ of Eq. 3 (the paper leaves them open).
 struct ConsistencyThresholds {
@@ -319,4 +319,4 @@ inline std::vector<int> solve_angle_cycles(const AngleCycleProblem& P, Consisten
   return r;
 }
 
-}  // namespace simsr
+}  // namespace simsr::shell

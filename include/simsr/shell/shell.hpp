@@ -1,13 +1,16 @@
 #pragma once
 /// \file
 /// Thin shells (Chen et al. 2023, "Deep Deformation Detail Synthesis for Thin Shell Models"):
-/// TS-ACAP deformation features of triangle-mesh sequences and their inverse map.
+/// TS-ACAP deformation features of triangle-mesh sequences and their inverse map; the mesh
+/// encoders and decoders of the network.
 ///
-///     simsr::TsAcap<double> acap(simsr::exec::omp, rest_V, F);       // once per mesh
-///     simsr::TsAcapState<double> state;                              // one per sequence
+///     simsr::shell::TsAcap<double> acap(simsr::exec::omp, rest_V, F);   // once per mesh
+///     simsr::shell::TsAcapState<double> state;                          // one per sequence
 ///     auto f = acap.encode(simsr::exec::omp, V_t, state);            // #V×9 per frame
 ///     auto V = acap.decode(simsr::exec::omp, f, centroid);           // back to positions
 
+#include "deform_transformer.hpp"
+#include "mesh_autoencoder.hpp"
 #include "one_ring_fit.hpp"
 #include "polar_rotation.hpp"
 #include "rotation_consistency.hpp"

@@ -36,7 +36,7 @@
 #include "polar_rotation.hpp"
 #include "rotation_consistency.hpp"
 
-namespace simsr {
+namespace simsr::shell {
 
 /// Features per vertex.
 inline constexpr Index ts_acap_feature_dim = 9;
@@ -204,7 +204,7 @@ class TsAcap {
       for (Index k = A.offsets[i]; k < A.offsets[i + 1]; ++k) {
         const Index j = A.neighbors[k];
         bi += S(0.5) * fit_.weights()[k] * (T[static_cast<std::size_t>(i)] + T[static_cast<std::size_t>(j)]) *
-              (detail::point(q, i) - detail::point(q, j));
+              (simsr::detail::point(q, i) - simsr::detail::point(q, j));
       }
       b.row(i) = bi.transpose();
     });
@@ -232,4 +232,4 @@ class TsAcap {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<S>> poisson_;
 };
 
-}  // namespace simsr
+}  // namespace simsr::shell
