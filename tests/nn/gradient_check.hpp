@@ -115,6 +115,22 @@ inline void check_gradients(const std::vector<GradientError>& errors, double tol
   }
 }
 
+/// check_gradients for networks with attention: the key projections' biases (names ending in
+/// ".k.bias") have an exactly zero gradient, since softmax is invariant to a constant added to a
+/// query's scores and q·(k_j + b_k) adds q·b_k to all of them; they are checked to be ~0 instead.
+inline void check_attention_gradients(const std::vector<GradientError>& errors, double tol = 1e-6) {
+  std::vector<GradientError> rest;
+  for (const auto& e : errors) {
+    if (e.what.size() > 7 && e.what.compare(e.what.size() - 7, 7, ".k.bias") == 0) {
+      INFO(e.what << ": gradient scale " << e.scale);
+      CHECK(e.scale < 1e-12);
+    } else {
+      rest.push_back(e);
+    }
+  }
+  check_gradients(rest, tol);
+}
+
 /// The same layer checked on its own (forward/backward with `mode`).
 template <nn::Layer L>
 std::vector<GradientError> layer_gradient_check(L& layer, nn::ParameterStore<double>* store, const Matrix<double>& x, nn::Mode mode,
