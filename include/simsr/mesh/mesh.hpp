@@ -10,6 +10,7 @@
 #include "normals.hpp"
 #include "poly_mesh.hpp"
 #include "isosurface.hpp"
+#include "loop_subdivision.hpp"
 #include "quality.hpp"
 #include "rigid_motion.hpp"
 #include "tet_overlap.hpp"
