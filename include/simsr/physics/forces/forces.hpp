@@ -11,4 +11,5 @@
 #include "obstacle_contact.hpp"
 #include "self_contact.hpp"
 #include "surface_bending.hpp"
+#include "triangle_membrane.hpp"
 #include "vertex_targets.hpp"
