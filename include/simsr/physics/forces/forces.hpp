@@ -2,7 +2,8 @@
 /// \file
 /// Forces and constraints of the quasistatic soft-tissue solver (SPEC §3): track and point
 /// springs, gravity, bone attachments (Dirichlet constraints), obstacle and self-contact; and
-/// SoftDECA's surface terms (bending, target and distance attraction) and its dynamics.
+/// SoftDECA's surface terms (bending, target and distance attraction) and its dynamics; the
+/// cloth membrane (TriangleMembrane).
 
 #include "bone_attachment.hpp"
 #include "embedded_springs.hpp"
