@@ -47,20 +47,44 @@ std::int64_t best_signs(const AxisSignProblem& P) {
 }
 
 /// The exact optimum of Eq. 4 over r ∈ [−range, range]ⁿ (r_0 = 0 when the gauge is fixed), by
-/// enumeration. The instances below keep every angle within ±3π, so the optimum lies inside.
+/// enumeration in odometer order, the objective updated by the terms at each changed vertex. The
+/// instances below keep every angle within ±3π·(<1) of a centre in ±3π, so the optimum lies inside.
 double best_cycles(const AngleCycleProblem& P, int range) {
+  constexpr double two_pi = 2 * pi;
   const Index n = P.num_vertices();
+  const Adjacency A = vertex_adjacency(P.edges, n);
   std::vector<int> r(static_cast<std::size_t>(n), -range);
   if (P.fix_first) r[0] = 0;
-  double best = std::numeric_limits<double>::infinity();
+  auto local = [&](Index i) {  // the terms at vertex i (edges counted from i's side only)
+    double F = 0;
+    for (const VIndex j : A[i]) {
+      const double d = two_pi * (r[i] - r[j]) + P.phi[i] - P.phi[j];
+      F += d * d;
+    }
+    if (P.previous) {
+      const double d = two_pi * r[i] + P.phi[i] - (*P.previous)[i];
+      F += d * d;
+    }
+    return F;
+  };
+  // changing r_i moves its edge terms (each shared with a neighbour: counted once in local(i)
+  // and once in local(j), so the change of the sum of edge terms is the change of local(i)'s
+  // edge part) and its own temporal term
+  auto set = [&](Index i, int value, double& F) {
+    const double before = local(i);
+    r[i] = value;
+    F += local(i) - before;
+  };
+  double F = P.objective(r), best = F;
+  std::vector<int> argmin = r;
   for (;;) {
-    best = std::min(best, P.objective(r));
     Index i = P.fix_first ? 1 : 0;
-    while (i < n && r[i] == range) r[i] = -range, ++i;
+    while (i < n && r[i] == range) set(i, -range, F), ++i;
     if (i == n) break;
-    ++r[i];
+    set(i, r[i] + 1, F);
+    if (F < best) best = F, argmin = r;
   }
-  return best;
+  return P.objective(argmin);  // exactly, without the updates' rounding
 }
 
 /// A small mesh's edges: the 1-ring disk (7 vertices) or the 2-ring one (19).
