@@ -128,3 +128,48 @@ TEST_CASE("ObstacleContact: bad input throws typed errors") {
   CHECK_THROWS_AS(c.energy(exec::seq, Points<>::Zero(3, 3)), ShapeError);
   CHECK_THROWS_AS(c.obstacle().set_centre(Vec3<>::Constant(INFINITY)), ArgumentError);
 }
+
+TEST_CASE("Capsule: distance against a brute-force closest point, gradient and Hessian by finite differences, beside and beyond the ends") {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  const Vec3<> a(0.1, -0.2, 0.3), b(0.4, 0.9, -0.5);
+  const Capsule<> cap(a, b, 0.25);
+  const double h = 1e-6;
+  int beside = 0, beyond = 0;
+  for (int k = 0; k < 300; ++k) {
+    const Vec3<> x(u(rng), u(rng), u(rng));
+    double best = 1e300;  // the segment sampled densely: an independent closest distance
+    for (int s = 0; s <= 20000; ++s) best = std::min(best, (x - (a + (b - a) * (s / 20000.0))).norm());
+    CHECK(cap.distance(x) == doctest::Approx(best - 0.25).epsilon(1e-7));
+    const double t = (x - a).dot(b - a) / (b - a).squaredNorm();
+    ((t > 0 && t < 1) ? beside : beyond)++;
+    Vec3<> g;
+    Mat3<> H;
+    for (int c = 0; c < 3; ++c) {
+      Vec3<> e = Vec3<>::Zero();
+      e[c] = h;
+      g[c] = (cap.distance(x + e) - cap.distance(x - e)) / (2 * h);
+      H.col(c) = (cap.distance_gradient(x + e) - cap.distance_gradient(x - e)) / (2 * h);
+    }
+    CHECK((cap.distance_gradient(x) - g).norm() < 1e-7);
+    CHECK((cap.distance_hessian(x) - H).cwiseAbs().maxCoeff() < 1e-5 * (1 + H.cwiseAbs().maxCoeff()));
+  }
+  CHECK(beside > 50);
+  CHECK(beyond > 50);
+  CHECK(cap.distance(a) == doctest::Approx(-0.25));  // on the axis: inside by the radius
+  CHECK(std::abs(cap.distance_gradient(0.5 * (a + b)).dot(b - a)) < 1e-12);
+  CHECK_THROWS_AS(Capsule<>(a, b, 0.0), ArgumentError);
+}
+
+TEST_CASE("ObstacleContact: the local-global stand-in is k_i I on every contact vertex, touching or not") {
+  const Index n = 5;
+  const IndexVector v = every_other(n);
+  const ObstacleContact contact(Capsule<>(Vec3<>(0, 0, 0), Vec3<>(1, 0, 0), 0.1), v, n, 7.0);
+  BlockHessian<double> L(n);
+  L.set_zero();
+  contact.add_global_matrix(exec::seq, L);
+  const Eigen::MatrixXd D = test::dense_hessian(L);
+  for (Index i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) CHECK(D(3 * i + c, 3 * i + c) == (i % 2 == 0 ? 7.0 : 0.0));
+  CHECK((D - Eigen::MatrixXd(D.diagonal().asDiagonal())).norm() == 0.0);
+}

@@ -14,6 +14,7 @@
 /// C¹ (its Hessian jumps at d = 0). Obstacles are a concept: any type with signed distance,
 /// its gradient and its Hessian works.
 
+#include <algorithm>
 #include <cmath>
 #include <concepts>
 #include <utility>
@@ -140,6 +141,80 @@ class Sphere {
   S r_;
 };
 
+/// A capsule: the points within `radius` of the segment [a, b] (a pole, a limb). With q the
+/// closest point of the segment and ρ = ‖x − q‖: d = ρ − r, ∇d = n = (x − q)/ρ, and
+/// ∇²d = (I − u uᵀ − n nᵀ)/ρ beside the segment (u its direction: the distance to a line) or
+/// (I − n nᵀ)/ρ beyond an end (the distance to a point). On the axis itself (ρ = 0) n is a fixed
+/// unit vector ⊥ u and ∇²d = 0. a = b is a sphere.
+template <class S = Scalar>
+class Capsule {
+ public:
+  using scalar_type = S;
+  /// ArgumentError for non-finite ends or a radius not finite and > 0.
+  Capsule(const Vec3<S>& a, const Vec3<S>& b, S radius) : r_(radius) {
+    detail::require_positive("Capsule: radius", radius);
+    set_ends(a, b);
+  }
+  const Vec3<S>& a() const { return a_; }
+  const Vec3<S>& b() const { return b_; }
+  S radius() const { return r_; }
+  /// Moves the segment (between frames).
+  void set_ends(const Vec3<S>& a, const Vec3<S>& b) {
+    detail::require_finite_vector("Capsule: end a", a);
+    detail::require_finite_vector("Capsule: end b", b);
+    a_ = a, b_ = b;
+  }
+  S distance(const Vec3<S>& x) const { return offset(x).norm() - r_; }
+  Vec3<S> distance_gradient(const Vec3<S>& x) const {
+    const Vec3<S> v = offset(x);
+    const S l = v.norm();
+    return on_axis(x, l) ? off_axis() : Vec3<S>(v / l);
+  }
+  Mat3<S> distance_hessian(const Vec3<S>& x) const {
+    const Vec3<S> v = offset(x);
+    const S l = v.norm();
+    if (on_axis(x, l)) return Mat3<S>::Zero();
+    const Vec3<S> n = v / l;
+    Mat3<S> H = Mat3<S>::Identity() - n * n.transpose();
+    const S t = parameter(x);
+    if (t > S(0) && t < S(1)) {  // beside the segment: no curvature along it
+      const Vec3<S> u = (b_ - a_).normalized();
+      H -= u * u.transpose();
+    }
+    return H / l;
+  }
+
+ private:
+  S parameter(const Vec3<S>& x) const {
+    const Vec3<S> ab = b_ - a_;
+    const S len2 = ab.squaredNorm();
+    return len2 > S(0) ? std::clamp((x - a_).dot(ab) / len2, S(0), S(1)) : S(0);
+  }
+  /// x minus its closest point: beside the segment the part of x − a normal to it (exactly ⊥ to
+  /// the axis up to rounding), beyond an end x minus that end.
+  Vec3<S> offset(const Vec3<S>& x) const {
+    const S t = parameter(x);
+    if (t <= S(0)) return x - a_;
+    if (t >= S(1)) return x - b_;
+    const Vec3<S> u = (b_ - a_).normalized(), w = x - a_;
+    return w - w.dot(u) * u;
+  }
+  /// ρ at rounding level: the direction of x − q means nothing there.
+  bool on_axis(const Vec3<S>& x, S l) const {
+    return !(l > S(64) * Eigen::NumTraits<S>::epsilon() * ((x - a_).norm() + (b_ - a_).norm()));
+  }
+  Vec3<S> off_axis() const {
+    const Vec3<S> ab = b_ - a_;
+    if (!(ab.norm() > S(0))) return Vec3<S>::UnitZ();
+    const Vec3<S> u = ab.normalized();
+    const Vec3<S> w = std::abs(u.x()) < S(0.9) ? Vec3<S>::UnitX() : Vec3<S>::UnitY();
+    return (w - w.dot(u) * u).normalized();
+  }
+
+  Vec3<S> a_, b_;
+  S r_;
+};
+
 /// Penalty contact of `vertices` (indices into x) against one obstacle O.
 ///
 /// Hessian per penetrating vertex: the 3×3 block k (∇d ∇dᵀ + d ∇²d), exact when positive
@@ -206,6 +281,15 @@ class ObstacleContact {
       if (detail::obstacle_penalty_block(o_, pos(x, i), k_[i], B)) H.add(v_[i], v_[i], B);
   }
 
+  /// The local–global solver's constant matrix: k_i I for every vertex that may touch, whether it
+  /// does or not. A stand-in (the true Hessian switches on and off with the contact set): the
+  /// solver takes the exact gradient and line-searches, so its fixed point is still the energy's
+  /// minimum, and the matrix stays factored while the contact set changes.
+  template <exec::HostPolicy P>
+  void add_global_matrix(P, BlockHessian<S>& L) const {
+    for (Index i = 0; i < v_.size(); ++i) L.add(v_[i], v_[i], Mat3<S>(k_[i] * Mat3<S>::Identity()));
+  }
+
  private:
   Vec3<S> pos(const Points<S>& x, Index i) const { return x.row(v_[i]).transpose(); }
 
@@ -219,7 +303,7 @@ class ObstacleContact {
 template <class O, class K>
 ObstacleContact(O, IndexVector, Index, K) -> ObstacleContact<O>;
 
-static_assert(Obstacle<Plane<double>> && Obstacle<Sphere<double>>);
+static_assert(Obstacle<Plane<double>> && Obstacle<Sphere<double>> && Obstacle<Capsule<double>>);
 static_assert(assert_energy_term<ObstacleContact<Sphere<double>>, double>());
 
 }  // namespace simsr::physics
