@@ -24,11 +24,13 @@ namespace {
 /// in Gray-code order: one flip per step, the objective updated by the flipped vertex's field.
 std::int64_t best_signs(const AxisSignProblem& P) {
   const Index n = P.num_vertices();
-  const Adjacency A = vertex_adjacency(P.edges, n);
+  // the adjacency rebuilt from the edges here, independently of consistency_graph's edge_of
+  const Edges& E = P.graph->edges;
+  const Adjacency A = vertex_adjacency(E, n);
   std::vector<int> score(A.neighbors.size(), 0);
-  for (Index e = 0; e < P.edges.rows(); ++e)
+  for (Index e = 0; e < E.rows(); ++e)
     for (int side = 0; side < 2; ++side) {
-      const Index a = P.edges(e, side), b = P.edges(e, 1 - side);
+      const Index a = E(e, side), b = E(e, 1 - side);
       for (Index k = A.offsets[a]; k < A.offsets[a + 1]; ++k)
         if (A.neighbors[k] == b) score[k] += P.edge_score[e];
     }
@@ -53,7 +55,7 @@ std::int64_t best_signs(const AxisSignProblem& P) {
 double best_cycles(const AngleCycleProblem& P, int range) {
   constexpr double two_pi = 2 * pi;
   const Index n = P.num_vertices();
-  const Adjacency A = vertex_adjacency(P.edges, n);
+  const Adjacency A = vertex_adjacency(P.graph->edges, n);
   std::vector<int> r(static_cast<std::size_t>(n), -range);
   if (P.fix_first) r[0] = 0;
   auto local = [&](Index i) {  // the terms at vertex i (edges counted from i's side only)
@@ -88,9 +90,6 @@ double best_cycles(const AngleCycleProblem& P, int range) {
   return P.objective(argmin);  // exactly, without the updates' rounding
 }
 
-/// A small mesh's edges: the 1-ring disk (7 vertices) or the 2-ring one (19).
-Edges disk_edges(Index rings) { return unique_edges(disk_surface(1.0, rings).F); }
-
 /// Axes and angles of a smooth rotation field (a twist along x plus a bend) with noise `noise`,
 /// reduced to principal form, as the encoder sees them.
 void field(const Points<>& X, double amount, double noise, std::mt19937& rng, std::vector<Vec3<>>& axis,
@@ -106,11 +105,12 @@ void field(const Points<>& X, double amount, double noise, std::mt19937& rng, st
   }
 }
 
-AxisSignProblem sign_problem(const Edges& E, const std::vector<Vec3<>>& axis, const std::vector<double>& theta,
+AxisSignProblem sign_problem(const ConsistencyGraph& G, const std::vector<Vec3<>>& axis, const std::vector<double>& theta,
                              const std::vector<Vec3<>>* prev_axis, const std::vector<double>* prev_theta) {
   AxisSignProblem P;
   const ConsistencyThresholds th;
-  P.edges = E;
+  P.graph = &G;
+  const Edges& E = G.edges;
   P.fix_first = prev_axis == nullptr;
   for (Index e = 0; e < E.rows(); ++e)
     P.edge_score.push_back(orientation_score(axis[E(e, 0)].dot(axis[E(e, 1)]), theta[E(e, 0)], theta[E(e, 1)], th));
@@ -137,14 +137,14 @@ TEST_CASE("solve_axis_signs: how often propagation + local improvement reaches E
   Tally smooth, random;
   for (const Index rings : {1, 2}) {
     const TriMesh<> disk = disk_surface(1.0, rings);
-    const Edges E = unique_edges(disk.F);
+    const ConsistencyGraph G = consistency_graph(unique_edges(disk.F), disk.V.rows());
     for (int k = 0; k < (rings == 1 ? 300 : 40); ++k) {
       std::vector<Vec3<>> axis, prev_axis;
       std::vector<double> theta, prev_theta;
       const bool temporal = k % 2 == 1, is_random = k % 4 >= 2;
       field(disk.V, 0.5 + 2.5 * (u(rng) + 1), is_random ? 2.0 : 0.15, rng, axis, theta);
       field(disk.V, 0.5 + 2.5 * (u(rng) + 1), is_random ? 2.0 : 0.15, rng, prev_axis, prev_theta);
-      const AxisSignProblem P = sign_problem(E, axis, theta, temporal ? &prev_axis : nullptr, &prev_theta);
+      const AxisSignProblem P = sign_problem(G, axis, theta, temporal ? &prev_axis : nullptr, &prev_theta);
       ConsistencySolveStats stats;
       const std::vector<int> o = solve_axis_signs(P, &stats);
       if (P.fix_first) CHECK(o[0] == 1);
@@ -165,12 +165,12 @@ TEST_CASE("solve_angle_cycles: how often propagation + local improvement reaches
   std::mt19937 rng(6);
   std::uniform_real_distribution<double> u(-1, 1);
   const TriMesh<> disk = disk_surface(1.0, 1);
-  const Edges E = unique_edges(disk.F);
+  const ConsistencyGraph G = consistency_graph(unique_edges(disk.F), disk.V.rows());
   int smooth_opt = 0, smooth_total = 0, random_opt = 0, random_total = 0;
   for (int k = 0; k < 200; ++k) {
     const bool temporal = k % 2 == 1, is_random = k % 4 >= 2;
     AngleCycleProblem P;
-    P.edges = E;
+    P.graph = &G;
     P.fix_first = !temporal;
     const double center = 3 * u(rng);
     for (Index i = 0; i < disk.V.rows(); ++i) {
@@ -199,9 +199,9 @@ TEST_CASE("solve_angle_cycles: how often propagation + local improvement reaches
 TEST_CASE("solve_angle_cycles: a field that winds past π unwraps to the continuous angles") {
   // a strip whose true angle grows 0 → 5π along it: the principal values jump, the solution does not
   const TriMesh<> sheet = square_sheet(1.0, 12);
-  const Edges E = unique_edges(sheet.F);
+  const ConsistencyGraph G = consistency_graph(unique_edges(sheet.F), sheet.V.rows());
   AngleCycleProblem P;
-  P.edges = E;
+  P.graph = &G;
   std::vector<double> truth;
   for (Index i = 0; i < sheet.V.rows(); ++i) {
     truth.push_back(5 * pi * sheet.V(i, 0) + 0.3 * sheet.V(i, 1));
@@ -212,17 +212,24 @@ TEST_CASE("solve_angle_cycles: a field that winds past π unwraps to the continu
 }
 
 TEST_CASE("rotation consistency: malformed problems are typed errors") {
+  Edges bad(1, 2);
+  bad << 0, 5;
+  CHECK(!test::typed_error_of<MeshError>([&] { consistency_graph(bad, 2); }).empty());  // vertex 5 of 2
+  Edges one(1, 2);
+  one << 0, 1;
+  const ConsistencyGraph G = consistency_graph(one, 2);
   AxisSignProblem P;
-  P.edges.resize(1, 2);
-  P.edges << 0, 5;
   P.edge_score = {1};
   P.vertex_score = {0, 0};
-  CHECK(!test::typed_error_of<ShapeError>([&] { solve_axis_signs(P); }).empty());
-  P.edges << 0, 1;
+  CHECK(!test::typed_error_of<ArgumentError>([&] { solve_axis_signs(P); }).empty());  // no graph
+  P.graph = &G;
+  P.vertex_score = {0, 0, 0};
+  CHECK(!test::typed_error_of<ShapeError>([&] { solve_axis_signs(P); }).empty());  // 3 values, 2 vertices
+  P.vertex_score = {0, 0};
   P.edge_score = {};
   CHECK(!test::typed_error_of<ShapeError>([&] { solve_axis_signs(P); }).empty());
   AngleCycleProblem Q;
-  Q.edges = P.edges;
+  Q.graph = &G;
   Q.phi = {0.0, 1.0};
   Q.previous = std::vector<double>{0.0};
   CHECK(!test::typed_error_of<ShapeError>([&] { solve_angle_cycles(Q); }).empty());

@@ -4,18 +4,9 @@
 #include <simsr/core/error.hpp>
 
 #include <string>
+#include <utility>
 
 namespace simsr::test {
-
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 /// The message of the exception of type E that `f` throws, "" when it throws none; an exception
 /// of another type escapes (and fails the test): for checks that the error is the right type.
@@ -27,6 +18,12 @@ std::string typed_error_of(F&& f) {
     return e.what();
   }
   return "";
+}
+
+/// typed_error_of for any simsr::Error.
+template <class F>
+std::string error_of(F&& f) {
+  return typed_error_of<Error>(std::forward<F>(f));
 }
 
 }  // namespace simsr::test

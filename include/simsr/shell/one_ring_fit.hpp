@@ -61,7 +61,6 @@ class OneRingFit {
   template <exec::HostPolicy P>
   OneRingFit(P policy, const Points<S>& rest, const Tris& F, OneRingFitOptions options = {})
       : options_(options), F_(F), rest_(rest) {
-    simsr::detail::require_cols("OneRingFit: F", F, 3);
     if (!(options.normal_scale > 0)) throw ArgumentError("OneRingFit: normal_scale must be > 0");
     if (!rest.allFinite()) throw ArgumentError("OneRingFit: rest positions contain NaN or Inf");
     adjacency_ = vertex_adjacency(F, rest.rows());

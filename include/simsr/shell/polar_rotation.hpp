@@ -7,11 +7,11 @@
 /// and back, a rotation vector ρ = Θ ω̂ with any Θ ∈ ℝ to R by Rodrigues' formula.
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 #include <cmath>
 #include <numbers>
 
 #include "../core/types.hpp"
+#include "../physics/materials/signed_svd.hpp"
 
 namespace simsr::shell {
 
@@ -23,16 +23,14 @@ struct PolarParts {
   Mat3<S> stretch;
 };
 
-/// Polar decomposition by SVD: T = U Σ Vᵀ, R = U D Vᵀ, S = V D Σ Vᵀ with D = diag(1, 1, det UVᵀ).
+/// Polar decomposition from the signed SVD the materials use (physics/materials/signed_svd.hpp:
+/// F = U diag(σ) Vᵀ with U, V proper rotations, σ₃ < 0 when det F < 0): R = U Vᵀ, S = V diag(σ) Vᵀ.
 template <class S>
 PolarParts<S> polar_decomposition(const Mat3<S>& T) {
-  const Eigen::JacobiSVD<Mat3<S>> svd(T, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Mat3<S>& U = svd.matrixU();
-  const Mat3<S>& V = svd.matrixV();
-  Vec3<S> d(1, 1, (U * V.transpose()).determinant() < 0 ? S(-1) : S(1));
+  const physics::SignedSvd<S> svd = physics::signed_svd(T);
   PolarParts<S> out;
-  out.R = U * d.asDiagonal() * V.transpose();
-  out.stretch = V * (d.cwiseProduct(svd.singularValues())).asDiagonal() * V.transpose();
+  out.R = svd.U * svd.V.transpose();
+  out.stretch = svd.V * svd.sigma.asDiagonal() * svd.V.transpose();
   out.stretch = S(0.5) * (out.stretch + out.stretch.transpose()).eval();  // exactly symmetric
   return out;
 }

@@ -49,10 +49,35 @@ inline int orientation_score(double dot, double theta_a, double theta_b, const C
   return dot > 0 ? 1 : -1;
 }
 
+/// The graph both problems live on, built once per mesh (not per frame): its edges, the vertex
+/// adjacency, and for each adjacency entry the edge it stands for.
+struct ConsistencyGraph {
+  Edges edges;
+  Adjacency adjacency;
+  std::vector<Index> edge_of;  ///< edge index of adjacency.neighbors[k]
+
+  Index num_vertices() const { return adjacency.num_vertices(); }
+};
+
+/// The graph of `edges` (#E×2, unique) over n vertices. MeshError for an index outside [0, n).
+inline ConsistencyGraph consistency_graph(Edges edges, Index n) {
+  ConsistencyGraph G;
+  G.adjacency = vertex_adjacency(edges, n);
+  G.edge_of.assign(G.adjacency.neighbors.size(), -1);
+  for (Index e = 0; e < edges.rows(); ++e)
+    for (int side = 0; side < 2; ++side) {
+      const Index a = edges(e, side), b = edges(e, 1 - side);
+      for (Index k = G.adjacency.offsets[a]; k < G.adjacency.offsets[a + 1]; ++k)
+        if (G.adjacency.neighbors[k] == b) G.edge_of[k] = e;
+    }
+  G.edges = std::move(edges);
+  return G;
+}
+
 /// Eq. 2 for one frame, scores precomputed: edge_score[e] = s for edges(e, ·), vertex_score[i] =
 /// the temporal s of vertex i (all 0 in a first frame).
 struct AxisSignProblem {
-  Edges edges;
+  const ConsistencyGraph* graph = nullptr;
   std::vector<int> edge_score;
   std::vector<int> vertex_score;
   bool fix_first = true;  ///< o_0 = 1 (the gauge of a first frame)
@@ -61,7 +86,8 @@ struct AxisSignProblem {
   /// The objective of Eq. 2 (to maximize).
   std::int64_t objective(const std::vector<int>& o) const {
     std::int64_t J = 0;
-    for (Index e = 0; e < edges.rows(); ++e) J += std::int64_t(o[edges(e, 0)]) * o[edges(e, 1)] * edge_score[e];
+    const Edges& E = graph->edges;
+    for (Index e = 0; e < E.rows(); ++e) J += std::int64_t(o[E(e, 0)]) * o[E(e, 1)] * edge_score[e];
     for (std::size_t i = 0; i < vertex_score.size(); ++i) J += std::int64_t(o[i]) * vertex_score[i];
     return J;
   }
@@ -69,7 +95,7 @@ struct AxisSignProblem {
 
 /// Eq. 4 for one frame: phi[i] = o_i θ_i; previous[i] = Φᵗ⁻¹_i when there is a previous frame.
 struct AngleCycleProblem {
-  Edges edges;
+  const ConsistencyGraph* graph = nullptr;
   std::vector<double> phi;
   std::optional<std::vector<double>> previous;
   bool fix_first = true;  ///< r_0 = 0 (the gauge of a first frame)
@@ -79,8 +105,9 @@ struct AngleCycleProblem {
   double objective(const std::vector<int>& r) const {
     constexpr double two_pi = 2 * std::numbers::pi;
     double F = 0;
-    for (Index e = 0; e < edges.rows(); ++e) {
-      const Index i = edges(e, 0), j = edges(e, 1);
+    const Edges& E = graph->edges;
+    for (Index e = 0; e < E.rows(); ++e) {
+      const Index i = E(e, 0), j = E(e, 1);
       const double d = two_pi * (r[i] - r[j]) + phi[i] - phi[j];
       F += d * d;
     }
@@ -145,12 +172,10 @@ std::vector<Index> edge_components(const Edges& E, Index n, Keep&& keep, Index& 
   return label;
 }
 
-inline void check_problem_edges(const char* what, const Edges& E, Index n) {
-  for (Index e = 0; e < E.rows(); ++e)
-    for (int k = 0; k < 2; ++k)
-      if (E(e, k) < 0 || E(e, k) >= n)
-        throw ShapeError(std::string(what) + ": edge " + std::to_string(e) + " names vertex " + std::to_string(E(e, k)),
-                         {0, n - 1}, {E(e, k)});
+/// ArgumentError without a graph, ShapeError when the problem's vertex count is not the graph's.
+inline void check_problem_graph(const char* what, const ConsistencyGraph* G, Index n) {
+  if (!G) throw ArgumentError(std::string(what) + ": the problem has no graph (consistency_graph)");
+  if (G->num_vertices() != n) throw ShapeError(std::string(what) + ": per-vertex values", {G->num_vertices()}, {n});
 }
 
 }  // namespace detail
@@ -158,21 +183,13 @@ inline void check_problem_edges(const char* what, const Edges& E, Index n) {
 /// Solves Eq. 2 by propagation and local improvement (see the file comment). Returns o (±1 each).
 inline std::vector<int> solve_axis_signs(const AxisSignProblem& P, ConsistencySolveStats* stats = nullptr) {
   const Index n = P.num_vertices();
-  if (static_cast<Index>(P.edge_score.size()) != P.edges.rows())
-    throw ShapeError("solve_axis_signs: edge_score", {P.edges.rows()}, {static_cast<std::int64_t>(P.edge_score.size())});
-  detail::check_problem_edges("solve_axis_signs", P.edges, n);
-  const Adjacency A = vertex_adjacency(P.edges, n);
-  // score of each adjacency entry (edge lists are unique, so a map from the pair is exact)
-  std::vector<int> score(A.neighbors.size(), 0);
-  {
-    for (Index e = 0; e < P.edges.rows(); ++e) {
-      const Index a = P.edges(e, 0), b = P.edges(e, 1);
-      for (Index k = A.offsets[a]; k < A.offsets[a + 1]; ++k)
-        if (A.neighbors[k] == b) score[k] += P.edge_score[e];
-      for (Index k = A.offsets[b]; k < A.offsets[b + 1]; ++k)
-        if (A.neighbors[k] == a) score[k] += P.edge_score[e];
-    }
-  }
+  detail::check_problem_graph("solve_axis_signs", P.graph, n);
+  const Edges& E = P.graph->edges;
+  const Adjacency& A = P.graph->adjacency;
+  if (static_cast<Index>(P.edge_score.size()) != E.rows())
+    throw ShapeError("solve_axis_signs: edge_score", {E.rows()}, {static_cast<std::int64_t>(P.edge_score.size())});
+  std::vector<int> score(A.neighbors.size());  // the score of each adjacency entry
+  for (std::size_t k = 0; k < score.size(); ++k) score[k] = P.edge_score[std::size_t(P.graph->edge_of[k])];
   std::vector<int> o(static_cast<std::size_t>(n), 0);
   auto field = [&](Index i) {  // h_i = vertex term + Σ_j s_ij o_j (unlabelled neighbours count 0)
     int h = P.vertex_score[i];
@@ -194,13 +211,13 @@ inline std::vector<int> solve_axis_signs(const AxisSignProblem& P, ConsistencySo
     // its boundary edges and its members' temporal terms
     Index count = 0;
     const std::vector<Index> label = detail::edge_components(
-        P.edges, n, [&](Index e) { return P.edge_score[e] * o[P.edges(e, 0)] * o[P.edges(e, 1)] > 0; }, count);
+        E, n, [&](Index e) { return P.edge_score[e] * o[E(e, 0)] * o[E(e, 1)] > 0; }, count);
     std::vector<std::int64_t> gain(static_cast<std::size_t>(count), 0);  // objective change of a flip
     std::vector<char> pinned(static_cast<std::size_t>(count), 0);
     for (Index i = 0; i < n; ++i) gain[label[i]] -= 2 * std::int64_t(o[i]) * P.vertex_score[i];
     if (P.fix_first && n > 0) pinned[label[0]] = 1;
-    for (Index e = 0; e < P.edges.rows(); ++e) {
-      const Index a = P.edges(e, 0), b = P.edges(e, 1);
+    for (Index e = 0; e < E.rows(); ++e) {
+      const Index a = E(e, 0), b = E(e, 1);
       if (label[a] == label[b]) continue;
       const std::int64_t term = std::int64_t(o[a]) * o[b] * P.edge_score[e];
       gain[label[a]] -= 2 * term;
@@ -225,10 +242,11 @@ inline std::vector<int> solve_axis_signs(const AxisSignProblem& P, ConsistencySo
 inline std::vector<int> solve_angle_cycles(const AngleCycleProblem& P, ConsistencySolveStats* stats = nullptr) {
   constexpr double two_pi = 2 * std::numbers::pi;
   const Index n = P.num_vertices();
-  detail::check_problem_edges("solve_angle_cycles", P.edges, n);
+  detail::check_problem_graph("solve_angle_cycles", P.graph, n);
+  const Edges& E = P.graph->edges;
   if (P.previous && static_cast<Index>(P.previous->size()) != n)
     throw ShapeError("solve_angle_cycles: previous angles", {n}, {static_cast<std::int64_t>(P.previous->size())});
-  const Adjacency A = vertex_adjacency(P.edges, n);
+  const Adjacency& A = P.graph->adjacency;
   std::vector<int> r(static_cast<std::size_t>(n), 0);
   const bool has_prev = P.previous.has_value();
   if (has_prev) {
@@ -242,7 +260,7 @@ inline std::vector<int> solve_angle_cycles(const AngleCycleProblem& P, Consisten
   if (P.fix_first && n > 0 && r[0] != 0) {  // the gauge: shift every component-0 label so r_0 = 0
     const int shift = r[0];
     Index count = 0;
-    const std::vector<Index> label = detail::edge_components(P.edges, n, [](Index) { return true; }, count);
+    const std::vector<Index> label = detail::edge_components(E, n, [](Index) { return true; }, count);
     for (Index i = 0; i < n; ++i)
       if (label[i] == label[0]) r[i] -= shift;
   }
@@ -278,9 +296,9 @@ inline std::vector<int> solve_angle_cycles(const AngleCycleProblem& P, Consisten
     // changes its boundary edges and its members' temporal terms only
     Index count = 0;
     const std::vector<Index> label = detail::edge_components(
-        P.edges, n,
+        E, n,
         [&](Index e) {
-          const Index a = P.edges(e, 0), b = P.edges(e, 1);
+          const Index a = E(e, 0), b = E(e, 1);
           return std::abs(two_pi * (r[a] - r[b]) + P.phi[a] - P.phi[b]) < std::numbers::pi;
         },
         count);
@@ -293,8 +311,8 @@ inline std::vector<int> solve_angle_cycles(const AngleCycleProblem& P, Consisten
     };
     if (has_prev)
       for (Index i = 0; i < n; ++i) add(label[i], two_pi * r[i] + P.phi[i] - (*P.previous)[i]);
-    for (Index e = 0; e < P.edges.rows(); ++e) {
-      const Index a = P.edges(e, 0), b = P.edges(e, 1);
+    for (Index e = 0; e < E.rows(); ++e) {
+      const Index a = E(e, 0), b = E(e, 1);
       if (label[a] == label[b]) continue;
       const double d = two_pi * (r[a] - r[b]) + P.phi[a] - P.phi[b];
       add(label[a], d);

@@ -73,7 +73,7 @@ class TsAcap {
   /// Throws what OneRingFit throws, and MeshError for a mesh in more than one piece.
   template <exec::HostPolicy P>
   TsAcap(P policy, const Points<S>& rest, const Tris& F, TsAcapOptions options = {})
-      : options_(options), fit_(policy, rest, F, options.fit), edges_(unique_edges(F)) {
+      : options_(options), fit_(policy, rest, F, options.fit), graph_(consistency_graph(unique_edges(F), rest.rows())) {
     const Components C = connected_components(F, rest.rows());
     if (C.count != 1)
       throw MeshError("triangle mesh", -1, "TsAcap needs one connected piece, got " + std::to_string(C.count));
@@ -98,7 +98,7 @@ class TsAcap {
 
   Index num_vertices() const { return fit_.num_vertices(); }
   const OneRingFit<S>& fit() const { return fit_; }
-  const Edges& edges() const { return edges_; }
+  const Edges& edges() const { return graph_.edges; }
 
   /// Features of frame V (#V×3) of a sequence whose previous frame `state` holds (empty: V is
   /// the first frame); `state` becomes V's. `report` (optional) receives what the integer steps did.
@@ -122,12 +122,12 @@ class TsAcap {
       throw ShapeError("TsAcap::encode: state (previous frame)", {n}, {state.axis.rows()});
     const ConsistencyThresholds& th = options_.thresholds;
     AxisSignProblem signs;
-    signs.edges = edges_;
+    signs.graph = &graph_;
     signs.fix_first = first;
-    signs.edge_score.resize(static_cast<std::size_t>(edges_.rows()));
+    signs.edge_score.resize(static_cast<std::size_t>(graph_.edges.rows()));
     signs.vertex_score.assign(static_cast<std::size_t>(n), 0);
-    for (Index e = 0; e < edges_.rows(); ++e) {
-      const Index a = edges_(e, 0), b = edges_(e, 1);
+    for (Index e = 0; e < graph_.edges.rows(); ++e) {
+      const Index a = graph_.edges(e, 0), b = graph_.edges(e, 1);
       signs.edge_score[e] = orientation_score(double(axis.row(a).dot(axis.row(b))), double(theta[a]), double(theta[b]), th);
     }
     if (!first)
@@ -137,7 +137,7 @@ class TsAcap {
     TsAcapFrameReport rep;
     const std::vector<int> o = solve_axis_signs(signs, &rep.axes);
     AngleCycleProblem cycles;
-    cycles.edges = edges_;
+    cycles.graph = &graph_;
     cycles.fix_first = first;
     cycles.phi.resize(static_cast<std::size_t>(n));
     for (Index i = 0; i < n; ++i) cycles.phi[i] = o[i] * double(theta[i]);
@@ -228,7 +228,7 @@ class TsAcap {
 
   TsAcapOptions options_;
   OneRingFit<S> fit_;
-  Edges edges_;
+  ConsistencyGraph graph_;  // the integer steps' graph, built once
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<S>> poisson_;
 };
 
