@@ -13,7 +13,8 @@
 #                   cuda-compile, and each benchmark compiled (clang syntax only, a ctest each: none
 #                   is built or run here; -DSIMSR_BUILD_BENCHMARKS=ON builds them)
 #   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite (pipeline's own parts) and the corpus replays under
-#                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, no recovery); the
+#                   ASan+UBSan (-fsanitize=address,undefined,float-cast-overflow, UBSan's address
+#                   checks left to ASan, no recovery); the
 #                   suites other than interp, nn, pipeline and scenario run here and under TSan only
 #                   (tests/CMakeLists.txt says why)
 #   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: every suite that runs exec::omp under TSan, with

@@ -113,7 +113,7 @@ TEST_CASE("Learned: train, held-out error, seq == omp, save and load give the sa
   CHECK_THROWS_WITH_AS(d.fit(exec::seq, other.problem), doctest::Contains("trained on other rest shapes"), ArgumentError);
 }
 
-TEST_CASE("Learned: the displacement scale is undone exactly: Embedded at start, the trainer's held-out error is apply's") {
+TEST_CASE("Learned: the displacement scale is undone exactly: Embedded at start, the trainer's held-out error is apply's" * doctest::test_suite("single-threaded")) {
   auto s = net_scene(10, 6);
   for (double k : {0.5, 7.0, 40.0}) {
     CAPTURE(k);
@@ -169,7 +169,7 @@ TEST_CASE("NetworkRecipe: the automatic displacement scale makes the training fr
   CHECK_THROWS_WITH_AS(r.config(still), doctest::Contains("all zero"), ArgumentError);
 }
 
-TEST_CASE("Learned: a run resumed from its checkpoint ends where the uninterrupted run ends") {
+TEST_CASE("Learned: a run resumed from its checkpoint ends where the uninterrupted run ends" * doctest::test_suite("single-threaded")) {
   auto s = net_scene(8, 3);
   const auto ckpt = tmp("checkpoint.npz");
   interp::Learned<> full(residual_config(), 1), first(residual_config(), 1), rest(residual_config(), 1);

@@ -112,7 +112,7 @@ TEST_CASE("nn::ContactLoss: two facing grids give the closed form (m − s)² pe
   }
 }
 
-TEST_CASE("nn::ContactLoss: the gradient matches central differences on random penetrating shapes (the normal's rotation included)") {
+TEST_CASE("nn::ContactLoss: the gradient matches central differences on random penetrating shapes (the normal's rotation included)" * doctest::test_suite("single-threaded")) {
   std::mt19937_64 rng(17);
   Index checked = 0, kinks = 0;
   for (int trial = 0; trial < 25; ++trial) {

@@ -89,7 +89,7 @@ TEST_CASE("SoftDecaSurrogate learns a nonlinear parameter-to-skin map on held-ou
   std::filesystem::remove(file);
 }
 
-TEST_CASE("SoftDecaSurrogate with a linear base: an exactly linear map before any training, the nonlinear rest learnt, the base saved") {
+TEST_CASE("SoftDecaSurrogate with a linear base: an exactly linear map before any training, the nonlinear rest learnt, the base saved" * doctest::test_suite("tsan-repeat")) {
   // exactly linear data: the base alone reproduces it (the untrained network's part is scaled
   // by the spread of what the base leaves, round-off)
   SoftDecaDataset lin = nn_test_softdeca_surrogate::synthetic(60, 5, 7);
