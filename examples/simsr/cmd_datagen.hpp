@@ -17,6 +17,7 @@
 // remeshes the kit's outer wrap to that edge length first (needs a build with CGAL);
 // --linear-solver cholmod factors with CHOLMOD (needs a build with it).
 #include <simsr/scenario/scenario.hpp>
+#include <simsr/shell/cloth_datagen.hpp>
 #include <simsr/scenario/softdeca/softdeca_datagen.hpp>
 #include <simsr/scenario/softdeca/sphere_template.hpp>
 #if defined(SIMSR_HAVE_CGAL)
@@ -30,7 +31,10 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -54,6 +58,8 @@ struct DatagenArgs {
   std::optional<Index> active_expressions;
   std::string solver = "local_global", softdeca_template = "ict", linear_solver = "simplicial";
   double skin_edge = 0;
+  // sheet / disk
+  Index sequences = 0, cells = 0, levels = -1;
 };
 
 /// The dataset with the linear solver --linear-solver names.
@@ -128,9 +134,36 @@ inline scenario::FaceModelOptions face_model_options(const DatagenArgs& a) {
   return o;
 }
 
+/// The thin-shell datasets (shell/cloth_datagen.hpp): a progress line per 10 frames on stderr,
+/// the summary (DIR/cloth_data.json) on stdout.
+inline int datagen_cloth(const DatagenArgs& a) {
+  const shell::ClothDataset d = shell::cloth_dataset(a.scenario);
+  shell::ClothDatagenOptions o;
+  o.size = shell::default_scene_size(d);
+  if (a.cells > 0) o.size.coarse_cells = a.cells;
+  if (a.levels >= 0) o.size.levels = a.levels;
+  o.sequences = a.sequences;
+  o.seed = a.seed;
+  o.checkpoint_every = a.checkpoint_every;
+  const auto start = std::chrono::steady_clock::now();
+  o.on_frame = [start](const std::string& seq, Index f, Index frames, const shell::ClothFrameReport& rc, const shell::ClothFrameReport& rf, double sc,
+                       double sf) {
+    if ((f + 1) % 10 != 0 && f + 1 != frames) return;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "%s frame %lld/%lld: coarse %.3f s (%lld Newton), fine %.3f s (%lld Newton), deepest %.1f mm; %.0f s so far\n", seq.c_str(),
+                 static_cast<long long>(f + 1), static_cast<long long>(frames), sc, static_cast<long long>(rc.newton_iterations), sf,
+                 static_cast<long long>(rf.newton_iterations), 1e3 * std::min(rc.deepest, rf.deepest), elapsed);
+  };
+  shell::generate_cloth_data(exec::omp, d, a.out, o);
+  std::ifstream summary(std::filesystem::path(a.out) / "cloth_data.json");
+  std::cout << nlohmann::ordered_json::parse(summary).dump() << '\n';
+  return 0;
+}
+
 inline int datagen(const DatagenArgs& a) {
   if (a.scenario == "softdeca") return datagen_softdeca(a);
-  if (a.scenario != "face") throw ArgumentError("--scenario: face or softdeca (got '" + a.scenario + "')");
+  if (a.scenario == "sheet" || a.scenario == "disk") return datagen_cloth(a);
+  if (a.scenario != "face") throw ArgumentError("--scenario: face, softdeca, sheet or disk (got '" + a.scenario + "')");
   scenario::FaceDatasetOptions o;
   o.kit = a.kit;
   o.model = face_model_options(a);
@@ -150,10 +183,20 @@ inline int datagen(const DatagenArgs& a) {
 }
 
 inline void add_datagen(CLI::App& app, std::function<int()>& action) {
-  auto* cmd = app.add_subcommand("datagen", "Simulate paired LR/HR data (the face of the core paper, §4) or SoftDECA's sampled layered-head data");
+  auto* cmd = app.add_subcommand("datagen",
+                                 "Simulate paired LR/HR data (the face of the core paper, §4; the SHEET and DISK cloths of the thin-shell paper) or "
+                                 "SoftDECA's sampled layered-head data");
   auto a = std::make_shared<DatagenArgs>();
-  cmd->add_option("--scenario", a->scenario, "what to simulate: face (paired LR/HR frames) or softdeca (sampled parameters on the layered head)")
+  cmd->add_option("--scenario", a->scenario,
+                  "what to simulate: face (paired LR/HR frames), softdeca (sampled parameters on the layered head), sheet or disk (coarse/fine cloth "
+                  "sequences)")
       ->capture_default_str();
+  cmd->add_option("--sequences", a->sequences, "sheet/disk: sequences to simulate (0: sheet 32, disk 16; every 5th held out)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
+  cmd->add_option("--cells", a->cells, "sheet: coarse cells per side (default 8: 81 vertices); disk: coarse rings (default 6: 127 vertices)")
+      ->check(CLI::Range(2, 1000));
+  cmd->add_option("--levels", a->levels, "sheet/disk: Loop subdivision levels from the coarse to the fine cloth (default 3)")->check(CLI::Range(0, 6));
   cmd->add_option("--samples", a->samples, "softdeca: parameter samples to simulate")->capture_default_str()->check(CLI::Range(1, 10000000));
   cmd->add_option("--layers", a->layers, "softdeca: prism layers per shell of the template (its resolution)")->capture_default_str()->check(CLI::Range(1, 16));
   cmd->add_option("--steps", a->steps, "softdeca: implicit steps from rest to the expression")->capture_default_str()->check(CLI::Range(1, 10000));

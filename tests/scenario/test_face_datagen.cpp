@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 #include "../support/error_of.hpp"
 #include "../support/require.hpp"
+#include "../support/scratch_dir.hpp"
 
 #include <simsr/data/frame_set.hpp>
 #include <simsr/io/npz.hpp>
@@ -23,14 +24,7 @@ Index column_of(const scenario::Performance& p, const std::string& n) {
   return Index(std::find(p.names.begin(), p.names.end(), n) - p.names.begin());
 }
 
-/// A scratch directory removed at the end of the scope.
-struct ScratchDir {
-  std::filesystem::path path;
-  explicit ScratchDir(const std::string& name) : path(std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()))) {
-    std::filesystem::remove_all(path);
-  }
-  ~ScratchDir() { std::filesystem::remove_all(path); }
-};
+using test::ScratchDir;
 
 }  // namespace
 
@@ -412,7 +406,7 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
   // simulated lips apart
   {
     const auto z = io::read_npz(whole.path / ".state" / "neutral.npz");
-    const Points<> hr_neutral = scenario::detail::points_of(z, "hr", face.hr.num_vertices(), "neutral.npz");
+    const Points<> hr_neutral = data::points_of(z, "hr", face.hr.num_vertices(), "neutral.npz");
     Points<> targets = hr_neutral;
     for (Index i = 0; i < face.surface.num_vertices(); ++i) targets.row(face.surface_hr_vertex[i]) = face.neutral.row(i);
     const auto crossing = scenario::intersecting_lip_pairs(face, targets).size(), simulated = scenario::intersecting_lip_pairs(face, hr_neutral).size();

@@ -15,3 +15,8 @@
 #include "polar_rotation.hpp"
 #include "rotation_consistency.hpp"
 #include "ts_acap.hpp"
+#include "wind.hpp"
+#include "cloth_simulator.hpp"
+#include "cloth_scenes.hpp"
+#include "cloth_datagen.hpp"
+#include "collision_refinement.hpp"

@@ -46,6 +46,7 @@
 #include "../../core/parallel.hpp"
 #include "../../data/contact_patches_file.hpp"
 #include "../../data/paired_frames.hpp"
+#include "../../data/run_checkpoint.hpp"
 #include "../../io/atomic_file.hpp"
 #include "../../io/mesh_io.hpp"
 #include "../../io/npz.hpp"
@@ -156,18 +157,6 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
   return f.hex();
 }
 
-inline std::string fingerprint_of(const io::NpzArrays& z) {
-  if (!z.contains("fingerprint")) return "";
-  const auto s = z.at("fingerprint").to_strings();
-  return s.empty() ? "" : s[0];
-}
-
-inline Points<> points_of(const io::NpzArrays& z, const std::string& name, Index rows, const std::string& file) {
-  const auto& a = z.at(name);
-  if (a.ndim() != 2 || a.shape[0] != rows || a.shape[1] != 3)
-    throw ShapeError(file + ": " + name, {rows, 3}, {a.ndim() > 0 ? Index(a.shape[0]) : 0, a.ndim() > 1 ? Index(a.shape[1]) : 0});
-  return a.to_points<double>();
-}
 
 /// A file's per-frame counts of intersecting HR lip triangle pairs (`hr_lip_pairs`, `frames` of
 /// them, each ≥ 0); ArgumentError naming the file otherwise.
@@ -242,7 +231,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     checkpoints.emplace_back();
     if (!std::filesystem::exists(partial)) continue;
     checkpoints.back() = io::read_npz(partial);
-    if (detail::fingerprint_of(*checkpoints.back()) != prints.back())
+    if (data::fingerprint_of(*checkpoints.back()) != prints.back())
       throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
   }
   std::filesystem::create_directories(state);
@@ -258,9 +247,9 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
   bool have_neutral = false;
   if (std::filesystem::exists(neutral_file)) {
     const auto z = io::read_npz(neutral_file);
-    if (detail::fingerprint_of(z) == model_print) {
-      lr_neutral = detail::points_of(z, "lr", face.lr.num_vertices(), neutral_file.string());
-      hr_neutral = detail::points_of(z, "hr", face.hr.num_vertices(), neutral_file.string());
+    if (data::fingerprint_of(z) == model_print) {
+      lr_neutral = data::points_of(z, "lr", face.lr.num_vertices(), neutral_file.string());
+      hr_neutral = data::points_of(z, "hr", face.hr.num_vertices(), neutral_file.string());
       have_neutral = true;
     }
   }
@@ -275,7 +264,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     io::NpzArrays z;
     z["lr"] = io::make_npy(lr_neutral);
     z["hr"] = io::make_npy(hr_neutral);
-    z["fingerprint"] = io::make_npy(std::vector<std::string>{model_print});
+    data::set_fingerprint(z, model_print);
     io::write_npz(neutral_file, z);
   }
 
@@ -292,7 +281,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     // a finished file of this very run: reuse
     if (std::filesystem::exists(final_file)) {
       const auto z = io::read_npz(final_file);
-      if (detail::fingerprint_of(z) == print) {
+      if (data::fingerprint_of(z) == print) {
         st.reused = true;
         detail::count_lip_frames(detail::lip_pairs_of(z, F, final_file.string()), st);
         measure_discrepancy(policy, face, data::read_paired_frames(final_file, N, M), st);
@@ -318,23 +307,17 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     hr.set_positions(hr_neutral);
     if (checkpoints[pi]) {
       const io::NpzArrays& z = *checkpoints[pi];
-      start = z.at("frames_done").item<std::int64_t>();
-      if (start < 1 || start > F) throw ArgumentError(partial.string() + ": frames_done " + std::to_string(start) + " outside [1, " + std::to_string(F) + "]");
-      const auto lo = z.at("lowres").to_matrix<double>(), hi = z.at("highres").to_matrix<double>();
-      if (lo.rows() != start || lo.cols() != 3 * N || hi.rows() != start || hi.cols() != 3 * M)
-        throw ArgumentError(partial.string() + ": its frame arrays do not match frames_done and the meshes");
-      out.lowres.topRows(start) = lo;
-      out.highres.topRows(start) = hi;
+      start = data::resume_frames(z, partial.string(), out);
       const auto lips = detail::lip_pairs_of(z, start, partial.string());
       std::copy(lips.begin(), lips.end(), lip_pairs.begin());
-      const Points<> lx = detail::points_of(z, "lr_state", N, partial.string()), hx = detail::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
+      const Points<> lx = data::points_of(z, "lr_state", N, partial.string()), hx = data::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
       const FaceControls last = face_controls(perf, start - 1, face);
       lr.set_controls(last);
       hr.set_controls(last);
       // the frame before the last: as the uninterrupted run had it (the neutral before frame 0)
       const FaceControls before = start >= 2 ? face_controls(perf, start - 2, face) : zero;
-      lr.set_positions(start >= 2 ? detail::points_of(z, "lr_before", N, partial.string()) : lr_neutral, before, lx);
-      hr.set_positions(start >= 2 ? detail::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()) : hr_neutral, before, hx);
+      lr.set_positions(start >= 2 ? data::points_of(z, "lr_before", N, partial.string()) : lr_neutral, before, lx);
+      hr.set_positions(start >= 2 ? data::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()) : hr_neutral, before, hx);
     }
     Points<> lr_before = lr.positions(), hr_before = hr.positions();
     for (Index f = start; f < F; ++f) {
@@ -360,24 +343,19 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       if (opt.on_frame) opt.on_frame(perf.name, f, F, rl, rh, sl, sh);
       const Index done = f + 1;
       if (done < F && done % opt.checkpoint_every == 0) {
-        io::NpzArrays z;
-        z["frames_done"] = io::make_npy<std::int64_t>({}, &done);
-        const data::FrameMatrix<double> lo = out.lowres.topRows(done), hi = out.highres.topRows(done);
-        z["lowres"] = io::make_npy(lo);
-        z["highres"] = io::make_npy(hi);
+        io::NpzArrays z = data::frames_checkpoint(out, done, print);
         z["lr_state"] = io::make_npy(lr.positions());
         z["hr_state"] = io::make_npy(hr.positions());
         z["lr_before"] = io::make_npy(lr_before);
         z["hr_before"] = io::make_npy(hr_before);
         z["hr_lip_pairs"] = io::make_npy<std::int64_t>({done}, lip_pairs.data());
-        z["fingerprint"] = io::make_npy(std::vector<std::string>{print});
         io::write_npz(partial, z);
       }
     }
     measure_discrepancy(policy, face, out, st);
     detail::count_lip_frames(lip_pairs, st);
     auto arrays = data::paired_frame_arrays(out);
-    arrays["fingerprint"] = io::make_npy(std::vector<std::string>{print});
+    data::set_fingerprint(arrays, print);
     arrays["hr_lip_pairs"] = io::make_npy<std::int64_t>({F}, lip_pairs.data());
     arrays["control_names"] = io::make_npy(perf.names);
     io::write_npz(final_file, arrays);

@@ -1,0 +1,329 @@
+#pragma once
+/// \file
+/// The SHEET and DISK datasets (Chen et al. 2023, supplement §3; issue #14 item 3): every
+/// sequence simulated at the coarse and at the fine resolution, separately, with the same
+/// parameters and no constraint between them, into
+///
+///     DIR/coarse_rest.obj, DIR/fine_rest.obj   the two cloths at rest (fine = Loop(coarse))
+///     DIR/<scene>_NNN.npz                      a sequence's frames (data::PairedFrames: lowres the
+///                                              coarse cloth, highres the fine one, F × 3N / 3M)
+///     DIR/cloth_data.json                      sizes, the split, per-sequence figures
+///
+/// Each sequence starts from the settled cloth (SHEET: sagging on its pins with the obstacle
+/// above it; DISK: draped on the table, no wind), settled once (`settle_frames`) and kept in
+/// DIR/.state. The split holds out whole sequences (every 5th: 20 %, the supplement's 3,200 /
+/// 800 and 1,600 / 400 frames), never frames of a sequence it trains on.
+///
+/// A run checkpoints each sequence every `checkpoint_every` frames (DIR/.state/<name>.npz: the
+/// frames so far and both cloths' last two states, written atomically), so a killed run resumes
+/// where it stopped and ends bitwise where the uninterrupted run ends. A file of another run
+/// (another scene, size, seed or parameters) is refused by fingerprint, never continued.
+///
+///     auto stats = shell::generate_cloth_data(exec::omp, shell::ClothDataset::sheet, "sheet_data", {});
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "../core/error.hpp"
+#include "../core/fingerprint.hpp"
+#include "../core/parallel.hpp"
+#include "../data/paired_frames.hpp"
+#include "../data/run_checkpoint.hpp"
+#include "../io/atomic_file.hpp"
+#include "../io/mesh_io.hpp"
+#include "../io/npz.hpp"
+#include "cloth_scenes.hpp"
+#include "cloth_simulator.hpp"
+
+namespace simsr::shell {
+
+/// What a cloth datagen run is asked for.
+struct ClothDatagenOptions {
+  ClothSceneSize size{0, -1};  ///< {0, -1}: the dataset's default_scene_size
+  Index sequences = 0;         ///< 0: SHEET 32, DISK 16 (about the supplement's 4,000 and 2,000 frames)
+  double extra_seconds = 1.0;  ///< simulated after a SHEET obstacle has left (the cloth swings back)
+  std::uint64_t seed = 7;
+  Index settle_frames = 45;    ///< frames to settle the start state
+  Index checkpoint_every = 20;
+  ClothMaterial material;
+  ClothOptions simulation;
+  /// Called after every simulated frame: sequence, frame, frames, both reports, seconds (coarse, fine).
+  std::function<void(const std::string&, Index, Index, const ClothFrameReport&, const ClothFrameReport&, double, double)> on_frame;
+};
+
+/// One sequence's figures.
+struct ClothSequenceStats {
+  std::string name;
+  bool test = false;    ///< held out
+  bool reused = false;  ///< a finished file of this run was found
+  Index frames = 0, simulated = 0;
+  Index coarse_iterations = 0, fine_iterations = 0;  ///< Newton iterations (frames simulated in this run)
+  Index halvings = 0;                                ///< steps halved after a failed solve (both resolutions)
+  double coarse_seconds = 0, fine_seconds = 0;
+  double deepest = 0;  ///< m, the deepest vertex inside the obstacle (both resolutions; this run's frames)
+  /// RMSE (m) of the Loop-subdivided coarse cloth against the fine one over the frames: the
+  /// evaluation's first baseline, measured from the file.
+  double subdivided_rmse = 0;
+};
+
+/// The sequences' names, in order: "<scene>_000", ...
+inline std::string cloth_sequence_name(ClothDataset d, Index k) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%s_%03lld", to_string(d), static_cast<long long>(k));
+  return buf;
+}
+
+/// Held out: every 5th sequence (4, 9, 14, ...), so each SHEET obstacle kind is in both sets.
+inline bool cloth_sequence_is_test(Index k) { return k % 5 == 4; }
+
+namespace detail {
+
+inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, const ClothDatagenOptions& o, Index sequence, Index frames) {
+  Fingerprint f;
+  f.add(std::int64_t(d)).add(pair.coarse.V).add(pair.coarse.F).add(pair.fine.V).add(pair.fine.F).add(pair.pinned);
+  const ClothMaterial& m = o.material;
+  const ClothOptions& s = o.simulation;
+  f.add(m.areal_density).add(m.stretch).add(m.bending).add(s.frame_time).add(s.substeps).add(s.damping).add(s.gravity).add(s.contact_stiffness);
+  f.add(s.newton.relative_tolerance).add(s.newton.absolute_tolerance).add(s.newton.max_iterations).add(std::int64_t(s.newton.hessian)).add(s.max_halvings);
+  f.add(o.settle_frames).add(o.seed).add(o.extra_seconds).add(sequence).add(frames);
+  return f.hex();
+}
+
+/// RMSE (m) over all frames and fine vertices of S·coarse against fine.
+inline double subdivided_rmse(const data::PairedFrames<>& p, const Eigen::SparseMatrix<double>& S) {
+  double sum = 0;
+  for (Index f = 0; f < p.num_frames(); ++f) {
+    const Points<> up = S * Points<>(p.lr(f));
+    sum += (up - p.hr(f)).squaredNorm();
+  }
+  return std::sqrt(sum / double(std::max<Index>(1, p.num_frames() * p.num_hr())));
+}
+
+/// A frame of one resolution, its failure made specific.
+template <class P, class Sim, class Move>
+ClothFrameReport advance_frame(P policy, Sim& sim, const Move& move, const std::string& seq, Index frame, const char* resolution) {
+  try {
+    return sim.advance(policy, move);
+  } catch (const ConvergenceError& e) {
+    throw Error("cloth datagen: sequence '" + seq + "', frame " + std::to_string(frame) + ", " + resolution + " solve failed: " + e.what());
+  }
+}
+
+}  // namespace detail
+
+/// Simulates the dataset into `dir` (see the file comment). Returns the figures of this run,
+/// also written to DIR/cloth_data.json.
+template <exec::HostPolicy P>
+std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, const std::filesystem::path& dir, const ClothDatagenOptions& opt = {}) {
+  if (opt.checkpoint_every < 1) throw ArgumentError("generate_cloth_data: checkpoint_every must be >= 1");
+  if (opt.settle_frames < 0) throw ArgumentError("generate_cloth_data: settle_frames must be >= 0");
+  if (!(opt.extra_seconds >= 0) || !std::isfinite(opt.extra_seconds)) throw ArgumentError("generate_cloth_data: extra_seconds must be finite and >= 0");
+  const ClothSceneSize size = opt.size.levels < 0 ? default_scene_size(d) : opt.size;
+  const Index count = opt.sequences > 0 ? opt.sequences : (d == ClothDataset::sheet ? 32 : 16);
+  const ClothPair pair = cloth_pair(d, size);
+  const Index N = pair.coarse.V.rows(), M = pair.fine.V.rows();
+  const double dt = opt.simulation.frame_time;
+
+  // the sequences, their frame counts and fingerprints; another run's checkpoints refused first
+  const auto sheets = d == ClothDataset::sheet ? sheet_sequences(count, opt.seed) : std::vector<SheetSequence>{};
+  const auto disks = d == ClothDataset::disk ? disk_sequences(count, opt.seed) : std::vector<DiskSequence>{};
+  auto frames_of = [&](Index k) {
+    const double seconds = d == ClothDataset::sheet ? sheets[std::size_t(k)].duration() + opt.extra_seconds : disks[std::size_t(k)].duration();
+    return std::max<Index>(1, Index(std::llround(seconds / dt)));
+  };
+  const auto state = dir / ".state";
+  std::vector<std::string> prints;
+  std::vector<std::optional<io::NpzArrays>> checkpoints;
+  for (Index k = 0; k < count; ++k) {
+    prints.push_back(detail::cloth_fingerprint(d, pair, opt, k, frames_of(k)));
+    const auto partial = state / (cloth_sequence_name(d, k) + ".npz");
+    checkpoints.emplace_back();
+    if (!std::filesystem::exists(partial)) continue;
+    checkpoints.back() = io::read_npz(partial);
+    if (data::fingerprint_of(*checkpoints.back()) != prints.back())
+      throw ArgumentError(partial.string() + " is a checkpoint of another run (another scene, size, seed or parameters): remove it or use another directory");
+  }
+  std::filesystem::create_directories(state);
+  {
+    io::MeshData<double> c, f;
+    c.V = pair.coarse.V;
+    c.F = pair.coarse.F;
+    f.V = pair.fine.V;
+    f.F = pair.fine.F;
+    io::write_mesh(dir / "coarse_rest.obj", c);
+    io::write_mesh(dir / "fine_rest.obj", f);
+  }
+
+  const std::string settle_print = detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames);
+  std::vector<ClothSequenceStats> stats;
+
+  // one scene's simulators (their obstacle types differ): make_obstacle(k) the obstacle at the
+  // start of sequence k (k < 0: while settling), move_for(k) its motion, air_for(k, t) the air
+  auto run = [&](auto make_obstacle, auto move_for, auto air_for) {
+    using O = std::decay_t<decltype(make_obstacle(Index(0)))>;
+    ClothSimulator<O> coarse(pair.coarse, pair.pinned, make_obstacle(-1), opt.material, opt.simulation);
+    ClothSimulator<O> fine(pair.fine, pair.pinned, make_obstacle(-1), opt.material, opt.simulation);
+    // the settled start state
+    Points<> settled[2][2];  // [coarse, fine][x, previous]
+    double settled_step[2] = {0, 0};
+    const auto settle_file = state / "settled.npz";
+    bool have = false;
+    if (std::filesystem::exists(settle_file)) {
+      const auto z = io::read_npz(settle_file);
+      if (data::fingerprint_of(z) == settle_print) {
+        settled[0][0] = data::points_of(z, "coarse", N, settle_file.string());
+        settled[0][1] = data::points_of(z, "coarse_previous", N, settle_file.string());
+        settled[1][0] = data::points_of(z, "fine", M, settle_file.string());
+        settled[1][1] = data::points_of(z, "fine_previous", M, settle_file.string());
+        settled_step[0] = data::scalar_of(z, "coarse_last_step", settle_file.string());
+        settled_step[1] = data::scalar_of(z, "fine_last_step", settle_file.string());
+        have = true;
+      }
+    }
+    if (!have) {
+      const std::function<void(O&, double)> still = [&](O& o, double) { o = make_obstacle(-1); };
+      for (Index f = 0; f < opt.settle_frames; ++f) {
+        detail::advance_frame(policy, coarse, still, "settle", f, "coarse");
+        detail::advance_frame(policy, fine, still, "settle", f, "fine");
+      }
+      settled[0][0] = coarse.positions(), settled[0][1] = coarse.previous_positions();
+      settled[1][0] = fine.positions(), settled[1][1] = fine.previous_positions();
+      settled_step[0] = coarse.last_step(), settled_step[1] = fine.last_step();
+      io::NpzArrays z;
+      z["coarse"] = io::make_npy(settled[0][0]);
+      z["coarse_previous"] = io::make_npy(settled[0][1]);
+      z["fine"] = io::make_npy(settled[1][0]);
+      z["fine_previous"] = io::make_npy(settled[1][1]);
+      z["coarse_last_step"] = io::make_npy<double>({}, &settled_step[0]);
+      z["fine_last_step"] = io::make_npy<double>({}, &settled_step[1]);
+      data::set_fingerprint(z, settle_print);
+      io::write_npz(settle_file, z);
+    }
+
+    for (Index k = 0; k < count; ++k) {
+      ClothSequenceStats st;
+      st.name = cloth_sequence_name(d, k);
+      st.test = cloth_sequence_is_test(k);
+      const Index F = frames_of(k);
+      st.frames = F;
+      const std::string& print = prints[std::size_t(k)];
+      const auto final_file = dir / (st.name + ".npz");
+      const auto partial = state / (st.name + ".npz");
+      if (std::filesystem::exists(final_file)) {
+        const auto z = io::read_npz(final_file);
+        if (data::fingerprint_of(z) == print) {
+          st.reused = true;
+          st.subdivided_rmse = detail::subdivided_rmse(data::read_paired_frames(final_file, N, M), pair.subdivision);
+          stats.push_back(st);
+          continue;
+        }
+      }
+      data::PairedFrames<> out;
+      out.lowres.resize(F, 3 * N);
+      out.highres.resize(F, 3 * M);
+      out.ids.resize(std::size_t(F));
+      for (Index f = 0; f < F; ++f) out.ids[std::size_t(f)] = f;
+      out.sequence.assign(std::size_t(F), 0);
+      out.sequence_names = {st.name};
+      Index start = 0;
+      coarse.set_state(settled[0][0], settled[0][1], 0, settled_step[0]);
+      fine.set_state(settled[1][0], settled[1][1], 0, settled_step[1]);
+      if (checkpoints[std::size_t(k)]) {
+        const io::NpzArrays& z = *checkpoints[std::size_t(k)];
+        start = data::resume_frames(z, partial.string(), out);
+        const Index steps = start * opt.simulation.substeps;
+        coarse.set_state(data::points_of(z, "coarse", N, partial.string()), data::points_of(z, "coarse_previous", N, partial.string()), steps,
+                         data::scalar_of(z, "coarse_last_step", partial.string()));
+        fine.set_state(data::points_of(z, "fine", M, partial.string()), data::points_of(z, "fine_previous", M, partial.string()), steps,
+                       data::scalar_of(z, "fine_last_step", partial.string()));
+      }
+      const std::function<void(O&, double)> move = move_for(k);
+      for (Index f = start; f < F; ++f) {
+        coarse.set_air(air_for(k, coarse.time()));
+        fine.set_air(air_for(k, fine.time()));
+        const auto t0 = std::chrono::steady_clock::now();
+        const ClothFrameReport rc = detail::advance_frame(policy, coarse, move, st.name, f, "coarse");
+        const auto t1 = std::chrono::steady_clock::now();
+        const ClothFrameReport rf = detail::advance_frame(policy, fine, move, st.name, f, "fine");
+        const auto t2 = std::chrono::steady_clock::now();
+        const double sc = std::chrono::duration<double>(t1 - t0).count(), sf = std::chrono::duration<double>(t2 - t1).count();
+        out.lr(f) = coarse.positions();
+        out.hr(f) = fine.positions();
+        st.coarse_seconds += sc;
+        st.fine_seconds += sf;
+        st.coarse_iterations += rc.newton_iterations;
+        st.fine_iterations += rf.newton_iterations;
+        st.halvings += rc.halvings + rf.halvings;
+        st.deepest = std::min({st.deepest, rc.deepest, rf.deepest});
+        ++st.simulated;
+        if (opt.on_frame) opt.on_frame(st.name, f, F, rc, rf, sc, sf);
+        const Index done = f + 1;
+        if (done < F && done % opt.checkpoint_every == 0) {
+          io::NpzArrays z = data::frames_checkpoint(out, done, print);
+          z["coarse"] = io::make_npy(coarse.positions());
+          z["coarse_previous"] = io::make_npy(coarse.previous_positions());
+          z["fine"] = io::make_npy(fine.positions());
+          z["fine_previous"] = io::make_npy(fine.previous_positions());
+          const double steps[2] = {coarse.last_step(), fine.last_step()};
+          z["coarse_last_step"] = io::make_npy<double>({}, &steps[0]);
+          z["fine_last_step"] = io::make_npy<double>({}, &steps[1]);
+          io::write_npz(partial, z);
+        }
+      }
+      st.subdivided_rmse = detail::subdivided_rmse(out, pair.subdivision);
+      auto arrays = data::paired_frame_arrays(out);
+      data::set_fingerprint(arrays, print);
+      io::write_npz(final_file, arrays);
+      std::filesystem::remove(partial);
+      stats.push_back(st);
+    }
+  };
+
+  if (d == ClothDataset::sheet) {
+    run([&](Index k) { return k < 0 ? sheets[0].obstacle_at(0) : sheets[std::size_t(k)].obstacle_at(0); },
+        [&](Index k) { return std::function<void(physics::Capsule<>&, double)>([&, k](physics::Capsule<>& o, double t) { o = sheets[std::size_t(k)].obstacle_at(t); }); },
+        [](Index, double) { return Air{}; });
+  } else {
+    run([](Index) { return disk_table(); }, [](Index) { return std::function<void(physics::RoundedCylinder<>&, double)>(); },
+        [&](Index k, double t) { return disks[std::size_t(k)].air_at(t); });
+  }
+
+  // the summary
+  nlohmann::ordered_json j;
+  j["scene"] = to_string(d);
+  j["coarse"] = {{"vertices", N}, {"triangles", pair.coarse.F.rows()}};
+  j["fine"] = {{"vertices", M}, {"triangles", pair.fine.F.rows()}, {"loop_levels", size.levels}};
+  j["seed"] = opt.seed;
+  j["frame_time_s"] = dt;
+  nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
+  Index train_frames = 0, test_frames = 0;
+  for (const auto& s : stats) {
+    (s.test ? test_frames : train_frames) += s.frames;
+    nlohmann::ordered_json e{{"name", s.name}, {"split", s.test ? "test" : "train"}, {"frames", s.frames}, {"reused", s.reused},
+                             {"simulated", s.simulated}, {"subdivided_rmse_m", s.subdivided_rmse}};
+    if (s.simulated > 0) {
+      e["coarse_seconds_per_frame"] = s.coarse_seconds / double(s.simulated);
+      e["fine_seconds_per_frame"] = s.fine_seconds / double(s.simulated);
+      e["coarse_newton_per_frame"] = double(s.coarse_iterations) / double(s.simulated);
+      e["fine_newton_per_frame"] = double(s.fine_iterations) / double(s.simulated);
+      e["halved_steps"] = s.halvings;
+      e["deepest_m"] = s.deepest;
+    }
+    seqs.push_back(e);
+  }
+  j["train_frames"] = train_frames;
+  j["test_frames"] = test_frames;
+  j["sequences"] = seqs;
+  io::write_file_atomic(dir / "cloth_data.json", j.dump(2) + "\n");
+  return stats;
+}
+
+}  // namespace simsr::shell

@@ -1,0 +1,157 @@
+// The thin-shell data's simulator (issue #14 item 3): wind forces, the SHEET and DISK scenes'
+// meshes, and short runs of both scenes at reduced sizes (the full sizes are the datagen's).
+#include <doctest/doctest.h>
+
+#include <simsr/shell/cloth_scenes.hpp>
+#include <simsr/shell/cloth_simulator.hpp>
+
+#include <cmath>
+#include <random>
+
+namespace shell_test_cloth {
+
+using namespace simsr;
+using namespace simsr::shell;
+
+TEST_CASE("wind_forces: ½ρC_d A |v_n| v_n n per triangle, a third per corner; none along the cloth or moving with the air; bad input named") {
+  TriMesh<> tri;
+  tri.V.resize(3, 3);
+  tri.V << 0, 0, 0, 2, 0, 0, 0, 1, 0;  // area 1, normal +z
+  tri.F.resize(1, 3);
+  tri.F << 0, 1, 2;
+  const Points<> still = Points<>::Zero(3, 3);
+  Air air;
+  air.velocity = Vec3<>(1, 2, -3);
+  air.density = 1.25;
+  air.drag = 0.8;
+  Points<> f;
+  wind_forces(exec::seq, tri.V, still, tri.F, air, f);
+  const double expected = 0.5 * 1.25 * 0.8 * 1.0 * 3 * (-3) / 3;  // |v_n| v_n with v_n = −3
+  for (Index i = 0; i < 3; ++i) CHECK((f.row(i) - Eigen::RowVector3d(0, 0, expected)).norm() < 1e-14);
+  // the cloth moving with the air: no relative velocity, no force
+  Points<> with_air = still.rowwise() + air.velocity.transpose();
+  wind_forces(exec::seq, tri.V, with_air, tri.F, air, f);
+  CHECK(f.cwiseAbs().maxCoeff() < 1e-14);
+  air.velocity = Vec3<>(4, -1, 0);  // along the cloth
+  wind_forces(exec::seq, tri.V, still, tri.F, air, f);
+  CHECK(f.cwiseAbs().maxCoeff() == 0);
+  // a curved sheet: the total force is the sum of the triangles' own, each along its normal
+  TriMesh<> sheet = square_sheet(1.0, 4);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  for (Index i = 0; i < sheet.V.rows(); ++i) sheet.V(i, 2) = u(rng);
+  Points<> v = Points<>::Zero(sheet.V.rows(), 3);
+  for (Index i = 0; i < v.rows(); ++i) v.row(i) << u(rng), u(rng), u(rng);
+  air.velocity = Vec3<>(0.5, -0.3, 2.0);
+  wind_forces(exec::seq, sheet.V, v, sheet.F, air, f);
+  Vec3<> total = Vec3<>::Zero();
+  for (Index t = 0; t < sheet.F.rows(); ++t) {
+    const Vec3<> a = sheet.V.row(sheet.F(t, 0)), b = sheet.V.row(sheet.F(t, 1)), c = sheet.V.row(sheet.F(t, 2));
+    const Vec3<> n = (b - a).cross(c - a).normalized();
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    const Vec3<> vbar = (v.row(sheet.F(t, 0)) + v.row(sheet.F(t, 1)) + v.row(sheet.F(t, 2))).transpose() / 3;
+    const double vn = (air.velocity - vbar).dot(n);
+    total += 0.5 * air.density * air.drag * area * std::abs(vn) * vn * n;
+  }
+  CHECK((f.colwise().sum().transpose() - total).norm() < 1e-12 * (1 + total.norm()));
+  CHECK(total.z() > 0);  // the wind blows up through it
+  CHECK_THROWS_AS(wind_forces(exec::seq, sheet.V, Points<>(v.topRows(3)), sheet.F, air, f), ShapeError);
+  Tris bad = sheet.F;
+  bad(2, 1) = 99;
+  CHECK_THROWS_AS(wind_forces(exec::seq, sheet.V, v, bad, air, f), MeshError);
+  air.density = -1;
+  CHECK_THROWS_AS(wind_forces(exec::seq, sheet.V, v, sheet.F, air, f), ArgumentError);
+}
+
+TEST_CASE("cloth_pair: SHEET 81 / 4,225 and DISK 127 / 7,057 vertices, the fine rest the Loop-subdivided coarse, the pins the same ids") {
+  const ClothPair sheet = cloth_pair(ClothDataset::sheet, default_scene_size(ClothDataset::sheet));
+  CHECK(sheet.coarse.V.rows() == 81);
+  CHECK(sheet.fine.V.rows() == 4225);
+  CHECK(sheet.fine.F.rows() == 8192);
+  CHECK((Points<>(sheet.subdivision * sheet.coarse.V) - sheet.fine.V).cwiseAbs().maxCoeff() == 0);
+  for (Index k = 0; k < 4; ++k)  // the corners are kept: pinned at the same spot in both
+    CHECK((sheet.fine.V.row(sheet.pinned[k]) - sheet.coarse.V.row(sheet.pinned[k])).norm() == 0);
+  CHECK(std::abs(sheet.coarse.V.col(0).mean()) < 1e-15);
+  const ClothPair disk = cloth_pair(ClothDataset::disk, default_scene_size(ClothDataset::disk));
+  CHECK(disk.coarse.V.rows() == 127);
+  CHECK(disk.fine.V.rows() == 7057);
+  CHECK(disk.pinned.size() == 7);
+  for (Index k = 0; k < 7; ++k) CHECK((disk.fine.V.row(disk.pinned[k]) - disk.coarse.V.row(disk.pinned[k])).norm() < 0.02);
+  CHECK(disk_table().distance(disk.coarse.V.row(0).transpose()) == doctest::Approx(0.03));  // just above the table
+  CHECK(cloth_dataset("disk") == ClothDataset::disk);
+  CHECK_THROWS_WITH_AS(cloth_dataset("skirt"), doctest::Contains("got 'skirt'"), ArgumentError);
+  CHECK_THROWS_AS(cloth_pair(ClothDataset::sheet, {1, 2}), ArgumentError);
+  CHECK_THROWS_AS(cloth_pair(ClothDataset::disk, {6, -1}), ArgumentError);
+}
+
+TEST_CASE("ClothSimulator on SHEET (reduced: 25 / 81 vertices): a sphere comes down and leaves; pins held, no vertex deep in it, the two resolutions agree") {
+  const ClothPair pair = cloth_pair(ClothDataset::sheet, {4, 1});
+  SheetSequence seq;
+  seq.radius = 0.12;
+  seq.centre = Vec3<>(0.05, -0.03, -0.25);
+  seq.descent_time = 0.5;
+  seq.hold_time = 0.2;
+  seq.start_height = 0.7;
+  ClothSimulator<physics::Capsule<>> coarse(pair.coarse, pair.pinned, seq.obstacle_at(0));
+  ClothSimulator<physics::Capsule<>> fine(pair.fine, pair.pinned, seq.obstacle_at(0));
+  auto move = [&](physics::Capsule<>& o, double t) { o = seq.obstacle_at(t); };
+  // a third run whose Newton solves are cut short: the failed steps are halved, and it follows
+  // the regular run closely (the momentum carried over each shorter step)
+  ClothOptions short_newton;
+  short_newton.newton.max_iterations = 5;
+  ClothSimulator<physics::Capsule<>> halving(pair.coarse, pair.pinned, seq.obstacle_at(0), {}, short_newton);
+  Index halvings = 0;
+  double halving_gap = 0;
+  const Index frames = Index(std::ceil(seq.duration() / coarse.options().frame_time));
+  double lowest = 0, deepest = 0, worst_gap = 0, largest_motion = 0;
+  for (Index f = 0; f < frames; ++f) {
+    const ClothFrameReport rc = coarse.advance(exec::omp, move), rf = fine.advance(exec::omp, move);
+    halvings += halving.advance(exec::seq, move).halvings;
+    halving_gap = std::max(halving_gap, (halving.positions() - coarse.positions()).rowwise().norm().maxCoeff());
+    CHECK(rc.newton_iterations >= 1);
+    deepest = std::min({deepest, rc.deepest, rf.deepest});
+    lowest = std::min(lowest, fine.positions().col(2).minCoeff());
+    const Points<> up = pair.subdivision * coarse.positions();
+    worst_gap = std::max(worst_gap, (up - fine.positions()).rowwise().norm().maxCoeff());
+    largest_motion = std::max(largest_motion, (fine.positions() - pair.fine.V).rowwise().norm().maxCoeff());
+  }
+  CHECK(coarse.time() == doctest::Approx(double(frames) * coarse.options().frame_time));
+  for (Index k = 0; k < 4; ++k) CHECK((fine.positions().row(pair.pinned[k]) - pair.fine.V.row(pair.pinned[k])).norm() == 0);
+  CHECK(lowest < -0.1);        // pushed down by the sphere (it stops 0.13 m below the sheet)
+  CHECK(deepest > -0.01);      // the penalty holds every vertex within a centimetre of the surface
+  CHECK(worst_gap < 0.5 * largest_motion);  // the same cloth at two resolutions, unconstrained
+  CHECK(halvings > 0);
+  CHECK(halving_gap < 0.02);
+  MESSAGE("Newton cut at 5 iterations: " << halvings << " steps halved, at most " << halving_gap << " m from the regular run");
+  MESSAGE("SHEET 25/81: lowest " << lowest << " m, deepest " << deepest << " m, subdivided-coarse to fine gap " << worst_gap << " m of " << largest_motion << " m motion");
+}
+
+TEST_CASE("ClothSimulator on DISK (reduced: 37 vertices): the cloth drapes over the table and the wind pushes it downwind; the centre stays") {
+  const ClothPair pair = cloth_pair(ClothDataset::disk, {3, 0});
+  REQUIRE(pair.coarse.V.rows() == 37);
+  DiskSequence windy;
+  windy.speed = 8;
+  windy.heading = 0.3;
+  windy.gust = 0;
+  ClothSimulator<physics::RoundedCylinder<>> calm(pair.coarse, pair.pinned, disk_table()), blown(pair.coarse, pair.pinned, disk_table());
+  double deepest = 0;
+  for (Index f = 0; f < 30; ++f) {
+    calm.advance(exec::seq);
+    blown.set_air(windy.air_at(blown.time()));
+    deepest = std::min(deepest, blown.advance(exec::omp).deepest);
+  }
+  CHECK(calm.positions().col(2).minCoeff() < -0.2);  // the rim hangs over the table's edge
+  CHECK(deepest > -0.01);
+  CHECK((calm.positions().row(0) - pair.coarse.V.row(0)).norm() == 0);
+  const Vec3<> downwind(std::cos(0.3), std::sin(0.3), 0);
+  const double shift = (blown.positions() - calm.positions()).colwise().mean() * downwind;
+  CHECK(shift > 0.01);
+  MESSAGE("DISK 37: rim at " << calm.positions().col(2).minCoeff() << " m; the 8 m/s wind moves the cloth " << shift << " m downwind on average");
+  // bad input
+  CHECK_THROWS_AS(ClothSimulator<physics::RoundedCylinder<>>(pair.coarse, (IndexVector(1) << 99).finished(), disk_table()), MeshError);
+  ClothOptions o;
+  o.substeps = 0;
+  CHECK_THROWS_AS(ClothSimulator<physics::RoundedCylinder<>>(pair.coarse, pair.pinned, disk_table(), {}, o), ArgumentError);
+}
+
+}  // namespace shell_test_cloth

@@ -1,0 +1,103 @@
+// The SHEET / DISK datagen (issue #14 item 3) at a reduced size: files, split, a killed run
+// resuming bitwise, another run's checkpoint refused, a finished file reused.
+#include <doctest/doctest.h>
+
+#include <simsr/shell/cloth_datagen.hpp>
+
+#include <fstream>
+#include <stdexcept>
+
+#include "../support/error_of.hpp"
+#include "../support/scratch_dir.hpp"
+
+namespace shell_test_cloth_datagen {
+
+using namespace simsr;
+using namespace simsr::shell;
+
+ClothDatagenOptions small_sheet() {
+  ClothDatagenOptions o;
+  o.size = {3, 1};  // 16 / 49 vertices
+  o.sequences = 5;  // the 5th held out
+  o.extra_seconds = 0;
+  o.settle_frames = 5;
+  o.checkpoint_every = 4;
+  o.simulation.frame_time = 0.1;
+  return o;
+}
+
+TEST_CASE("cloth datagen (SHEET, reduced): every sequence at both resolutions, the 5th held out; a killed run resumes bitwise; another run is refused") {
+  test::ScratchDir whole("simsr_test_cloth_whole"), resumed("simsr_test_cloth_resumed");
+  ClothDatagenOptions opt = small_sheet();
+  opt.sequences = 2;
+  const auto stats = generate_cloth_data(exec::omp, ClothDataset::sheet, whole.path, opt);
+  REQUIRE(stats.size() == 2);
+  for (const auto& s : stats) {
+    CHECK_FALSE(s.reused);
+    CHECK(s.simulated == s.frames);
+    CHECK(s.frames >= 15);  // 1.9-3.9 s at 10 frames per second
+    CHECK(s.fine_iterations >= s.frames);
+    CHECK(s.deepest > -0.01);
+    CHECK(s.subdivided_rmse > 0);
+    CHECK_FALSE(s.test);
+    const auto p = data::read_paired_frames(whole.path / (s.name + ".npz"), 16, 49);
+    CHECK(p.num_frames() == s.frames);
+    CHECK(p.lowres.allFinite());
+    CHECK(p.highres.allFinite());
+  }
+  CHECK(std::filesystem::exists(whole.path / "coarse_rest.obj"));
+  CHECK(std::filesystem::exists(whole.path / "fine_rest.obj"));
+  const auto json = nlohmann::json::parse(std::ifstream(whole.path / "cloth_data.json"));
+  CHECK(json["coarse"]["vertices"] == 16);
+  CHECK(json["fine"]["vertices"] == 49);
+  CHECK(json["sequences"].size() == 2);
+  CHECK(cloth_sequence_is_test(4));
+  CHECK_FALSE(cloth_sequence_is_test(3));
+
+  // killed at frame 6 of the second sequence (checkpointed at 4), resumed: bitwise the same
+  Index kill_at = 6, simulated = 0;
+  std::string killed_in = cloth_sequence_name(ClothDataset::sheet, 1);
+  ClothDatagenOptions k = opt;
+  k.on_frame = [&](const std::string& seq, Index f, Index, const ClothFrameReport&, const ClothFrameReport&, double, double) {
+    ++simulated;
+    if (seq == killed_in && f == kill_at) throw std::runtime_error("killed");
+  };
+  CHECK_THROWS_AS(generate_cloth_data(exec::omp, ClothDataset::sheet, resumed.path, k), std::runtime_error);
+  CHECK(std::filesystem::exists(resumed.path / ".state" / (killed_in + ".npz")));
+  ClothDatagenOptions other = k;
+  other.material.stretch *= 2;
+  CHECK(test::error_of([&] { generate_cloth_data(exec::omp, ClothDataset::sheet, resumed.path, other); }).find("another run") != std::string::npos);
+  kill_at = -1;
+  simulated = 0;
+  const auto again = generate_cloth_data(exec::omp, ClothDataset::sheet, resumed.path, k);
+  CHECK(again[0].reused);  // the first sequence was finished before the kill
+  CHECK(simulated == stats[1].frames - 4);
+  for (const auto& s : stats) {
+    const auto a = data::read_paired_frames(whole.path / (s.name + ".npz")), b = data::read_paired_frames(resumed.path / (s.name + ".npz"));
+    CHECK(a.lowres == b.lowres);
+    CHECK(a.highres == b.highres);
+  }
+  CHECK_FALSE(std::filesystem::exists(resumed.path / ".state" / (killed_in + ".npz")));
+  CHECK(again[1].subdivided_rmse == stats[1].subdivided_rmse);
+  CHECK_THROWS_AS(generate_cloth_data(exec::omp, ClothDataset::sheet, resumed.path, [] { auto o = small_sheet(); o.checkpoint_every = 0; return o; }()), ArgumentError);
+}
+
+TEST_CASE("cloth datagen (DISK, reduced): the wind's sequences, the draped start shared") {
+  test::ScratchDir dir("simsr_test_cloth_disk");
+  ClothDatagenOptions opt;
+  opt.size = {2, 1};  // 19 / 61 vertices
+  opt.sequences = 2;
+  opt.settle_frames = 10;
+  opt.simulation.frame_time = 0.2;
+  const auto stats = generate_cloth_data(exec::omp, ClothDataset::disk, dir.path, opt);
+  REQUIRE(stats.size() == 2);
+  CHECK(stats[0].frames == 20);  // 4 s at 5 frames per second
+  const auto a = data::read_paired_frames(dir.path / "disk_000.npz"), b = data::read_paired_frames(dir.path / "disk_001.npz");
+  // both start from the same draped state and the stronger wind moves the cloth further
+  const double moved_a = (a.hr(a.num_frames() - 1) - a.hr(0)).rowwise().norm().mean(), moved_b = (b.hr(b.num_frames() - 1) - b.hr(0)).rowwise().norm().mean();
+  MESSAGE("DISK 19/61: mean fine-vertex motion over the sequence, 1 m/s wind " << moved_a << " m, 8 m/s " << moved_b << " m");
+  CHECK(moved_b > moved_a);
+  CHECK(stats[0].deepest > -0.01);
+}
+
+}  // namespace shell_test_cloth_datagen
