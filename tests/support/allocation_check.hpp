@@ -32,10 +32,8 @@ namespace simsr::test {
 /// it: C++ lets a compiler elide a new/delete pair whose memory is never used ([expr.new]), and
 /// clang -O1 does so for a buffer of which only the size is read (the malloc counter's own
 /// checks then saw one allocation of two).
-inline void escape(const void* p) {
-  static const void* volatile sink = nullptr;
-  sink = p;
-}
+inline const void* volatile escape_sink = nullptr;
+inline void escape(const void* p) { escape_sink = p; }
 
 #if defined(SIMSR_TEST_THREAD_SANITIZER)
 inline constexpr bool allocations_counted = false;
