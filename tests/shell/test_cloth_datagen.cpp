@@ -98,6 +98,14 @@ TEST_CASE("cloth datagen (DISK, reduced): the wind's sequences, the draped start
   MESSAGE("DISK 19/61: mean fine-vertex motion over the sequence, 1 m/s wind " << moved_a << " m, 8 m/s " << moved_b << " m");
   CHECK(moved_b > moved_a);
   CHECK(stats[0].deepest > -0.01);
+  // three sequences spread the speeds 1, 4.5, 8 m/s: the first file is the same sequence and is
+  // reused, the second (8 m/s before) is another one and is simulated again
+  opt.sequences = 3;
+  const auto again = generate_cloth_data(exec::omp, ClothDataset::disk, dir.path, opt);
+  REQUIRE(again.size() == 3);
+  CHECK(again[0].reused);
+  CHECK_FALSE(again[1].reused);
+  CHECK_FALSE(again[2].reused);
 }
 
 }  // namespace shell_test_cloth_datagen

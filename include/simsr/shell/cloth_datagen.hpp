@@ -86,14 +86,18 @@ inline bool cloth_sequence_is_test(Index k) { return k % 5 == 4; }
 
 namespace detail {
 
-inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, const ClothDatagenOptions& o, Index sequence, Index frames) {
+/// The fingerprint of a sequence's (or the settled start's: sequence −1) file: the meshes, the
+/// material and options, and the sequence's own parameters (a sequence's wind speed depends on
+/// how many sequences were drawn, so its index alone would not do).
+inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, const ClothDatagenOptions& o, Index sequence, Index frames,
+                                     const std::vector<double>& parameters) {
   Fingerprint f;
   f.add(std::int64_t(d)).add(pair.coarse.V).add(pair.coarse.F).add(pair.fine.V).add(pair.fine.F).add(pair.pinned);
   const ClothMaterial& m = o.material;
   const ClothOptions& s = o.simulation;
   f.add(m.areal_density).add(m.stretch).add(m.bending).add(s.frame_time).add(s.substeps).add(s.damping).add(s.gravity).add(s.contact_stiffness);
   f.add(s.newton.relative_tolerance).add(s.newton.absolute_tolerance).add(s.newton.max_iterations).add(std::int64_t(s.newton.hessian)).add(s.max_halvings);
-  f.add(o.settle_frames).add(o.seed).add(o.extra_seconds).add(sequence).add(frames);
+  f.add(o.settle_frames).add(o.seed).add(o.extra_seconds).add(sequence).add(frames).add(parameters);
   return f.hex();
 }
 
@@ -139,11 +143,19 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     const double seconds = d == ClothDataset::sheet ? sheets[std::size_t(k)].duration() + opt.extra_seconds : disks[std::size_t(k)].duration();
     return std::max<Index>(1, Index(std::llround(seconds / dt)));
   };
+  auto parameters_of = [&](Index k) {
+    if (d == ClothDataset::sheet) {
+      const SheetSequence& q = sheets[std::size_t(k)];
+      return std::vector<double>{double(q.pole), q.radius, q.centre.x(), q.centre.y(), q.centre.z(), q.heading, q.descent_time, q.hold_time, q.start_height};
+    }
+    const DiskSequence& q = disks[std::size_t(k)];
+    return std::vector<double>{q.speed, q.heading, q.gust, q.gust_period, q.duration_s};
+  };
   const auto state = dir / ".state";
   std::vector<std::string> prints;
   std::vector<std::optional<io::NpzArrays>> checkpoints;
   for (Index k = 0; k < count; ++k) {
-    prints.push_back(detail::cloth_fingerprint(d, pair, opt, k, frames_of(k)));
+    prints.push_back(detail::cloth_fingerprint(d, pair, opt, k, frames_of(k), parameters_of(k)));
     const auto partial = state / (cloth_sequence_name(d, k) + ".npz");
     checkpoints.emplace_back();
     if (!std::filesystem::exists(partial)) continue;
@@ -162,7 +174,9 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     io::write_mesh(dir / "fine_rest.obj", f);
   }
 
-  const std::string settle_print = detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames);
+  // SHEET settles with the first sequence's obstacle at its start (above the sheet)
+  const std::string settle_print =
+      detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames, d == ClothDataset::sheet ? parameters_of(0) : std::vector<double>{});
   std::vector<ClothSequenceStats> stats;
 
   // one scene's simulators (their obstacle types differ): make_obstacle(k) the obstacle at the
