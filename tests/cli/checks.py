@@ -2,6 +2,7 @@
 script, finish() prints the tally and exits 0 (all passed) or 1; missing_peer() ends a script
 whose peer (a Python package, a tool's optional component) is absent."""
 import os
+import subprocess
 import sys
 
 failures = []
@@ -28,3 +29,15 @@ def missing_peer(reason):
     print(f"MISSING (a failure under SIMSR_REQUIRE_PEERS=1, a skip otherwise): {reason}")
     required = os.environ.get("SIMSR_REQUIRE_PEERS", "0") not in ("", "0")
     sys.exit(1 if required or failures else 77)
+
+
+def tool(exe):
+    """A runner of the executable: run(*args, expect=0) checks that it exits 0 (expect=0) or
+    non-zero (any other expect), the stderr tail in the failure, and returns the process."""
+    def run(*args, expect=0):
+        p = subprocess.run([exe, *args], capture_output=True, text=True)
+        ok = p.returncode == 0 if expect == 0 else p.returncode != 0
+        check(ok, f"{os.path.basename(exe)} {' '.join(args)}: exit {p.returncode}, expected {'0' if expect == 0 else 'non-zero'}; "
+                  f"stderr: {p.stderr.strip()[-400:]}")
+        return p
+    return run

@@ -9,10 +9,9 @@ Exit 0: all checks passed; 1: a check failed; 77: numpy is missing (1 with SIMSR
 import json
 import os
 import shutil
-import subprocess
 import sys
 
-from checks import check, finish, missing_peer
+from checks import check, finish, missing_peer, tool
 
 try:
     import numpy as np
@@ -25,11 +24,7 @@ os.makedirs(WORK)
 data = os.path.join(WORK, "sheet")
 
 
-def simsr(*args, expect=0):
-    p = subprocess.run([SIMSR, *args], capture_output=True, text=True)
-    ok = p.returncode == 0 if expect == 0 else p.returncode != 0
-    check(ok, f"simsr {' '.join(args)}: exit {p.returncode}, expected {'0' if expect == 0 else 'non-zero'}; stderr: {p.stderr.strip()[-400:]}")
-    return p
+simsr = tool(SIMSR)
 
 
 args = ["datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "1", "--out", data]

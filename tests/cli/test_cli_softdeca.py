@@ -17,7 +17,7 @@ import shutil
 import subprocess
 import sys
 
-from checks import check, finish, missing_peer
+from checks import check, finish, missing_peer, tool
 
 try:
     import numpy as np
@@ -30,11 +30,7 @@ os.makedirs(WORK)
 data = os.path.join(WORK, "data")
 
 
-def simsr(*args, expect=0):
-    p = subprocess.run([SIMSR, *args], capture_output=True, text=True)
-    ok = p.returncode == 0 if expect == 0 else p.returncode != 0
-    check(ok, f"simsr {' '.join(args)}: exit {p.returncode}, expected {'0' if expect == 0 else 'non-zero'}; stderr: {p.stderr.strip()[-400:]}")
-    return p
+simsr = tool(SIMSR)
 
 
 def datagen(*extra, expect=0):

@@ -23,7 +23,7 @@ data::PairedFrames<> frames_of(Index F, Index N, Index M, double seed) {
 TEST_CASE("run checkpoint: the frames so far and the fingerprint round-trip; bad counts, shapes and missing arrays are named") {
   const data::PairedFrames<> run = frames_of(6, 4, 9, 0.5);
   io::NpzArrays z = data::frames_checkpoint(run, 4, "abc123");
-  CHECK(data::fingerprint_of(z) == "abc123");
+  CHECK(io::fingerprint_of(z) == "abc123");
   data::PairedFrames<> resumed = frames_of(6, 4, 9, 7.0);  // sized for the whole sequence
   CHECK(data::resume_frames(z, "x.npz", resumed) == 4);
   CHECK(resumed.lowres.topRows(4) == run.lowres.topRows(4));
@@ -33,7 +33,7 @@ TEST_CASE("run checkpoint: the frames so far and the fingerprint round-trip; bad
   io::write_npz(file, z);
   const io::NpzArrays back = io::read_npz(file);
   std::filesystem::remove(file);
-  CHECK(data::fingerprint_of(back) == "abc123");
+  CHECK(io::fingerprint_of(back) == "abc123");
   data::PairedFrames<> again = frames_of(6, 4, 9, 3.0);
   CHECK(data::resume_frames(back, "x.npz", again) == 4);
   CHECK(again.lowres.topRows(4) == run.lowres.topRows(4));
@@ -42,12 +42,12 @@ TEST_CASE("run checkpoint: the frames so far and the fingerprint round-trip; bad
   z["p"] = io::make_npy(p);
   const double h = 0.25;
   z["h"] = io::make_npy<double>({}, &h);
-  CHECK(data::points_of(z, "p", 5, "x.npz") == p);
-  CHECK(data::scalar_of(z, "h", "x.npz") == 0.25);
-  CHECK_THROWS_AS(data::points_of(z, "p", 6, "x.npz"), ShapeError);
-  CHECK_THROWS_WITH_AS(data::points_of(z, "q", 5, "x.npz"), doctest::Contains("x.npz: no 'q'"), ArgumentError);
-  CHECK_THROWS_AS(data::scalar_of(z, "p", "x.npz"), ArgumentError);
-  CHECK(data::fingerprint_of(io::NpzArrays{}).empty());
+  CHECK(io::points_of(z, "p", 5, "x.npz") == p);
+  CHECK(io::scalar_of(z, "h", "x.npz") == 0.25);
+  CHECK_THROWS_AS(io::points_of(z, "p", 6, "x.npz"), ShapeError);
+  CHECK_THROWS_WITH_AS(io::points_of(z, "q", 5, "x.npz"), doctest::Contains("x.npz: no 'q'"), ArgumentError);
+  CHECK_THROWS_AS(io::scalar_of(z, "p", "x.npz"), ArgumentError);
+  CHECK(io::fingerprint_of(io::NpzArrays{}).empty());
   // a count past the sequence, frames of other meshes
   data::PairedFrames<> shorter = frames_of(3, 4, 9, 0);
   CHECK_THROWS_WITH_AS(data::resume_frames(z, "x.npz", shorter), doctest::Contains("frames_done 4 outside [1, 3]"), ArgumentError);

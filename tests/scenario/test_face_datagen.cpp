@@ -406,7 +406,7 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
   // simulated lips apart
   {
     const auto z = io::read_npz(whole.path / ".state" / "neutral.npz");
-    const Points<> hr_neutral = data::points_of(z, "hr", face.hr.num_vertices(), "neutral.npz");
+    const Points<> hr_neutral = io::points_of(z, "hr", face.hr.num_vertices(), "neutral.npz");
     Points<> targets = hr_neutral;
     for (Index i = 0; i < face.surface.num_vertices(); ++i) targets.row(face.surface_hr_vertex[i]) = face.neutral.row(i);
     const auto crossing = scenario::intersecting_lip_pairs(face, targets).size(), simulated = scenario::intersecting_lip_pairs(face, hr_neutral).size();

@@ -1,11 +1,11 @@
 #pragma once
 /// \file
-/// The files of a resumable data run (the face's and the cloths' datagen): each file carries the
-/// fingerprint of the run that wrote it (core/fingerprint.hpp), so a file of another run is
-/// refused or recomputed, never continued; a sequence's checkpoint holds its frames so far
+/// The checkpoints of a resumable data run (the face's and the cloths' datagen; the file helpers
+/// they share, fingerprints and named arrays, are io/run_file.hpp): a sequence's checkpoint
+/// holds its frames so far
 /// (PairedFrames' lowres / highres rows) and whatever state the simulators need to go on.
 ///
-///     io::NpzArrays z = data::frames_checkpoint(frames, done, print);   // + the solvers' state
+///     io::NpzArrays z = data::frames_checkpoint(frames, done, print);  // fingerprint included   // + the solvers' state
 ///     z["x"] = io::make_npy(sim.positions());
 ///     io::write_npz(partial, z);
 ///     ...
@@ -18,37 +18,10 @@
 #include "../core/error.hpp"
 #include "../core/types.hpp"
 #include "../io/npz.hpp"
+#include "../io/run_file.hpp"
 #include "paired_frames.hpp"
 
 namespace simsr::data {
-
-/// The fingerprint a run file carries ("" for none).
-inline std::string fingerprint_of(const io::NpzArrays& z) {
-  if (!z.contains("fingerprint")) return "";
-  const auto s = z.at("fingerprint").to_strings();
-  return s.empty() ? "" : s[0];
-}
-
-/// `print` as the file's fingerprint array.
-inline void set_fingerprint(io::NpzArrays& z, const std::string& print) { z["fingerprint"] = io::make_npy(std::vector<std::string>{print}); }
-
-/// A rows×3 array `name` of a run file; ArgumentError naming the file when it is missing,
-/// ShapeError when it has another shape.
-inline Points<> points_of(const io::NpzArrays& z, const std::string& name, Index rows, const std::string& file) {
-  if (!z.contains(name)) throw ArgumentError(file + ": no '" + name + "' array");
-  const auto& a = z.at(name);
-  if (a.ndim() != 2 || a.shape[0] != rows || a.shape[1] != 3)
-    throw ShapeError(file + ": " + name, {rows, 3}, {a.ndim() > 0 ? Index(a.shape[0]) : 0, a.ndim() > 1 ? Index(a.shape[1]) : 0});
-  return a.to_points<double>();
-}
-
-/// A scalar `name` of a run file; ArgumentError naming the file when it is missing or not a scalar.
-inline double scalar_of(const io::NpzArrays& z, const std::string& name, const std::string& file) {
-  if (!z.contains(name)) throw ArgumentError(file + ": no '" + name + "' array");
-  const auto& a = z.at(name);
-  if (a.ndim() != 0) throw ArgumentError(file + ": '" + name + "' is not a scalar");
-  return a.item<double>();
-}
 
 /// A checkpoint of `frames` after its first `done` rows: frames_done, lowres, highres and the
 /// fingerprint (the caller adds its solvers' state).
@@ -59,7 +32,7 @@ inline io::NpzArrays frames_checkpoint(const PairedFrames<>& frames, Index done,
   const FrameMatrix<double> lo = frames.lowres.topRows(done), hi = frames.highres.topRows(done);
   z["lowres"] = io::make_npy(lo);
   z["highres"] = io::make_npy(hi);
-  set_fingerprint(z, print);
+  io::set_fingerprint(z, print);
   return z;
 }
 

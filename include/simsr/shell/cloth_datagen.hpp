@@ -160,7 +160,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     checkpoints.emplace_back();
     if (!std::filesystem::exists(partial)) continue;
     checkpoints.back() = io::read_npz(partial);
-    if (data::fingerprint_of(*checkpoints.back()) != prints.back())
+    if (io::fingerprint_of(*checkpoints.back()) != prints.back())
       throw ArgumentError(partial.string() + " is a checkpoint of another run (another scene, size, seed or parameters): remove it or use another directory");
   }
   std::filesystem::create_directories(state);
@@ -192,13 +192,13 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     bool have = false;
     if (std::filesystem::exists(settle_file)) {
       const auto z = io::read_npz(settle_file);
-      if (data::fingerprint_of(z) == settle_print) {
-        settled[0][0] = data::points_of(z, "coarse", N, settle_file.string());
-        settled[0][1] = data::points_of(z, "coarse_previous", N, settle_file.string());
-        settled[1][0] = data::points_of(z, "fine", M, settle_file.string());
-        settled[1][1] = data::points_of(z, "fine_previous", M, settle_file.string());
-        settled_step[0] = data::scalar_of(z, "coarse_last_step", settle_file.string());
-        settled_step[1] = data::scalar_of(z, "fine_last_step", settle_file.string());
+      if (io::fingerprint_of(z) == settle_print) {
+        settled[0][0] = io::points_of(z, "coarse", N, settle_file.string());
+        settled[0][1] = io::points_of(z, "coarse_previous", N, settle_file.string());
+        settled[1][0] = io::points_of(z, "fine", M, settle_file.string());
+        settled[1][1] = io::points_of(z, "fine_previous", M, settle_file.string());
+        settled_step[0] = io::scalar_of(z, "coarse_last_step", settle_file.string());
+        settled_step[1] = io::scalar_of(z, "fine_last_step", settle_file.string());
         have = true;
       }
     }
@@ -218,7 +218,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
       z["fine_previous"] = io::make_npy(settled[1][1]);
       z["coarse_last_step"] = io::make_npy<double>({}, &settled_step[0]);
       z["fine_last_step"] = io::make_npy<double>({}, &settled_step[1]);
-      data::set_fingerprint(z, settle_print);
+      io::set_fingerprint(z, settle_print);
       io::write_npz(settle_file, z);
     }
 
@@ -233,7 +233,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
       const auto partial = state / (st.name + ".npz");
       if (std::filesystem::exists(final_file)) {
         const auto z = io::read_npz(final_file);
-        if (data::fingerprint_of(z) == print) {
+        if (io::fingerprint_of(z) == print) {
           st.reused = true;
           st.subdivided_rmse = detail::subdivided_rmse(data::read_paired_frames(final_file, N, M), pair.subdivision);
           stats.push_back(st);
@@ -254,10 +254,10 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
         const io::NpzArrays& z = *checkpoints[std::size_t(k)];
         start = data::resume_frames(z, partial.string(), out);
         const Index steps = start * opt.simulation.substeps;
-        coarse.set_state(data::points_of(z, "coarse", N, partial.string()), data::points_of(z, "coarse_previous", N, partial.string()), steps,
-                         data::scalar_of(z, "coarse_last_step", partial.string()));
-        fine.set_state(data::points_of(z, "fine", M, partial.string()), data::points_of(z, "fine_previous", M, partial.string()), steps,
-                       data::scalar_of(z, "fine_last_step", partial.string()));
+        coarse.set_state(io::points_of(z, "coarse", N, partial.string()), io::points_of(z, "coarse_previous", N, partial.string()), steps,
+                         io::scalar_of(z, "coarse_last_step", partial.string()));
+        fine.set_state(io::points_of(z, "fine", M, partial.string()), io::points_of(z, "fine_previous", M, partial.string()), steps,
+                       io::scalar_of(z, "fine_last_step", partial.string()));
       }
       const std::function<void(O&, double)> move = move_for(k);
       for (Index f = start; f < F; ++f) {
@@ -294,7 +294,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
       }
       st.subdivided_rmse = detail::subdivided_rmse(out, pair.subdivision);
       auto arrays = data::paired_frame_arrays(out);
-      data::set_fingerprint(arrays, print);
+      io::set_fingerprint(arrays, print);
       io::write_npz(final_file, arrays);
       std::filesystem::remove(partial);
       stats.push_back(st);

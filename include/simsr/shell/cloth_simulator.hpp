@@ -172,16 +172,17 @@ class ClothSimulator {
       move(contact_.obstacle(), (start + fraction) * step_time());
       face_contact_.obstacle() = contact_.obstacle();
     }
-    Points<> f;
-    wind_forces(policy, x_, velocities(), rest_.F, air_, f);
-    wind_.set_forces(std::move(f));
+    // the step's buffers live in the simulator: a frame allocates nothing of its own here
+    velocity_ = (x_ - previous_) / last_step_;
+    wind_forces(policy, x_, velocity_, rest_.F, air_, forces_);
+    wind_.set_forces(forces_);
     // backward Euler over h from x_n with velocity (x_n − x_{n−1})/h_last: the prediction
     // x_n + (h/h_last)(x_n − x_{n−1})
     inertia_.set_parameters({.h = h, .alpha = 1, .beta = options_.damping, .gamma = h / last_step_});
-    Points<> x = x_;
+    trial_ = x_;
     physics::NewtonReport r;
     try {
-      r = solver_.solve(policy, x, boundary_, membrane_, bending_, gravity_, inertia_, wind_, contact_, face_contact_);
+      r = solver_.solve(policy, trial_, boundary_, membrane_, bending_, gravity_, inertia_, wind_, contact_, face_contact_);
     } catch (const ConvergenceError& e) {
       report.newton_iterations += e.iterations();
       if (depth >= options_.max_halvings) throw;
@@ -191,9 +192,9 @@ class ClothSimulator {
       return;
     }
     report.newton_iterations += r.iterations;
-    inertia_.advance(x);
-    previous_ = x_;
-    x_ = std::move(x);
+    inertia_.advance(trial_);
+    previous_.swap(x_);
+    x_.swap(trial_);
     last_step_ = h;
   }
   static ClothOptions checked(ClothOptions o) {
@@ -244,6 +245,7 @@ class ClothSimulator {
   physics::QuasistaticSolver<> solver_;
   Air air_;
   Points<> x_, previous_;
+  Points<> velocity_, forces_, trial_;  ///< per-step buffers (see step_piece)
   Index steps_ = 0;
   double last_step_ = 1;  ///< set to the step in the constructor
 };

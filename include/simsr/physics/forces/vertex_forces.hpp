@@ -32,11 +32,11 @@ class VertexForces {
   Index num_vertices() const { return f_.rows(); }
   const Points<S>& forces() const { return f_; }
   /// ShapeError for another vertex count, ArgumentError for a non-finite force.
-  void set_forces(Points<S> f) {
+  void set_forces(const Points<S>& f) {
     if (f.rows() != f_.rows() || f.cols() != 3)
       throw ShapeError("VertexForces: forces", {f_.rows(), 3}, {f.rows(), f.cols()});
     if (!f.allFinite()) throw ArgumentError("VertexForces: a force is not finite");
-    f_ = std::move(f);
+    f_ = f;  // same size: a copy into the existing buffer
   }
 
   /// −Σ f_i·x_i (J).

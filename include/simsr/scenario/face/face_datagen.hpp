@@ -231,7 +231,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     checkpoints.emplace_back();
     if (!std::filesystem::exists(partial)) continue;
     checkpoints.back() = io::read_npz(partial);
-    if (data::fingerprint_of(*checkpoints.back()) != prints.back())
+    if (io::fingerprint_of(*checkpoints.back()) != prints.back())
       throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
   }
   std::filesystem::create_directories(state);
@@ -247,9 +247,9 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
   bool have_neutral = false;
   if (std::filesystem::exists(neutral_file)) {
     const auto z = io::read_npz(neutral_file);
-    if (data::fingerprint_of(z) == model_print) {
-      lr_neutral = data::points_of(z, "lr", face.lr.num_vertices(), neutral_file.string());
-      hr_neutral = data::points_of(z, "hr", face.hr.num_vertices(), neutral_file.string());
+    if (io::fingerprint_of(z) == model_print) {
+      lr_neutral = io::points_of(z, "lr", face.lr.num_vertices(), neutral_file.string());
+      hr_neutral = io::points_of(z, "hr", face.hr.num_vertices(), neutral_file.string());
       have_neutral = true;
     }
   }
@@ -264,7 +264,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     io::NpzArrays z;
     z["lr"] = io::make_npy(lr_neutral);
     z["hr"] = io::make_npy(hr_neutral);
-    data::set_fingerprint(z, model_print);
+    io::set_fingerprint(z, model_print);
     io::write_npz(neutral_file, z);
   }
 
@@ -281,7 +281,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     // a finished file of this very run: reuse
     if (std::filesystem::exists(final_file)) {
       const auto z = io::read_npz(final_file);
-      if (data::fingerprint_of(z) == print) {
+      if (io::fingerprint_of(z) == print) {
         st.reused = true;
         detail::count_lip_frames(detail::lip_pairs_of(z, F, final_file.string()), st);
         measure_discrepancy(policy, face, data::read_paired_frames(final_file, N, M), st);
@@ -310,14 +310,14 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
       start = data::resume_frames(z, partial.string(), out);
       const auto lips = detail::lip_pairs_of(z, start, partial.string());
       std::copy(lips.begin(), lips.end(), lip_pairs.begin());
-      const Points<> lx = data::points_of(z, "lr_state", N, partial.string()), hx = data::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
+      const Points<> lx = io::points_of(z, "lr_state", N, partial.string()), hx = io::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
       const FaceControls last = face_controls(perf, start - 1, face);
       lr.set_controls(last);
       hr.set_controls(last);
       // the frame before the last: as the uninterrupted run had it (the neutral before frame 0)
       const FaceControls before = start >= 2 ? face_controls(perf, start - 2, face) : zero;
-      lr.set_positions(start >= 2 ? data::points_of(z, "lr_before", N, partial.string()) : lr_neutral, before, lx);
-      hr.set_positions(start >= 2 ? data::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()) : hr_neutral, before, hx);
+      lr.set_positions(start >= 2 ? io::points_of(z, "lr_before", N, partial.string()) : lr_neutral, before, lx);
+      hr.set_positions(start >= 2 ? io::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()) : hr_neutral, before, hx);
     }
     Points<> lr_before = lr.positions(), hr_before = hr.positions();
     for (Index f = start; f < F; ++f) {
@@ -355,7 +355,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     measure_discrepancy(policy, face, out, st);
     detail::count_lip_frames(lip_pairs, st);
     auto arrays = data::paired_frame_arrays(out);
-    data::set_fingerprint(arrays, print);
+    io::set_fingerprint(arrays, print);
     arrays["hr_lip_pairs"] = io::make_npy<std::int64_t>({F}, lip_pairs.data());
     arrays["control_names"] = io::make_npy(perf.names);
     io::write_npz(final_file, arrays);

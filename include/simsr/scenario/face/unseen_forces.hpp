@@ -28,7 +28,7 @@
 
 #include "../../core/error.hpp"
 #include "../../core/fingerprint.hpp"
-#include "../../data/run_checkpoint.hpp"
+#include "../../io/run_file.hpp"
 #include "../../io/npz.hpp"
 #include "../../mesh/normals.hpp"
 #include "../../physics/forces/embedded_obstacle_contact.hpp"
@@ -127,7 +127,7 @@ std::vector<UnseenForceStats> generate_unseen_force_frames(P policy, const FaceM
     st.name = name;
     st.frames = F;
     const auto file = out_dir / (name + ".npz");
-    if (std::filesystem::exists(file) && data::fingerprint_of(io::read_npz(file)) == print) {
+    if (std::filesystem::exists(file) && io::fingerprint_of(io::read_npz(file)) == print) {
       st.reused = true;
       stats.push_back(st);
       return;
@@ -157,7 +157,7 @@ std::vector<UnseenForceStats> generate_unseen_force_frames(P policy, const FaceM
     std::vector<std::int64_t> ids(static_cast<std::size_t>(F));
     for (Index f = 0; f < F; ++f) ids[std::size_t(f)] = f;
     z["frame"] = io::make_npy<std::int64_t>({F}, ids.data());
-    data::set_fingerprint(z, print);
+    io::set_fingerprint(z, print);
     extra_arrays.write(z);
     io::write_npz(file, z);
     stats.push_back(st);
