@@ -30,6 +30,8 @@ def main():
     ap.add_argument("--size", type=int, default=300, help="pixels per panel")
     ap.add_argument("--reference", default="truth", help="the right-most surface's file stem (default truth: the HR truth)")
     ap.add_argument("--reference-title", default="HR truth", help="its title")
+    ap.add_argument("--view", default="front", choices=["front", "oblique"],
+                    help="camera: front (the face) or oblique (a z-up cloth from above and aside: simsr demo --dataset sheet|disk)")
     ap.add_argument("--field", default="error", help="the point data the bottom row colours by (default error; change for Fig. 7)")
     a = ap.parse_args()
     for f in ("lr_input.vtu", a.reference + ".vtu"):
@@ -81,7 +83,7 @@ def main():
     window.SetSize(cols * a.size, 2 * a.size)
     bounds = truth.GetBounds()
     centre = [(bounds[2 * i] + bounds[2 * i + 1]) / 2 for i in range(3)]
-    height = max(bounds[3] - bounds[2], bounds[1] - bounds[0])
+    height = max(bounds[3] - bounds[2], bounds[1] - bounds[0], bounds[5] - bounds[4])
 
     def panel(row, col, poly, title, coloured):
         ren = vtk.vtkRenderer()
@@ -104,7 +106,7 @@ def main():
         if poly is lr:
             actor.GetProperty().SetInterpolationToFlat()
         ren.AddActor(actor)
-        label_and_frame(ren, title, centre, height)
+        label_and_frame(ren, title, centre, height, a.view)
         window.AddRenderer(ren)
         return ren
 

@@ -50,9 +50,10 @@ def read_surface(path, who, smooth=True):
     return nrm.GetOutput()
 
 
-def label_and_frame(ren, title, centre, height):
+def label_and_frame(ren, title, centre, height, view="front"):
     """A black title in the panel's lower left and the camera every render uses: the face from
-    the front, a little from the left, its height filling the panel."""
+    the front, a little from the left, its height filling the panel (view "front"); or a z-up
+    scene from above and aside (view "oblique": the cloths of the thin-shell paper)."""
     import vtk
     text = vtk.vtkTextActor()
     text.SetInput(title)
@@ -63,8 +64,12 @@ def label_and_frame(ren, title, centre, height):
     ren.AddActor2D(text)
     cam = ren.GetActiveCamera()
     cam.SetFocalPoint(*centre)
-    cam.SetPosition(centre[0] + 0.35 * height, centre[1] + 0.1 * height, centre[2] + 2.2 * height)
-    cam.SetViewUp(0, 1, 0)
+    if view == "oblique":
+        cam.SetPosition(centre[0] + 1.1 * height, centre[1] - 1.6 * height, centre[2] + 1.2 * height)
+        cam.SetViewUp(0, 0, 1)
+    else:
+        cam.SetPosition(centre[0] + 0.35 * height, centre[1] + 0.1 * height, centre[2] + 2.2 * height)
+        cam.SetViewUp(0, 1, 0)
     ren.ResetCameraClippingRange()
 
 

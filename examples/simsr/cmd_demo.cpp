@@ -9,6 +9,7 @@
 // Its own translation unit: the pipeline pulls in every area of the library.
 #include <simsr/pipeline/ablations.hpp>
 #include <simsr/pipeline/demo.hpp>
+#include <simsr/shell/cloth_demo.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -30,9 +31,34 @@ struct DemoArgs {
   pipeline::DemoOptions o;
   std::string preset = "default";
   bool no_network = false;
+  shell::ClothDemoOptions cloth;  ///< --dataset sheet|disk
+  CLI::Option* out_given = nullptr;
+  CLI::Option* epochs_given = nullptr;
+  CLI::Option* seed_given = nullptr;
+  CLI::Option* batch_given = nullptr;
+  Index cells = 0, levels = -1;  ///< sheet/disk: 0 / −1 the scene's default
 };
 
+/// The thin-shell demo (shell/cloth_demo.hpp): progress on stderr, the tables on stdout.
+int cloth_demo_cmd(DemoArgs& a) {
+  shell::ClothDemoOptions& c = a.cloth;
+  c.scene = shell::cloth_dataset(a.o.dataset);
+  c.out = a.out_given->count() > 0 ? a.o.out : std::filesystem::path("out") / a.o.dataset;
+  if (a.epochs_given->count() > 0) c.training.epochs = a.o.recipe.epochs;
+  if (a.seed_given->count() > 0) c.network_seed = c.training.seed = static_cast<std::uint64_t>(a.o.recipe.seed);
+  if (a.batch_given->count() > 0) c.training.batch = a.o.recipe.batch_size;
+  c.data.size = shell::default_scene_size(c.scene);
+  if (a.cells > 0) c.data.size.coarse_cells = a.cells;
+  if (a.levels >= 0) c.data.size.levels = a.levels;
+  const auto report = shell::run_cloth_demo(exec::omp, c, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
+  std::cout << shell::cloth_report_text(report) << "report: " << (c.out / "report.json").string() << "; files people open: "
+            << (c.out / "results" / "frame_errors.csv").string() << " (per frame), " << (c.out / "results" / "compare").string()
+            << "/*/ (ParaView; scripts/render_comparison.py DIR --out F.png --view oblique)\n";
+  return 0;
+}
+
 int demo_cmd(DemoArgs& a) {
+  if (a.o.dataset == "sheet" || a.o.dataset == "disk") return cloth_demo_cmd(a);
   a.o.face.model = scenario::face_model_preset(a.preset);
   a.o.network = !a.no_network;
   const auto report = pipeline::run_demo(exec::omp, a.o, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
@@ -51,11 +77,21 @@ namespace {
 void add_demo_options(CLI::App* cmd, DemoArgs& args) {
   auto* a = &args;
   auto& o = a->o;
-  cmd->add_option("--dataset", o.dataset, "face (simulated from the ICT kit) or bunny (the authors' frames)")
-      ->check(CLI::IsMember({"face", "bunny"}))
+  cmd->add_option("--dataset", o.dataset,
+                  "face (simulated from the ICT kit), bunny (the authors' frames), or sheet / disk (the thin-shell paper's cloths)")
+      ->check(CLI::IsMember({"face", "bunny", "sheet", "disk"}))
       ->capture_default_str();
   cmd->add_option("--data", o.data, "the shared data folder (ict_face/, bunny/)")->capture_default_str();
-  cmd->add_option("--out", o.out, "output folder (a rerun reuses its finished stages)")->capture_default_str();
+  a->out_given = cmd->add_option("--out", o.out, "output folder (a rerun reuses its finished stages; sheet/disk: default out/sheet, out/disk)")
+                     ->capture_default_str();
+  auto& cl = a->cloth;
+  cmd->add_option("--sequences", cl.data.sequences, "sheet/disk: sequences to simulate (0: sheet 32, disk 16; every 5th held out)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--cells", a->cells, "sheet: coarse cells per side (8: 81 vertices); disk: rings (6: 127 vertices)")
+      ->check(CLI::Range(2, 64));
+  cmd->add_option("--levels", a->levels, "sheet/disk: Loop levels from the coarse to the fine cloth (3: the paper's ×64 faces)")
+      ->check(CLI::Range(0, 6));
   cmd->add_option("--preset", a->preset, "face mesh sizes: default, paper-ratio, paper-lr")->capture_default_str();
   cmd->add_option("--frames", o.face.frames, "face: frames per performance")->capture_default_str()->check(CLI::Range(14, 100000));
   cmd->add_option("--train-sequences", o.train_sequences, "face: performances trained on")->delimiter(',')->capture_default_str();
@@ -67,8 +103,8 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
   cmd->add_option("--rbf-regularization", o.method_parameters.rbf_regularization, "rbf: lambda added to the kernel's diagonal")->capture_default_str();
   cmd->add_option("--vae-epochs", o.method_parameters.vae_epochs, "beta_vae: training epochs")->capture_default_str();
   auto& r = o.recipe;
-  cmd->add_option("--epochs", r.epochs, "network: epochs")->capture_default_str();
-  cmd->add_option("--batch-size", r.batch_size, "network: frames per batch")->capture_default_str();
+  a->epochs_given = cmd->add_option("--epochs", r.epochs, "network: epochs (sheet/disk: default 60)")->capture_default_str();
+  a->batch_given = cmd->add_option("--batch-size", r.batch_size, "network: frames per batch (sheet/disk: windows per batch, default 16)")->capture_default_str();
   cmd->add_option("--lr", r.lr, "network: Adam learning rate")->capture_default_str();
   cmd->add_option("--lr-decay-epochs", r.lr_decay_epochs, "network: halve the learning rate every n epochs (0: never)")->capture_default_str();
   cmd->add_option("--w-zreg", r.w_zreg, "network: weight of the latent regularizer (-1: the official 2)")->capture_default_str();
@@ -78,7 +114,7 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
   cmd->add_option("--residual-base", r.residual_base, "network: what the residual adds to: local_linear (fitted on the training frames) or embedded")
       ->check(CLI::IsMember({"embedded", "local_linear"}))
       ->capture_default_str();
-  cmd->add_option("--seed", r.seed, "network: seed of the initial weights and the shuffling")->capture_default_str();
+  a->seed_given = cmd->add_option("--seed", r.seed, "network: seed of the initial weights and the shuffling")->capture_default_str();
   cmd->add_flag("--without-fe", r.without_fe, "network ablation w/o FE (§5.4)");
   cmd->add_flag("--without-cu", r.without_cu, "network ablation w/o CU (§5.4)");
   cmd->add_option("--knn", r.knn, "network: EdgeConv k (default 5)");

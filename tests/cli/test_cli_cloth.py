@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
-"""The thin-shell data from the command line (issue #14): `simsr datagen --scenario sheet` at a
+"""The thin-shell pipeline from the command line (issue #14): `simsr datagen --scenario sheet` at a
 reduced size (3 cells, one Loop level: 16 / 49 vertices, one sequence), its files, its summary
-and progress lines, a finished run reused, and bad options named.
+and progress lines, a finished run reused, and bad options named; `simsr demo --dataset sheet` at
+the same size (5 sequences, the 5th held out; 3 epochs): its report, per-frame errors and views
+(rendered by scripts/render_comparison.py --view oblique), and a rerun that trains nothing.
 
     /usr/bin/python3 tests/cli/test_cli_cloth.py SIMSR_EXE WORK_DIR
 
@@ -9,6 +11,7 @@ Exit 0: all checks passed; 1: a check failed; 77: numpy is missing (1 with SIMSR
 import json
 import os
 import shutil
+import subprocess
 import sys
 
 from checks import check, finish, missing_peer, tool
@@ -54,4 +57,45 @@ check(s2.get("sequences", [{}])[0].get("reused") is True and "frame" not in agai
 bad = simsr("datagen", "--scenario", "skirt", "--out", os.path.join(WORK, "x"), expect=1)
 check("skirt" in bad.stderr, f"an unknown scenario is named: {bad.stderr.strip()[-200:]}")
 simsr("datagen", "--scenario", "disk", "--cells", "1", "--out", os.path.join(WORK, "y"), expect=1)
+
+# the demo end to end at the reduced size
+demo = os.path.join(WORK, "demo")
+dargs = ["demo", "--dataset", "sheet", "--cells", "3", "--levels", "1", "--sequences", "5", "--epochs", "3", "--out", demo]
+d = simsr(*dargs)
+check("RMSE to the fine simulation" in d.stdout and "coarse_simulation" in d.stdout, f"the tables on stdout: {d.stdout[-400:]}")
+check(d.stderr.count("train: epoch ") == 3, "a progress line per epoch")
+report = {}
+if os.path.exists(os.path.join(demo, "report.json")):
+    with open(os.path.join(demo, "report.json")) as f:
+        report = json.load(f)
+rm = report.get("rmse_m", {})
+check(all(k in rm and rm[k] > 0 for k in ("subdivided", "synthesized", "synthesized_refined", "decoded_truth")), f"four RMSEs: {rm}")
+check(report.get("coarse_vertices") == 16 and report.get("fine_vertices") == 49, "the pair's sizes")
+check(len(report.get("training", [])) == 3, "the training history")
+sec = report.get("seconds_per_frame", {})
+check(all(sec.get(k, 0) > 0 for k in ("coarse_simulation", "fine_simulation", "ts_acap_extraction", "synthesis")), f"Table 1's stages timed: {sec}")
+test_frames = report.get("test_frames", 0)
+csv = os.path.join(demo, "results", "frame_errors.csv")
+rows = open(csv).read().strip().splitlines() if os.path.exists(csv) else []
+check(test_frames > 0 and len(rows) == test_frames + 1 and all(r.startswith("sheet_004,") for r in rows[1:]), f"a csv row per held-out frame: {len(rows)}")
+# the RMSE in the report is the root mean square of the csv's per-frame figures
+if len(rows) > 1:
+    sub = np.array([float(r.split(",")[2]) for r in rows[1:]])
+    check(abs(np.sqrt(np.mean(sub ** 2)) - rm.get("subdivided", 0)) < 1e-9, "the csv and the report agree")
+cmp_root = os.path.join(demo, "results", "compare")
+views = sorted(os.listdir(cmp_root)) if os.path.isdir(cmp_root) else []
+check(len(views) == 1 and views[0].startswith("sheet_004_"), f"one view folder for the held-out sequence: {views}")
+if views:
+    files = sorted(os.listdir(os.path.join(cmp_root, views[0])))
+    check(files == ["lr_input.vtu", "refined.vtu", "subdivided.vtu", "synthesized.vtu", "truth.vtu"], f"the view's files: {files}")
+    png = os.path.join(WORK, "sheet_view.png")
+    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "render_comparison.py")
+    r = subprocess.run([sys.executable, script, os.path.join(cmp_root, views[0]), "--out", png, "--view", "oblique"], capture_output=True, text=True)
+    check(r.returncode == 0 and os.path.exists(png) and os.path.getsize(png) > 1000, f"render_comparison.py --view oblique: {r.stderr.strip()[-300:]}")
+# a rerun: the data reused, the training resumed at its end (no epoch trained), the same figures
+d2 = simsr(*dargs)
+check("train: epoch" not in d2.stderr and "data: sheet_" not in d2.stderr, f"a rerun simulates and trains nothing: {d2.stderr[-300:]}")
+if os.path.exists(os.path.join(demo, "report.json")):
+    with open(os.path.join(demo, "report.json")) as f:
+        check(json.load(f).get("rmse_m") == rm, "the rerun's figures are the first run's")
 finish()

@@ -3,7 +3,9 @@
 #include <simsr/mesh/generators.hpp>
 #include <simsr/shell/ts_acap.hpp>
 
+#include <algorithm>
 #include <numbers>
+#include <numeric>
 #include <random>
 
 #include "../support/error_of.hpp"
@@ -31,6 +33,12 @@ double poisson_energy(const TsAcap<double>& acap, const std::vector<Mat3<>>& T, 
 }
 
 Vec3<> centroid(const Points<>& V) { return V.colwise().mean().transpose(); }
+
+TsAcapFeatures<double> rest_features_of(const TsAcap<double>& acap) {
+  TsAcapFeatures<double> f = TsAcapFeatures<double>::Zero(acap.num_vertices(), 9);
+  f.col(3).setOnes(), f.col(6).setOnes(), f.col(8).setOnes();
+  return f;
+}
 
 /// A sheet rolled (isometrically, as cloth bends) around an axis along y with curvature κ, then
 /// turned by `spin` about a tilted axis.
@@ -123,6 +131,76 @@ TEST_CASE("TsAcap: decoding returns the least-squares positions of the fitted gr
     }
     CHECK((centroid(back) - centroid(V)).norm() < 1e-12);
   }
+}
+
+TEST_CASE("TsAcap: anchored decoding is the least-squares answer with the anchors fixed (a dense solve of the residuals)") {
+  const TriMesh<> m = square_sheet(1.0, 5);  // 36 vertices
+  TsAcap<double> acap(exec::seq, m.V, m.F);
+  const Adjacency& A = acap.fit().adjacency();
+  const Points<>& q = acap.fit().rest();
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g;
+  for (int trial = 0; trial < 12; ++trial) {
+    // a random anchor set of 1-5 distinct vertices
+    std::vector<VIndex> all(static_cast<std::size_t>(m.V.rows()));
+    std::iota(all.begin(), all.end(), VIndex(0));
+    std::shuffle(all.begin(), all.end(), rng);
+    const Index na = 1 + trial % 5;
+    IndexVector anchors(na);
+    for (Index a = 0; a < na; ++a) anchors[a] = all[std::size_t(a)];
+    acap.set_anchors(anchors);
+    // a rolled, turned and randomly perturbed frame (not a similarity: the fit is inexact)
+    Points<> V = roll(m.V, 0.3 * trial, 0.5 * trial);
+    for (Index i = 0; i < V.rows(); ++i) V.row(i) += 0.01 * Eigen::RowVector3d(g(rng), g(rng), g(rng));
+    TsAcapState<double> state;
+    const TsAcapFeatures<double> f = acap.encode(exec::seq, V, state);
+    Points<> at(na, 3);
+    for (Index a = 0; a < na; ++a) at.row(a) = V.row(anchors[a]) + 0.05 * Eigen::RowVector3d(g(rng), g(rng), g(rng));
+    const Points<> p = acap.decode_anchored(exec::omp, f, at);
+    for (Index a = 0; a < na; ++a) CHECK(p.row(anchors[a]) == at.row(a));
+    // the reference: every residual √w_ij ((p_i − p_j) − T_i (q_i − q_j)) as a row of a dense
+    // least-squares problem in the free vertices' coordinates, solved by QR
+    const std::vector<Mat3<>> T = acap.gradients_from_features(exec::seq, f);
+    std::vector<Index> col(std::size_t(m.V.rows()), -1);
+    Index nf = 0;
+    for (Index i = 0; i < m.V.rows(); ++i)
+      if ((anchors.array() != VIndex(i)).all()) col[std::size_t(i)] = nf++;
+    Eigen::MatrixXd L = Eigen::MatrixXd::Zero(Index(A.neighbors.size()), nf);
+    Eigen::MatrixXd r(Index(A.neighbors.size()), 3);
+    for (Index i = 0; i < m.V.rows(); ++i)
+      for (Index k = A.offsets[i]; k < A.offsets[i + 1]; ++k) {
+        const Index j = A.neighbors[k];
+        const double s = std::sqrt(acap.fit().weights()[k]);
+        Eigen::RowVector3d rhs = s * (T[std::size_t(i)] * Vec3<>(q.row(i) - q.row(j))).transpose();
+        auto place = [&](Index v, double sign) {
+          if (col[std::size_t(v)] >= 0) L(k, col[std::size_t(v)]) += sign * s;
+          else for (Index a = 0; a < na; ++a) if (anchors[a] == v) rhs -= sign * s * at.row(a);
+        };
+        place(i, 1), place(j, -1);
+        r.row(k) = rhs;
+      }
+    const Eigen::MatrixXd x = L.colPivHouseholderQr().solve(r);
+    double worst = 0;
+    for (Index i = 0; i < m.V.rows(); ++i)
+      if (col[std::size_t(i)] >= 0) worst = std::max(worst, (p.row(i) - x.row(col[std::size_t(i)])).norm());
+    CHECK(worst < 1e-10);
+  }
+  // a rigid motion with its anchors where the motion puts them decodes exactly
+  const Mat3<> R = Eigen::AngleAxisd(2.5, Vec3<>(1, 2, 3).normalized()).toRotationMatrix();
+  Points<> V = (m.V * R.transpose()).rowwise() + Eigen::RowVector3d(0.3, -1, 2);
+  IndexVector corners(2);
+  corners << 0, VIndex(m.V.rows() - 1);
+  acap.set_anchors(corners);
+  TsAcapState<double> state;
+  Points<> at(2, 3);
+  at << V.row(0), V.row(m.V.rows() - 1);
+  CHECK((acap.decode_anchored(exec::seq, acap.encode(exec::seq, V, state), at) - V).cwiseAbs().maxCoeff() < 1e-12);
+  // bad anchors are typed errors
+  CHECK(!test::typed_error_of<MeshError>([&] { acap.set_anchors(IndexVector::Constant(1, VIndex(m.V.rows()))); }).empty());
+  CHECK(!test::typed_error_of<MeshError>([&] { acap.set_anchors(IndexVector::Constant(2, VIndex(3))); }).empty());
+  CHECK(!test::typed_error_of<ShapeError>([&] { acap.decode_anchored(exec::seq, rest_features_of(acap), Points<>::Zero(3, 3)); }).empty());
+  const TsAcap<double> fresh(exec::seq, m.V, m.F);
+  CHECK(!test::typed_error_of<ArgumentError>([&] { fresh.decode_anchored(exec::seq, rest_features_of(fresh), at); }).empty());
 }
 
 TEST_CASE("TsAcap: a rolling, turning sheet: features continuous in time past π, decoding error O(h²)") {

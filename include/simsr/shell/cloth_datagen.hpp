@@ -314,6 +314,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   nlohmann::ordered_json j;
   j["scene"] = to_string(d);
   j["coarse"] = {{"vertices", N}, {"triangles", pair.coarse.F.rows()}};
+  j["coarse_cells"] = size.coarse_cells;
   j["fine"] = {{"vertices", M}, {"triangles", pair.fine.F.rows()}, {"loop_levels", size.levels}};
   j["seed"] = opt.seed;
   j["frame_time_s"] = dt;

@@ -195,6 +195,95 @@ class TsAcap {
   template <exec::HostPolicy P>
   Points<S> positions_from_gradients(P policy, const std::vector<Mat3<S>>& T, const Vec3<S>& centroid) const {
     const Index n = num_vertices();
+    const Eigen::Matrix<S, Eigen::Dynamic, 3> b = poisson_rhs(policy, T);
+    Points<S> p(n, 3);
+    p.row(0).setZero();
+    if (n > 1) {
+      const Eigen::Matrix<S, Eigen::Dynamic, 3> x = poisson_.solve(b.bottomRows(n - 1));
+      p.bottomRows(n - 1) = x;
+    }
+    const Vec3<S> shift = centroid - Vec3<S>(p.colwise().mean().transpose());
+    p.rowwise() += shift.transpose();
+    return p;
+  }
+
+  /// Fixes `anchors` (vertex indices, at least one) for decode_anchored: the Laplacian of the
+  /// other vertices, factored once. Where a scene pins vertices (a sheet's corners, a tablecloth's
+  /// centre), their known positions replace the centroid, which is what a coarse mesh predicts
+  /// worst (the fine cloth hangs differently as a whole). MeshError for an index outside the mesh
+  /// or a repeated one.
+  void set_anchors(const IndexVector& anchors) {
+    const Index n = num_vertices();
+    if (anchors.size() == 0) throw ArgumentError("TsAcap::set_anchors: no anchor");
+    free_index_.assign(static_cast<std::size_t>(n), 0);
+    for (Index a = 0; a < anchors.size(); ++a) {
+      const Index v = anchors[a];
+      if (v < 0 || v >= n) throw MeshError("vertex", v, "TsAcap::set_anchors: outside the mesh of " + std::to_string(n) + " vertices");
+      if (free_index_[std::size_t(v)] < 0) throw MeshError("vertex", v, "TsAcap::set_anchors: anchored twice");
+      free_index_[std::size_t(v)] = -1 - a;
+    }
+    Index m = 0;
+    for (auto& k : free_index_)
+      if (k >= 0) k = m++;
+    anchors_ = anchors;
+    const Adjacency& A = fit_.adjacency();
+    std::vector<Eigen::Triplet<S, Index>> trip;
+    for (Index i = 0; i < n; ++i) {
+      const Index r = free_index_[std::size_t(i)];
+      if (r < 0) continue;
+      for (Index k = A.offsets[i]; k < A.offsets[i + 1]; ++k) {
+        const Index c = free_index_[std::size_t(A.neighbors[k])];
+        trip.emplace_back(r, r, fit_.weights()[k]);
+        if (c >= 0) trip.emplace_back(r, c, -fit_.weights()[k]);
+      }
+    }
+    Eigen::SparseMatrix<S> K(m, m);
+    K.setFromTriplets(trip.begin(), trip.end());
+    if (m > 0) {
+      anchored_.compute(K);
+      if (anchored_.info() != Eigen::Success)
+        throw MeshError("triangle mesh", -1, "TsAcap::set_anchors: the weighted Laplacian of the free vertices does not factor");
+    }
+  }
+  const IndexVector& anchors() const { return anchors_; }
+
+  /// Positions from #V×9 features with the anchors of set_anchors at `anchor_positions` (one row
+  /// per anchor, in set_anchors' order): the Poisson problem of the file comment with those
+  /// vertices fixed. ArgumentError before set_anchors; ShapeError for a wrong row count.
+  template <exec::HostPolicy P>
+  Points<S> decode_anchored(P policy, const TsAcapFeatures<S>& f, const Points<S>& anchor_positions) const {
+    if (anchors_.size() == 0) throw ArgumentError("TsAcap::decode_anchored: call set_anchors first");
+    if (anchor_positions.rows() != anchors_.size())
+      throw ShapeError("TsAcap::decode_anchored: anchor positions", {anchors_.size(), 3}, {anchor_positions.rows(), 3});
+    const std::vector<Mat3<S>> T = gradients_from_features(policy, f);
+    const Index n = num_vertices(), m = n - anchors_.size();
+    const Eigen::Matrix<S, Eigen::Dynamic, 3> b = poisson_rhs(policy, T);
+    const Adjacency& A = fit_.adjacency();
+    Eigen::Matrix<S, Eigen::Dynamic, 3> bf(m, 3);
+    for (Index i = 0; i < n; ++i) {
+      const Index r = free_index_[std::size_t(i)];
+      if (r < 0) continue;
+      bf.row(r) = b.row(i);
+      for (Index k = A.offsets[i]; k < A.offsets[i + 1]; ++k) {
+        const Index c = free_index_[std::size_t(A.neighbors[k])];
+        if (c < 0) bf.row(r) += fit_.weights()[k] * anchor_positions.row(-1 - c);
+      }
+    }
+    Points<S> p(n, 3);
+    const Eigen::Matrix<S, Eigen::Dynamic, 3> x = m > 0 ? Eigen::Matrix<S, Eigen::Dynamic, 3>(anchored_.solve(bf)) : bf;
+    for (Index i = 0; i < n; ++i) {
+      const Index r = free_index_[std::size_t(i)];
+      if (r >= 0) p.row(i) = x.row(r);
+      else p.row(i) = anchor_positions.row(-1 - r);
+    }
+    return p;
+  }
+
+ private:
+  /// b_i = ½ Σ_j w_ij (T_i + T_j)(q_i − q_j), the right-hand side of the file comment's equations.
+  template <exec::HostPolicy P>
+  Eigen::Matrix<S, Eigen::Dynamic, 3> poisson_rhs(P policy, const std::vector<Mat3<S>>& T) const {
+    const Index n = num_vertices();
     if (static_cast<Index>(T.size()) != n) throw ShapeError("TsAcap: gradients", {n}, {static_cast<std::int64_t>(T.size())});
     const Adjacency& A = fit_.adjacency();
     const Points<S>& q = fit_.rest();
@@ -208,18 +297,9 @@ class TsAcap {
       }
       b.row(i) = bi.transpose();
     });
-    Points<S> p(n, 3);
-    p.row(0).setZero();
-    if (n > 1) {
-      const Eigen::Matrix<S, Eigen::Dynamic, 3> x = poisson_.solve(b.bottomRows(n - 1));
-      p.bottomRows(n - 1) = x;
-    }
-    const Vec3<S> shift = centroid - Vec3<S>(p.colwise().mean().transpose());
-    p.rowwise() += shift.transpose();
-    return p;
+    return b;
   }
 
- private:
   void check_features(const TsAcapFeatures<S>& f) const {
     if (f.rows() != num_vertices())
       throw ShapeError("TsAcap: features", {num_vertices(), ts_acap_feature_dim}, {f.rows(), f.cols()});
@@ -230,6 +310,9 @@ class TsAcap {
   OneRingFit<S> fit_;
   ConsistencyGraph graph_;  // the integer steps' graph, built once
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<S>> poisson_;
+  IndexVector anchors_;
+  std::vector<Index> free_index_;  // per vertex: its row among the free vertices, or −1 − (its anchor number)
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<S>> anchored_;
 };
 
 }  // namespace simsr::shell

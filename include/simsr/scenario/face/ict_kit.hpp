@@ -14,10 +14,8 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,6 +23,7 @@
 #include "../../core/types.hpp"
 #include "../../io/npz.hpp"
 #include "../../io/obj.hpp"
+#include "../../io/text_file.hpp"
 #include "../../mesh/poly_mesh.hpp"
 
 namespace simsr::scenario {
@@ -90,18 +89,6 @@ struct IctKit {
   }
 };
 
-namespace detail {
-
-inline std::string read_whole_file(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw ParseError(p.string(), 0, "cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-}  // namespace detail
-
 /// Reads the kit from `dir` (full_neutral.obj, regions.json, expressions_full.npz) and checks that
 /// the files belong together: the ranges tile 0..V−1 without gap or overlap, `deltas` is E×V×3
 /// with E names, every delta finite. ParseError / ArgumentError /
@@ -114,7 +101,7 @@ inline IctKit read_ict_kit(const std::filesystem::path& dir) {
   const auto regions_file = dir / "regions.json";
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(detail::read_whole_file(regions_file));
+    j = nlohmann::json::parse(io::read_text_file(regions_file));
   } catch (const nlohmann::json::exception& e) {
     throw ParseError(regions_file.string(), 0, e.what());
   }

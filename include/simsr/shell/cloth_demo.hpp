@@ -1,0 +1,189 @@
+#pragma once
+/// \file
+/// `simsr demo --dataset sheet|disk` as a library call: the thin-shell paper's evaluation end to
+/// end. The coarse/fine data (cloth_datagen.hpp; a rerun reuses finished sequences, a killed one
+/// resumes), the TS-ACAP features, the network trained on the training sequences (a checkpoint
+/// per epoch: a killed run resumes), and the held-out sequences synthesized from their coarse
+/// frames only and compared with the fine simulation. Files:
+///   OUT/data/                     the dataset (cloth_data.json, <scene>_NNN.npz, rest meshes)
+///   OUT/network/model.npz         the trained network (DetailSynthesisNet::save)
+///   OUT/network/train.npz         the training checkpoint
+///   OUT/results/frame_errors.csv  per held-out frame: RMS distance of subdivided / synthesized / refined
+///   OUT/results/compare/<seq>_<f>/  lr_input.vtu (coarse), subdivided / synthesized / refined.vtu
+///                                 with their per-vertex `error` (m), truth.vtu: each held-out
+///                                 sequence's frame where subdivision errs most (ParaView;
+///                                 scripts/render_comparison.py --view oblique draws the panel)
+///   OUT/report.json               the RMSE table, the Table 1 timings, the training history
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "../io/atomic_file.hpp"
+#include "../io/vtu.hpp"
+#include "cloth_datagen.hpp"
+#include "cloth_synthesis.hpp"
+
+namespace simsr::shell {
+
+struct ClothDemoOptions {
+  ClothDataset scene = ClothDataset::sheet;
+  std::filesystem::path out = "out/sheet";
+  ClothDatagenOptions data;            ///< sequences, sizes, seed of the scene
+  DetailSynthesisOptions network;      ///< the supplement's sizes by default
+  ClothTrainingOptions training;       ///< epochs, batch, seed (the checkpoint is OUT/network/train.npz)
+  std::uint64_t network_seed = 1;      ///< the initial weights
+};
+
+/// Runs the demo (see the file comment); `say` receives progress lines. Returns OUT/report.json.
+template <exec::HostPolicy P>
+nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const std::function<void(const std::string&)>& say = {}) {
+  auto tell = [&](const std::string& s) {
+    if (say) say(s);
+  };
+  const auto data_dir = o.out / "data", net_dir = o.out / "network", results = o.out / "results";
+  std::filesystem::create_directories(net_dir);
+  std::filesystem::create_directories(results);
+
+  ClothDatagenOptions gen = o.data;
+  const auto user_frame = gen.on_frame;
+  gen.on_frame = [&](const std::string& s, Index f, Index F, const ClothFrameReport& c, const ClothFrameReport& fi, double sc, double sf) {
+    if (user_frame) user_frame(s, f, F, c, fi, sc, sf);
+    if ((f + 1) % 20 == 0 || f + 1 == F) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "data: %s frame %lld/%lld (coarse %.3f s, fine %.3f s)", s.c_str(), (long long)(f + 1), (long long)F, sc, sf);
+      tell(buf);
+    }
+  };
+  tell("data: " + data_dir.string());
+  generate_cloth_data(policy, o.scene, data_dir, gen);
+  const ClothData data = read_cloth_data(data_dir);
+
+  tell("features: TS-ACAP of every frame (coarse " + std::to_string(data.num_coarse()) + ", fine " + std::to_string(data.num_fine()) +
+       " vertices)");
+  ClothSynthesis run(policy, data, o.network, o.network_seed,
+                     [&](const std::string& s, Index done, Index total) { tell("features: " + s + " (" + std::to_string(done) + "/" + std::to_string(total) + ")"); });
+  run.on_epoch = [&](const ClothEpochReport& r) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "train: epoch %lld/%lld lr %.1e loss synthesis %.4f reconstruction %.4f latent %.4f (%.1f s)", (long long)r.epoch,
+                  (long long)r.epochs, r.lr, r.loss.synthesis, r.loss.reconstruction, r.loss.latent, r.seconds);
+    tell(buf);
+  };
+  ClothTrainingOptions t = o.training;
+  t.checkpoint = net_dir / "train.npz";
+  const std::vector<ClothEpochReport> history = run.train(policy, t);
+  run.network().save(net_dir / "model.npz");
+
+  tell("evaluate: the held-out sequences from their coarse frames");
+  const ClothEvaluation e = run.evaluate(policy);
+
+  // per-frame errors and the middle frame of each held-out sequence as meshes
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "sequence,frame,subdivided_m,synthesized_m,refined_m\n";
+  for (const auto& s : e.sequences)
+    for (Index f = 0; f < s.frames; ++f)
+      csv << s.name << ',' << f << ',' << s.frame_subdivided[std::size_t(f)] << ',' << s.frame_synthesized[std::size_t(f)] << ','
+          << s.frame_refined[std::size_t(f)] << '\n';
+  io::write_file_atomic(results / "frame_errors.csv", csv.str());
+  // Fig.-6-style views of each held-out sequence's frame where the subdivided mesh errs most
+  for (std::size_t q = 0, k = 0; q < data.sequences.size(); ++q) {
+    const ClothSequenceFrames& s = data.sequences[q];
+    if (!s.test) continue;
+    const ClothSequenceEvaluation& ev = e.sequences[k++];
+    const auto worst = std::size_t(std::max_element(ev.frame_subdivided.begin(), ev.frame_subdivided.end()) - ev.frame_subdivided.begin());
+    std::vector<Points<>> raw;
+    const std::vector<Points<>> refined = run.synthesize(policy, Index(q), nullptr, nullptr, &raw);
+    const auto dir = results / "compare" / (s.name + "_" + std::to_string(worst));
+    std::filesystem::create_directories(dir);
+    io::VtuGrid lr;
+    lr.set_points(s.coarse[worst]).set_triangles(data.pair.coarse.F);
+    io::write_vtu(dir / "lr_input.vtu", lr);
+    const Points<>& truth = s.fine[worst];
+    auto view = [&](const char* name, const Points<>& x) {
+      io::VtuGrid g;
+      g.set_points(x).set_triangles(data.pair.fine.F);
+      g.add_point_data("error", VecX<double>((x - truth).rowwise().norm()));
+      io::write_vtu(dir / (std::string(name) + ".vtu"), g);
+    };
+    view("truth", truth);
+    view("subdivided", Points<>(data.pair.subdivision * s.coarse[worst]));
+    view("synthesized", raw[worst]);
+    view("refined", refined[worst]);
+  }
+
+  // the simulation's cost per frame, from the dataset's summary (frames simulated in any run)
+  const nlohmann::json summary = nlohmann::json::parse(io::read_text_file(data_dir / "cloth_data.json"));
+  double coarse_s = 0, fine_s = 0, weight = 0;
+  for (const auto& s : summary.at("sequences"))
+    if (s.contains("coarse_seconds_per_frame")) {
+      const double w = s.at("simulated").get<double>();
+      coarse_s += w * s.at("coarse_seconds_per_frame").get<double>();
+      fine_s += w * s.at("fine_seconds_per_frame").get<double>();
+      weight += w;
+    }
+
+  nlohmann::ordered_json r;
+  r["scene"] = to_string(o.scene);
+  r["coarse_vertices"] = data.num_coarse();
+  r["fine_vertices"] = data.num_fine();
+  r["test_frames"] = e.frames;
+  r["rmse_m"] = {{"subdivided", e.subdivided_rmse}, {"synthesized", e.synthesized_rmse}, {"synthesized_refined", e.refined_rmse},
+                  {"decoded_truth", e.decoded_truth_rmse}};
+  nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
+  for (const auto& s : e.sequences)
+    seqs.push_back({{"name", s.name}, {"frames", s.frames}, {"subdivided_m", s.subdivided_rmse}, {"synthesized_m", s.synthesized_rmse},
+                    {"refined_m", s.refined_rmse}, {"decoded_truth_m", s.decoded_truth_rmse}, {"inside_before_vertex_frames", s.inside_before}, {"projected_vertex_frames", s.projected},
+                    {"deepest_before_m", s.deepest_before}, {"deepest_after_m", s.deepest_after}});
+  r["sequences"] = seqs;
+  const FeatureJumps& j = run.feature_jumps();
+  r["feature_jumps"] = {{"coarse_temporal", j.coarse_temporal}, {"coarse_spatial", j.coarse_spatial}, {"fine_temporal", j.fine_temporal},
+                        {"fine_spatial", j.fine_spatial}, {"coarse_vertex_frames", j.coarse_vertex_frames}, {"coarse_edge_frames", j.coarse_edge_frames},
+                        {"fine_vertex_frames", j.fine_vertex_frames}, {"fine_edge_frames", j.fine_edge_frames},
+                        {"coarse_largest_angle_rad", j.coarse_largest_angle}, {"fine_largest_angle_rad", j.fine_largest_angle}};
+  nlohmann::ordered_json tt{{"ts_acap_extraction", e.timings.ts_acap}, {"synthesis", e.timings.synthesis}, {"collision_refinement", e.timings.refinement}};
+  if (weight > 0) {
+    tt["coarse_simulation"] = coarse_s / weight;
+    tt["fine_simulation"] = fine_s / weight;
+  }
+  r["seconds_per_frame"] = tt;
+  nlohmann::ordered_json hist = nlohmann::ordered_json::array();
+  for (const auto& h : history)
+    hist.push_back({{"epoch", h.epoch}, {"lr", h.lr}, {"synthesis", h.loss.synthesis}, {"reconstruction", h.loss.reconstruction}, {"latent", h.loss.latent},
+                    {"seconds", h.seconds}});
+  r["training"] = hist;
+  io::write_file_atomic(o.out / "report.json", r.dump(2) + "\n");
+  return r;
+}
+
+/// The RMSE and timing tables of a report as text.
+inline std::string cloth_report_text(const nlohmann::ordered_json& r) {
+  char buf[512];
+  std::string s;
+  std::snprintf(buf, sizeof buf, "%s: %lld coarse / %lld fine vertices, %lld held-out frames\n\n", r.at("scene").get<std::string>().c_str(),
+                (long long)r.at("coarse_vertices").get<Index>(), (long long)r.at("fine_vertices").get<Index>(), (long long)r.at("test_frames").get<Index>());
+  s += buf;
+  s += "RMSE to the fine simulation (m; decoded_truth: the true fine features decoded, the features' floor)\n";
+  for (const char* k : {"subdivided", "synthesized", "synthesized_refined", "decoded_truth"}) {
+    std::snprintf(buf, sizeof buf, "  %-22s %.5f\n", k, r.at("rmse_m").at(k).get<double>());
+    s += buf;
+  }
+  const auto& j = r.at("feature_jumps");
+  std::snprintf(buf, sizeof buf, "\nrotation-feature jumps > pi (the integer steps' misses): coarse %lld temporal / %lld spatial, fine %lld / %lld (largest |angle| %.2f rad)\n",
+                (long long)j.at("coarse_temporal").get<Index>(), (long long)j.at("coarse_spatial").get<Index>(), (long long)j.at("fine_temporal").get<Index>(),
+                (long long)j.at("fine_spatial").get<Index>(), j.at("fine_largest_angle_rad").get<double>());
+  s += buf;
+  s += "\nseconds per frame (Table 1's stages)\n";
+  for (const auto& [k, v] : r.at("seconds_per_frame").items()) {
+    std::snprintf(buf, sizeof buf, "  %-22s %.5f\n", k.c_str(), v.get<double>());
+    s += buf;
+  }
+  return s;
+}
+
+}  // namespace simsr::shell

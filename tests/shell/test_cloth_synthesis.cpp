@@ -1,0 +1,160 @@
+// Detail synthesis on a reduced SHEET dataset (issue #14 items 2 and 5): the dataset read back
+// with its obstacles, training that fits, a killed training run resuming bitwise, another run's
+// checkpoint refused, and the evaluation's figures checked against a direct computation.
+#include <doctest/doctest.h>
+
+#include <simsr/shell/cloth_datagen.hpp>
+#include <simsr/shell/cloth_synthesis.hpp>
+
+#include <numbers>
+
+#include "../support/error_of.hpp"
+#include "../support/scratch_dir.hpp"
+
+namespace shell_test_cloth_synthesis {
+
+using namespace simsr;
+using namespace simsr::shell;
+
+DetailSynthesisOptions small_net() {
+  DetailSynthesisOptions o;
+  o.codec = {.channels = 6, .latent = 8};
+  o.transformer = {.latent = 8, .d_model = 16, .feed_forward = 32, .heads = 8, .blocks = 1, .frames = 3};
+  o.lr_step = 1000;
+  return o;
+}
+
+const std::filesystem::path& dataset() {
+  static const test::ScratchDir dir("simsr_test_cloth_synthesis");
+  static const bool made = [] {
+    ClothDatagenOptions o;
+    o.size = {3, 1};  // 16 / 49 vertices
+    o.sequences = 5;  // the 5th held out
+    o.extra_seconds = 0;
+    o.settle_frames = 5;
+    o.simulation.frame_time = 0.1;
+    generate_cloth_data(exec::omp, ClothDataset::sheet, dir.path, o);
+    return true;
+  }();
+  (void)made;
+  return dir.path;
+}
+
+TEST_CASE("read_cloth_data: the pair, the split and every frame; the obstacle at a frame's end touches the simulated cloth") {
+  const ClothData d = read_cloth_data(dataset());
+  CHECK(d.num_coarse() == 16);
+  CHECK(d.num_fine() == 49);
+  REQUIRE(d.sequences.size() == 5);
+  CHECK(d.sequences[4].test);
+  CHECK_FALSE(d.sequences[0].test);
+  CHECK(read_cloth_data(dataset(), "test").sequences.size() == 1);
+  for (const auto& s : d.sequences) {
+    CHECK(s.fine.size() == s.coarse.size());
+    // the simulation kept the fine cloth outside the obstacle, and touched it: the rebuilt
+    // obstacle (time (f+1)·dt) must agree to the contact's few millimetres
+    double closest = 1e9;
+    for (Index f = 0; f < s.num_frames(); ++f)
+      d.with_obstacle(s.index, f, [&](const auto& o) {
+        for (Index i = 0; i < d.num_fine(); ++i) closest = std::min(closest, o.distance(Vec3<>(s.fine[std::size_t(f)].row(i).transpose())));
+      });
+    CHECK(closest > -0.005);
+    CHECK(closest < 0.02);
+  }
+  // one frame later the obstacle would be inside the cloth: the check above can tell the timing
+  double later = 1e9;
+  for (const auto& s : d.sequences)
+    for (Index f = 0; f < s.num_frames(); ++f) {
+      const auto o = d.sheet[std::size_t(s.index)].obstacle_at(double(f + 2) * d.frame_time);
+      for (Index i = 0; i < d.num_fine(); ++i) later = std::min(later, o.distance(Vec3<>(s.fine[std::size_t(f)].row(i).transpose())));
+    }
+  CHECK(later < -0.01);
+  test::ScratchDir empty("simsr_test_cloth_synthesis_empty");
+  CHECK(test::typed_error_of<ParseError>([&] { read_cloth_data(empty.path); }).find("cloth_data.json") != std::string::npos);
+}
+
+TEST_CASE("ClothSynthesis: training lowers the loss; a killed run resumes bitwise; another run is refused; the evaluation's figures") {
+  const ClothData d = read_cloth_data(dataset());
+  test::ScratchDir state("simsr_test_cloth_synthesis_state");
+  const auto ckpt = state.path / "train.npz";
+  DetailSynthesisOptions net;
+  net.lr_step = 1000;
+
+  ClothSynthesis whole(exec::seq, d, net, 3);
+  const auto h = whole.train(exec::seq, {.epochs = 12, .batch = 8});
+  REQUIRE(h.size() == 12);
+  CHECK(h.back().loss.synthesis < 0.6 * h.front().loss.synthesis);
+  CHECK(h.back().loss.reconstruction < 0.6 * h.front().loss.reconstruction);
+
+  ClothSynthesis killed(exec::seq, d, net, 3);
+  killed.train(exec::seq, {.epochs = 6, .batch = 8, .checkpoint = ckpt});
+  ClothSynthesis resumed(exec::seq, d, net, 3);
+  const auto hr = resumed.train(exec::seq, {.epochs = 12, .batch = 8, .checkpoint = ckpt});
+  REQUIRE(hr.size() == 12);
+  CHECK(hr.back().loss.synthesis == h.back().loss.synthesis);
+  CHECK(resumed.network().store().values() == whole.network().store().values());
+  ClothSynthesis other(exec::seq, d, net, 3);
+  CHECK(test::typed_error_of<ArgumentError>([&] { other.train(exec::seq, {.epochs = 12, .batch = 4, .checkpoint = ckpt}); }).find("another run") !=
+        std::string::npos);
+
+  // the evaluation's figures are the held-out sequence's, as computed here from synthesize()
+  const ClothEvaluation ev = whole.evaluate(exec::seq);
+  REQUIRE(ev.sequences.size() == 1);
+  const auto& t = d.sequences[4];
+  CHECK(ev.frames == t.num_frames());
+  std::vector<Points<>> raw;
+  ClothSequenceEvaluation e;
+  const auto refined = whole.synthesize(exec::seq, 4, nullptr, &e, &raw);
+  double a = 0, b = 0, c = 0, fl = 0;
+  TsAcapState<double> truth_state;
+  for (Index f = 0; f < t.num_frames(); ++f) {
+    Points<> pins(d.pair.pinned.size(), 3);
+    for (Index p = 0; p < pins.rows(); ++p) pins.row(p) = t.coarse[std::size_t(f)].row(d.pair.pinned[p]);
+    fl += (whole.fine_acap().decode_anchored(exec::seq, whole.fine_acap().encode(exec::seq, t.fine[std::size_t(f)], truth_state), pins) -
+           t.fine[std::size_t(f)]).squaredNorm();
+    a += (d.pair.subdivision * t.coarse[std::size_t(f)] - t.fine[std::size_t(f)]).squaredNorm();
+    b += (raw[std::size_t(f)] - t.fine[std::size_t(f)]).squaredNorm();
+    c += (refined[std::size_t(f)] - t.fine[std::size_t(f)]).squaredNorm();
+    // the pinned corners are where the coarse frame has them
+    for (Index p = 0; p < d.pair.pinned.size(); ++p)
+      CHECK((raw[std::size_t(f)].row(d.pair.pinned[p]) - t.coarse[std::size_t(f)].row(d.pair.pinned[p])).norm() < 1e-12);
+    // refinement left nothing inside the obstacle
+    d.with_obstacle(t.index, f, [&](const auto& o) {
+      for (Index i = 0; i < d.num_fine(); ++i) CHECK(o.distance(Vec3<>(refined[std::size_t(f)].row(i).transpose())) > -1e-9);
+    });
+  }
+  const double n = double(t.num_frames() * d.num_fine());
+  CHECK(ev.subdivided_rmse == doctest::Approx(std::sqrt(a / n)).epsilon(1e-9));
+  CHECK(ev.synthesized_rmse == doctest::Approx(std::sqrt(b / n)).epsilon(1e-6));
+  CHECK(ev.refined_rmse == doctest::Approx(std::sqrt(c / n)).epsilon(1e-6));
+  CHECK(ev.decoded_truth_rmse == doctest::Approx(std::sqrt(fl / n)).epsilon(1e-9));
+  CHECK(ev.decoded_truth_rmse < ev.subdivided_rmse);  // the features carry more than subdivision
+  CHECK(ev.sequences[0].inside_before == e.inside_before);
+  // every training frame's features were counted (fine: training sequences only)
+  Index train_frames = 0, all_frames = 0;
+  for (const auto& q : d.sequences) all_frames += q.num_frames(), train_frames += q.test ? 0 : q.num_frames();
+  CHECK(whole.feature_jumps().coarse_vertex_frames == all_frames * 16);
+  CHECK(whole.feature_jumps().fine_vertex_frames == train_frames * 49);
+  CHECK(ev.timings.ts_acap > 0);
+  CHECK(ev.timings.synthesis > 0);
+  MESSAGE("held out (12 epochs): subdivided ", ev.subdivided_rmse, " m, synthesized ", ev.synthesized_rmse, " m, refined ", ev.refined_rmse,
+          " m, true features decoded ", ev.decoded_truth_rmse, " m");
+}
+
+TEST_CASE("FeatureJumps: counts rotation-vector jumps beyond pi in time and across edges, nothing below") {
+  Edges E(3, 2);
+  E << 0, 1, 1, 2, 0, 2;
+  std::vector<TsAcapFeatures<double>> seq(3, rest_features(3));
+  seq[1](0, 0) = 3.0;  // vertex 0 turns 3 rad about x: below pi from frame 0, and from its neighbours
+  seq[2](0, 0) = 3.0 - 2 * std::numbers::pi;  // the same rotation one cycle down: a 2π jump in time and across both its edges
+  seq[2](1, 1) = 0.5;
+  FeatureJumps j;
+  j.add(seq, E, false);
+  CHECK(j.fine_temporal == 1);
+  CHECK(j.fine_spatial == 2);
+  CHECK(j.fine_vertex_frames == 9);
+  CHECK(j.fine_edge_frames == 9);
+  CHECK(j.fine_largest_angle == doctest::Approx(2 * std::numbers::pi - 3.0));
+  CHECK(j.coarse_temporal + j.coarse_spatial == 0);
+}
+
+}  // namespace shell_test_cloth_synthesis
