@@ -41,7 +41,7 @@ def main():
     if a.methods:
         methods = [m for m in a.methods.split(",") if m]
     else:
-        order = ["embedded", "idw", "rbf", "mls", "ridge", "beta_vae", "network"]
+        order = ["embedded", "idw", "rbf", "mls", "ridge", "beta_vae", "network", "subdivided", "synthesized", "refined"]
         found = [f[:-4] for f in os.listdir(a.folder)
                  if f.endswith(".vtu") and f not in ("lr_input.vtu", "truth.vtu", a.reference + ".vtu") and not f.startswith("rest_")]
         methods = sorted(found, key=lambda m: (order.index(m) if m in order else len(order), m))

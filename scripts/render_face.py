@@ -65,7 +65,7 @@ def label_and_frame(ren, title, centre, height, view="front"):
     cam = ren.GetActiveCamera()
     cam.SetFocalPoint(*centre)
     if view == "oblique":
-        cam.SetPosition(centre[0] + 1.1 * height, centre[1] - 1.6 * height, centre[2] + 1.2 * height)
+        cam.SetPosition(centre[0] + 1.5 * height, centre[1] - 2.2 * height, centre[2] + 1.6 * height)
         cam.SetViewUp(0, 0, 1)
     else:
         cam.SetPosition(centre[0] + 0.35 * height, centre[1] + 0.1 * height, centre[2] + 2.2 * height)
