@@ -11,7 +11,7 @@
 ///
 /// Training, per window of T consecutive frames s..s+T−1 of one sequence (the supplement prints
 /// no loss; these are the terms an encoder–transformer–decoder needs):
-///   L = ‖D(ẑ) − f‖² + ‖D(E_f(f)) − f‖² + ‖ẑ − sg(E_f(f))‖²   (means over entries)
+///   L = ‖D(ẑ) − f‖² + ‖D(E_f(f)) − f‖² + ‖ẑ − sg(E_f(f))‖² / sg(‖E_f(f)‖²)   (means over entries)
 /// with f the fine features of the window (normalized), ẑ = Transformer(E_c(c + n), E_f(f shifted
 /// by one frame)) and n ~ N(0, 0.001) the supplement's noise on the coarse inputs (variance
 /// 0.001). The second term makes D the decoder of E_f's latent space (so the fine latents fed back
@@ -198,10 +198,13 @@ class DetailSynthesisNet {
 
     SynthesisLoss loss;
     const double nz = double(z_hat_.size()), nf = double(target_.size());
-    // ‖ẑ − sg(z)‖²
+    // ‖ẑ − sg(z)‖² / sg(mean z²): relative to the latents' own scale, which nothing else fixes
+    // (the decoder takes any scale; on SHEET at 81 / 1,089 vertices the absolute term grew to
+    // ~2,000 in 5 epochs and its gradient swamped the synthesis term's)
     d_z_hat_ = z_hat_ - z_target_;
-    loss.latent = double(d_z_hat_.squaredNorm()) / nz;
-    d_z_hat_ *= S(2.0 / nz);
+    const double scale = double(z_target_.squaredNorm()) / nz + 1e-12;
+    loss.latent = double(d_z_hat_.squaredNorm()) / nz / scale;
+    d_z_hat_ *= S(2.0 / nz / scale);
     // ‖D(E_f(f)) − f‖²: gradient into the fine encoder's target rows
     fine_dec_.forward(policy, nn::Mode::train, z_target_, dec_out_);
     d_dec_ = dec_out_ - target_;
