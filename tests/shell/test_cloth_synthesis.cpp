@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <simsr/shell/cloth_datagen.hpp>
+#include <simsr/mesh/generators.hpp>
 #include <simsr/shell/cloth_synthesis.hpp>
 
 #include <numbers>
@@ -136,6 +137,22 @@ TEST_CASE("ClothSynthesis: training lowers the loss; a killed run resumes bitwis
   CHECK(whole.feature_jumps().fine_vertex_frames == train_frames * 49);
   CHECK(ev.timings.ts_acap > 0);
   CHECK(ev.timings.synthesis > 0);
+  // the trained network saved and loaded into a fresh one synthesizes the same features; a model
+  // of another mesh pair, or a file that is no model, is refused
+  const auto model = state.path / "model.npz";
+  whole.network().save(model);
+  const Adjacency Ac = vertex_adjacency(d.pair.coarse.F, 16), Af = vertex_adjacency(d.pair.fine.F, 49);
+  DetailSynthesisNet<float> loaded(Ac, Af, DetailSynthesisNet<float>::saved_options(model), 99);
+  loaded.load(model);
+  CHECK(loaded.store().values() == whole.network().store().values());
+  CHECK(loaded.fine_scaling().scale == whole.network().fine_scaling().scale);
+  const nn::Matrix<float> coarse_in = whole.network().normalize(std::vector<TsAcapFeatures<double>>(3, rest_features(16)), {}).coarse;
+  CHECK(loaded.synthesize(exec::seq, coarse_in) == whole.network().synthesize(exec::seq, coarse_in));
+  const TriMesh<> sheet4 = square_sheet(1.0, 4);
+  DetailSynthesisNet<float> wrong(vertex_adjacency(sheet4.F, 25), Af, net, 1);
+  CHECK(test::typed_error_of<ArgumentError>([&] { wrong.load(model); }).find("16 / 49") != std::string::npos);
+  CHECK(!test::typed_error_of<ParseError>([&] { loaded.load(ckpt); }).empty());
+
   MESSAGE("held out (12 epochs): subdivided ", ev.subdivided_rmse, " m, synthesized ", ev.synthesized_rmse, " m, refined ", ev.refined_rmse,
           " m, true features decoded ", ev.decoded_truth_rmse, " m");
 }
