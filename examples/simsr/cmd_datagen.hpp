@@ -139,9 +139,7 @@ inline scenario::FaceModelOptions face_model_options(const DatagenArgs& a) {
 inline int datagen_cloth(const DatagenArgs& a) {
   const shell::ClothDataset d = shell::cloth_dataset(a.scenario);
   shell::ClothDatagenOptions o;
-  o.size = shell::default_scene_size(d);
-  if (a.cells > 0) o.size.coarse_cells = a.cells;
-  if (a.levels >= 0) o.size.levels = a.levels;
+  o.size = shell::scene_size(d, a.cells, a.levels);
   o.sequences = a.sequences;
   o.seed = a.seed;
   o.checkpoint_every = a.checkpoint_every;

@@ -47,9 +47,7 @@ int cloth_demo_cmd(DemoArgs& a) {
   if (a.epochs_given->count() > 0) c.training.epochs = a.o.recipe.epochs;
   if (a.seed_given->count() > 0) c.network_seed = c.training.seed = static_cast<std::uint64_t>(a.o.recipe.seed);
   if (a.batch_given->count() > 0) c.training.batch = a.o.recipe.batch_size;
-  c.data.size = shell::default_scene_size(c.scene);
-  if (a.cells > 0) c.data.size.coarse_cells = a.cells;
-  if (a.levels >= 0) c.data.size.levels = a.levels;
+  c.data.size = shell::scene_size(c.scene, a.cells, a.levels);
   const auto report = shell::run_cloth_demo(exec::omp, c, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
   std::cout << shell::cloth_report_text(report) << "report: " << (c.out / "report.json").string() << "; files people open: "
             << (c.out / "results" / "frame_errors.csv").string() << " (per frame), " << (c.out / "results" / "compare").string()

@@ -66,6 +66,12 @@ TEST_CASE("wind_forces: ½ρC_d A |v_n| v_n n per triangle, a third per corner; 
 TEST_CASE("cloth_pair: SHEET 81 / 4,225 and DISK 127 / 7,057 vertices, the fine rest the Loop-subdivided coarse, the pins the same ids") {
   const ClothPair sheet = cloth_pair(ClothDataset::sheet, default_scene_size(ClothDataset::sheet));
   CHECK(sheet.coarse.V.rows() == 81);
+  // the command line's overrides: 0 cells / −1 levels keep the scene's default
+  CHECK(scene_size(ClothDataset::sheet, 0, -1).coarse_cells == 8);
+  CHECK(scene_size(ClothDataset::sheet, 4, -1).coarse_cells == 4);
+  CHECK(scene_size(ClothDataset::sheet, 4, -1).levels == 3);
+  CHECK(scene_size(ClothDataset::disk, 0, 0).levels == 0);
+  CHECK(scene_size(ClothDataset::disk, 0, 0).coarse_cells == 6);
   CHECK(sheet.fine.V.rows() == 4225);
   CHECK(sheet.fine.F.rows() == 8192);
   CHECK((Points<>(sheet.subdivision * sheet.coarse.V) - sheet.fine.V).cwiseAbs().maxCoeff() == 0);

@@ -33,6 +33,7 @@
 #include "../core/fingerprint.hpp"
 #include "../io/npy.hpp"
 #include "adam.hpp"
+#include "adam_state.hpp"
 #include "finite_checks.hpp"
 #include "model_file.hpp"
 #include "shuffle.hpp"
@@ -224,24 +225,12 @@ class Trainer {
   /// NumericalError (nothing written) when a weight, buffer or moment is not finite.
   void save_checkpoint(const std::filesystem::path& path, const ModelData& data) const {
     io::NpzArrays a = model_arrays(*net_, data);  // checks the weights and buffers
-    const std::int64_t ep = epoch_, st = adam_.steps();
+    const std::int64_t ep = epoch_;
     a["train/epoch"] = io::make_npy<std::int64_t>({}, &ep);
-    a["train/adam_step"] = io::make_npy<std::int64_t>({}, &st);
-    const auto& s = adam_.state();
-    for (const auto& e : net_->store().entries()) {
-      if (e.kind != TensorEntry::Kind::parameter) continue;
-      std::vector<std::int64_t> shape(e.shape.begin(), e.shape.end());
-      if (s.exp_avg.size() == net_->store().num_parameters()) {
-        a["train/exp_avg/" + e.name] = io::make_npy<S>(shape, s.exp_avg.data() + e.offset);
-        a["train/exp_avg_sq/" + e.name] = io::make_npy<S>(shape, s.exp_avg_sq.data() + e.offset);
-      }
-    }
+    add_adam_state(a, net_->store(), adam_);
     std::ostringstream rng;
     rng << rng_;
     a["train/rng"] = io::make_npy(std::vector<std::string>{rng.str()});
-    for (Index i = 0; i < Index(s.exp_avg.size()); ++i)
-      if (!std::isfinite(double(s.exp_avg[i])) || !std::isfinite(double(s.exp_avg_sq[i])))
-        throw NumericalError("nn::Trainer::save_checkpoint", "Adam's moment " + std::to_string(i), adam_.steps(), double(s.exp_avg[i]));
     a["train/options"] = io::make_npy(std::vector<std::string>{options_json().dump()});
     a["train/data"] = io::make_npy(std::vector<std::string>{data_json().dump()});
     io::write_npz(path, a);
@@ -309,8 +298,7 @@ class Trainer {
     compare_json(differences, "data", json_text(a, file, "train/data"), data_json());
     if (!differences.empty()) throw ArgumentError(file + ": this checkpoint comes from another run; " + differences);
     const std::int64_t epoch = a.at("train/epoch").item<std::int64_t>();
-    typename Adam<S>::State s;
-    s.step = a.at("train/adam_step").item<std::int64_t>();
+    typename Adam<S>::State s = read_adam_state(a, net_->store(), file);
     if (epoch > epochs())
       throw ArgumentError(file + ": the checkpoint has trained " + std::to_string(epoch) + " epochs, more than this run's " + std::to_string(epochs()));
     if (epoch < 0 || s.step < 0 || s.step != epoch * std::int64_t(steps_per_epoch()))
@@ -319,25 +307,6 @@ class Trainer {
     load_state(net_->store(), a);
     net_->parameters_changed();
     epoch_ = Index(epoch);
-    if (s.step > 0) {
-      const Index n = net_->store().num_parameters();
-      s.exp_avg.setZero(n);
-      s.exp_avg_sq.setZero(n);
-      for (const auto& e : net_->store().entries()) {
-        if (e.kind != TensorEntry::Kind::parameter) continue;
-        for (const auto& key : {"train/exp_avg/" + e.name, "train/exp_avg_sq/" + e.name})
-          if (!a.contains(key)) throw ArgumentError(file + ": the checkpoint has no optimizer state '" + key + "'");
-        const auto m = a.at("train/exp_avg/" + e.name).template to_vector<S>();
-        const auto v = a.at("train/exp_avg_sq/" + e.name).template to_vector<S>();
-        if (Index(m.size()) != e.size || Index(v.size()) != e.size)
-          throw ShapeError(file + ": optimizer state of '" + e.name + "'", {e.size}, {Index(m.size())});
-        for (std::size_t i = 0; i < m.size(); ++i)
-          if (!std::isfinite(double(m[i])) || !std::isfinite(double(v[i])))
-            throw ArgumentError(file + ": optimizer state of '" + e.name + "' entry " + std::to_string(i) + " is not finite");
-        std::copy(m.begin(), m.end(), s.exp_avg.data() + e.offset);
-        std::copy(v.begin(), v.end(), s.exp_avg_sq.data() + e.offset);
-      }
-    }
     adam_.load_state(std::move(s));
     std::istringstream rng(a.at("train/rng").to_strings().at(0));
     rng >> rng_;

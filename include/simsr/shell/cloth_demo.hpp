@@ -80,25 +80,12 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   run.network().save(net_dir / "model.npz");
 
   tell("evaluate: the held-out sequences from their coarse frames");
-  const ClothEvaluation e = run.evaluate(policy);
-
-  // per-frame errors and the middle frame of each held-out sequence as meshes
-  std::ostringstream csv;
-  csv.precision(17);
-  csv << "sequence,frame,subdivided_m,synthesized_m,refined_m\n";
-  for (const auto& s : e.sequences)
-    for (Index f = 0; f < s.frames; ++f)
-      csv << s.name << ',' << f << ',' << s.frame_subdivided[std::size_t(f)] << ',' << s.frame_synthesized[std::size_t(f)] << ','
-          << s.frame_refined[std::size_t(f)] << '\n';
-  io::write_file_atomic(results / "frame_errors.csv", csv.str());
-  // Fig.-6-style views of each held-out sequence's frame where the subdivided mesh errs most
-  for (std::size_t q = 0, k = 0; q < data.sequences.size(); ++q) {
-    const ClothSequenceFrames& s = data.sequences[q];
-    if (!s.test) continue;
-    const ClothSequenceEvaluation& ev = e.sequences[k++];
+  // Fig.-6-style views of each held-out sequence's frame where the subdivided mesh errs most,
+  // written from the frames the evaluation synthesized
+  const ClothEvaluation e = run.evaluate(policy, [&](Index q, const std::vector<Points<>>& raw, const std::vector<Points<>>& refined,
+                                                     const ClothSequenceEvaluation& ev) {
+    const ClothSequenceFrames& s = data.sequences[std::size_t(q)];
     const auto worst = std::size_t(std::max_element(ev.frame_subdivided.begin(), ev.frame_subdivided.end()) - ev.frame_subdivided.begin());
-    std::vector<Points<>> raw;
-    const std::vector<Points<>> refined = run.synthesize(policy, Index(q), nullptr, nullptr, &raw);
     const auto dir = results / "compare" / (s.name + "_" + std::to_string(worst));
     std::filesystem::create_directories(dir);
     io::VtuGrid lr;
@@ -115,7 +102,16 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
     view("subdivided", Points<>(data.pair.subdivision * s.coarse[worst]));
     view("synthesized", raw[worst]);
     view("refined", refined[worst]);
-  }
+  });
+
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "sequence,frame,subdivided_m,synthesized_m,refined_m\n";
+  for (const auto& s : e.sequences)
+    for (Index f = 0; f < s.frames; ++f)
+      csv << s.name << ',' << f << ',' << s.frame_subdivided[std::size_t(f)] << ',' << s.frame_synthesized[std::size_t(f)] << ','
+          << s.frame_refined[std::size_t(f)] << '\n';
+  io::write_file_atomic(results / "frame_errors.csv", csv.str());
 
   // the simulation's cost per frame, from the dataset's summary (frames simulated in any run)
   const nlohmann::json summary = nlohmann::json::parse(io::read_text_file(data_dir / "cloth_data.json"));
@@ -142,10 +138,11 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
                     {"deepest_before_m", s.deepest_before}, {"deepest_after_m", s.deepest_after}});
   r["sequences"] = seqs;
   const FeatureJumps& j = run.feature_jumps();
-  r["feature_jumps"] = {{"coarse_temporal", j.coarse_temporal}, {"coarse_spatial", j.coarse_spatial}, {"fine_temporal", j.fine_temporal},
-                        {"fine_spatial", j.fine_spatial}, {"coarse_vertex_frames", j.coarse_vertex_frames}, {"coarse_edge_frames", j.coarse_edge_frames},
-                        {"fine_vertex_frames", j.fine_vertex_frames}, {"fine_edge_frames", j.fine_edge_frames},
-                        {"coarse_largest_angle_rad", j.coarse_largest_angle}, {"fine_largest_angle_rad", j.fine_largest_angle}};
+  auto counts = [](const FeatureJumps::Counts& c) {
+    return nlohmann::ordered_json{{"temporal", c.temporal}, {"spatial", c.spatial}, {"vertex_frames", c.vertex_frames},
+                                  {"edge_frames", c.edge_frames}, {"largest_angle_rad", c.largest_angle}};
+  };
+  r["feature_jumps"] = {{"coarse", counts(j.coarse)}, {"fine", counts(j.fine)}};
   nlohmann::ordered_json tt{{"ts_acap_extraction", e.timings.ts_acap}, {"synthesis", e.timings.synthesis}, {"collision_refinement", e.timings.refinement}};
   if (weight > 0) {
     tt["coarse_simulation"] = coarse_s / weight;
@@ -175,8 +172,9 @@ inline std::string cloth_report_text(const nlohmann::ordered_json& r) {
   }
   const auto& j = r.at("feature_jumps");
   std::snprintf(buf, sizeof buf, "\nrotation-feature jumps > pi (the integer steps' misses): coarse %lld temporal / %lld spatial, fine %lld / %lld (largest |angle| %.2f rad)\n",
-                (long long)j.at("coarse_temporal").get<Index>(), (long long)j.at("coarse_spatial").get<Index>(), (long long)j.at("fine_temporal").get<Index>(),
-                (long long)j.at("fine_spatial").get<Index>(), j.at("fine_largest_angle_rad").get<double>());
+                (long long)j.at("coarse").at("temporal").get<Index>(), (long long)j.at("coarse").at("spatial").get<Index>(),
+                (long long)j.at("fine").at("temporal").get<Index>(), (long long)j.at("fine").at("spatial").get<Index>(),
+                j.at("fine").at("largest_angle_rad").get<double>());
   s += buf;
   s += "\nseconds per frame (Table 1's stages)\n";
   for (const auto& [k, v] : r.at("seconds_per_frame").items()) {

@@ -65,6 +65,15 @@ struct ClothSceneSize {
 /// The default size of a dataset (the paper's SHEET counts; DISK's nearest ring count).
 inline ClothSceneSize default_scene_size(ClothDataset d) { return d == ClothDataset::sheet ? ClothSceneSize{8, 3} : ClothSceneSize{6, 3}; }
 
+/// The scene's default size with a user's overrides: `cells` when > 0, `levels` when >= 0 (the
+/// command line's --cells / --levels, where 0 / −1 mean "the default").
+inline ClothSceneSize scene_size(ClothDataset d, Index cells, Index levels) {
+  ClothSceneSize s = default_scene_size(d);
+  if (cells > 0) s.coarse_cells = cells;
+  if (levels >= 0) s.levels = levels;
+  return s;
+}
+
 /// The scene's two meshes (see the file comment). ArgumentError for fewer than 2 cells (SHEET),
 /// 2 rings (DISK) or a negative level count.
 inline ClothPair cloth_pair(ClothDataset d, ClothSceneSize size) {

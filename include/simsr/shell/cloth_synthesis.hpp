@@ -20,6 +20,7 @@
 
 #include "../core/fingerprint.hpp"
 #include "../io/run_file.hpp"
+#include "../nn/adam_state.hpp"
 #include "cloth_data.hpp"
 #include "collision_refinement.hpp"
 #include "detail_synthesis.hpp"
@@ -74,24 +75,26 @@ struct ClothEvaluation {
 /// mesh, but the network must learn a discontinuity. This is what replacing CoMISo's solver by
 /// propagation + local improvement can cost; 0 means nothing.
 struct FeatureJumps {
-  Index coarse_temporal = 0, coarse_spatial = 0, fine_temporal = 0, fine_spatial = 0;
-  Index coarse_vertex_frames = 0, coarse_edge_frames = 0, fine_vertex_frames = 0, fine_edge_frames = 0;
-  double coarse_largest_angle = 0, fine_largest_angle = 0;  ///< the largest |Φ| met (rad)
+  /// One resolution's counts over every frame added.
+  struct Counts {
+    Index temporal = 0, spatial = 0;        ///< vertex-frames / edge-frames with a jump > π
+    Index vertex_frames = 0, edge_frames = 0;
+    double largest_angle = 0;               ///< the largest |Φ| met (rad)
 
-  void add(const std::vector<TsAcapFeatures<double>>& seq, const Edges& edges, bool coarse) {
-    constexpr double pi = std::numbers::pi;
-    Index& temporal = coarse ? coarse_temporal : fine_temporal;
-    Index& spatial = coarse ? coarse_spatial : fine_spatial;
-    for (std::size_t f = 0; f < seq.size(); ++f) {
-      const auto rho = seq[f].leftCols<3>();
-      for (Index e = 0; e < edges.rows(); ++e) spatial += (rho.row(edges(e, 0)) - rho.row(edges(e, 1))).norm() > pi;
-      if (f > 0) temporal += ((rho - seq[f - 1].leftCols<3>()).rowwise().norm().array() > pi).count();
-      double& largest = coarse ? coarse_largest_angle : fine_largest_angle;
-      largest = std::max(largest, rho.rowwise().norm().maxCoeff());
-      (coarse ? coarse_vertex_frames : fine_vertex_frames) += rho.rows();
-      (coarse ? coarse_edge_frames : fine_edge_frames) += edges.rows();
+    /// Counts a sequence's features (its frames in order) over the mesh's unique edges.
+    void add(const std::vector<TsAcapFeatures<double>>& seq, const Edges& edges) {
+      constexpr double pi = std::numbers::pi;
+      for (std::size_t f = 0; f < seq.size(); ++f) {
+        const auto rho = seq[f].leftCols<3>();
+        for (Index e = 0; e < edges.rows(); ++e) spatial += (rho.row(edges(e, 0)) - rho.row(edges(e, 1))).norm() > pi;
+        if (f > 0) temporal += ((rho - seq[f - 1].leftCols<3>()).rowwise().norm().array() > pi).count();
+        largest_angle = std::max(largest_angle, rho.rowwise().norm().maxCoeff());
+        vertex_frames += rho.rows();
+        edge_frames += edges.rows();
+      }
     }
-  }
+  };
+  Counts coarse, fine;
 };
 
 namespace detail {
@@ -130,11 +133,10 @@ class ClothSynthesis {
         for (const auto& f : fine[q]) train_f.push_back(&f);
       }
     if (train_c.empty()) throw ArgumentError("ClothSynthesis: the dataset has no training sequence");
-    net_.coarse_scaling() = FeatureScaling::fit(train_c);
-    net_.fine_scaling() = FeatureScaling::fit(train_f);
+    net_.set_scaling(FeatureScaling::fit(train_c), FeatureScaling::fit(train_f));
     for (std::size_t q = 0; q < data.sequences.size(); ++q) {
-      feature_jumps_.add(coarse[q], coarse_acap_.edges(), true);
-      feature_jumps_.add(fine[q], fine_acap_.edges(), false);
+      feature_jumps_.coarse.add(coarse[q], coarse_acap_.edges());
+      feature_jumps_.fine.add(fine[q], fine_acap_.edges());
       features_.push_back(net_.normalize(coarse[q], fine[q]));
     }
   }
@@ -254,9 +256,14 @@ class ClothSynthesis {
     return fine_acap_.decode(policy, fine, Vec3<>((data_->pair.subdivision * coarse).colwise().mean().transpose()));
   }
 
-  /// Every held-out sequence against its fine simulation (see ClothEvaluation).
+  /// What evaluate() hands on per held-out sequence: its index, the synthesized and the refined
+  /// frames, and its figures (so a caller can write views without synthesizing again).
+  using SequenceSink = std::function<void(Index, const std::vector<Points<>>&, const std::vector<Points<>>&, const ClothSequenceEvaluation&)>;
+
+  /// Every held-out sequence against its fine simulation (see ClothEvaluation); `sink` (optional)
+  /// receives each sequence's frames.
   template <exec::HostPolicy P>
-  ClothEvaluation evaluate(P policy) {
+  ClothEvaluation evaluate(P policy, const SequenceSink& sink = {}) {
     ClothEvaluation e;
     double sub = 0, syn = 0, ref = 0, flo = 0;
     for (std::size_t q = 0; q < data_->sequences.size(); ++q) {
@@ -287,6 +294,7 @@ class ClothSynthesis {
       r.decoded_truth_rmse = std::sqrt(d / double(r.frames));
       sub += a, syn += b, ref += c, flo += d;
       e.frames += r.frames;
+      if (sink) sink(Index(q), raw, refined, r);
       e.sequences.push_back(std::move(r));
     }
     if (e.frames == 0) throw ArgumentError("ClothSynthesis::evaluate: the dataset has no held-out sequence");
@@ -304,11 +312,7 @@ class ClothSynthesis {
   void save_checkpoint(const std::filesystem::path& file, const std::string& print, const std::vector<ClothEpochReport>& history) const {
     io::NpzArrays z;
     nn::add_state(z, net_.store());
-    const auto& st = net_.optimizer().state();
-    const std::int64_t step = st.step;
-    z["train/step"] = io::make_npy<std::int64_t>({}, &step);
-    z["train/exp_avg"] = io::make_npy<float>({st.exp_avg.size()}, st.exp_avg.data());
-    z["train/exp_avg_sq"] = io::make_npy<float>({st.exp_avg_sq.size()}, st.exp_avg_sq.data());
+    nn::add_adam_state(z, net_.store(), net_.optimizer());
     std::vector<double> h;
     for (const auto& r : history) h.insert(h.end(), {r.lr, r.loss.synthesis, r.loss.reconstruction, r.loss.latent, r.seconds});
     z["train/history"] = io::make_npy<double>({std::int64_t(history.size()), 5}, h.data());
@@ -321,12 +325,8 @@ class ClothSynthesis {
     if (io::fingerprint_of(z) != print)
       throw ArgumentError(file.string() + ": a training checkpoint of another run (other data, network or options); remove it to start over");
     nn::load_state(net_.store(), z);
-    typename nn::Adam<float>::State st;
-    st.step = z.at("train/step").to_vector<std::int64_t>().at(0);
-    const auto m = z.at("train/exp_avg").to_vector<float>(), v = z.at("train/exp_avg_sq").to_vector<float>();
-    st.exp_avg = nn::ConstVectorMap<float>(m.data(), Index(m.size()));
-    st.exp_avg_sq = nn::ConstVectorMap<float>(v.data(), Index(v.size()));
-    net_.optimizer().load_state(std::move(st));
+    net_.optimizer().load_state(nn::read_adam_state(z, net_.store(), file.string()));
+    if (!z.contains("train/history")) throw ArgumentError(file.string() + ": the checkpoint has no 'train/history'");
     const auto h = z.at("train/history").to_vector<double>();
     const Index epochs = Index(h.size() / 5);
     for (Index e = 0; e < epochs; ++e) {

@@ -123,6 +123,7 @@ class DetailSynthesisNet {
         fine_dec_(store_, "fine_dec", fine, options.codec, rng_),
         adam_(store_, {.lr = options.lr}) {
     rest_.resize(m_, ts_acap_feature_dim);
+    set_scaling(FeatureScaling{}, FeatureScaling{});
   }
 
   Index num_coarse() const { return n_; }
@@ -131,8 +132,13 @@ class DetailSynthesisNet {
   const DetailSynthesisOptions& options() const { return opt_; }
   nn::ParameterStore<S>& store() { return store_; }
   const nn::ParameterStore<S>& store() const { return store_; }
-  FeatureScaling& coarse_scaling() { return scale_c_; }
-  FeatureScaling& fine_scaling() { return scale_f_; }
+  /// The feature scalings (from the training frames: FeatureScaling::fit); the rest mesh's
+  /// normalized features, the fine input before a sequence's first frame, follow from the fine one.
+  void set_scaling(const FeatureScaling& coarse, const FeatureScaling& fine) {
+    scale_c_ = coarse;
+    scale_f_ = fine;
+    scale_f_.normalize(rest_features(m_), rest_, 0);
+  }
   const FeatureScaling& coarse_scaling() const { return scale_c_; }
   const FeatureScaling& fine_scaling() const { return scale_f_; }
   nn::Adam<S>& optimizer() { return adam_; }
@@ -164,7 +170,6 @@ class DetailSynthesisNet {
   SynthesisLoss train_step(P policy, const std::vector<SequenceFeatures<S>>& seqs, const SynthesisBatch& batch, nn::Rng& rng) {
     const Index T = frames(), B = static_cast<Index>(batch.windows.size());
     if (B == 0) throw ArgumentError("DetailSynthesisNet::train_step: an empty batch");
-    refresh_rest();
     coarse_in_.resize(B * T * n_, ts_acap_feature_dim);
     fine_all_.resize(B * (T + 1) * m_, ts_acap_feature_dim);
     target_.resize(B * T * m_, ts_acap_feature_dim);
@@ -242,7 +247,6 @@ class DetailSynthesisNet {
       throw ShapeError("DetailSynthesisNet::synthesize: coarse features (F·N rows)", {-1, 9}, {coarse.rows(), coarse.cols()});
     const Index F = coarse.rows() / n_;
     if (F < T) throw ArgumentError("DetailSynthesisNet::synthesize: a sequence needs >= " + std::to_string(T) + " frames, got " + std::to_string(F));
-    refresh_rest();
     coarse_enc_.forward(policy, nn::Mode::eval, coarse, zc_);
     fine_enc_.forward(policy, nn::Mode::eval, rest_, zf_);
     nn::Matrix<S> z(F + 1, L);  // row t+1: frame t's fine latent; row 0: the rest mesh's
@@ -281,28 +285,30 @@ class DetailSynthesisNet {
   /// network shape or mesh, ParseError when it is not such a file.
   void load(const std::filesystem::path& file) {
     const io::NpzArrays z = io::read_npz(file);
-    if (!z.contains("config")) throw ParseError(file.string(), 0, "not a detail-synthesis model (no 'config')");
-    const nlohmann::json j = nlohmann::json::parse(z.at("config").to_strings().at(0), nullptr, false);
-    if (j.is_discarded() || j.value("kind", "") != "shell::DetailSynthesisNet")
-      throw ParseError(file.string(), 0, "not a detail-synthesis model");
+    const nlohmann::json j = model_config(z, file);
     if (j.at("coarse_vertices").get<Index>() != n_ || j.at("fine_vertices").get<Index>() != m_)
       throw ArgumentError(file.string() + ": a model of " + std::to_string(j["coarse_vertices"].get<Index>()) + " / " +
                           std::to_string(j["fine_vertices"].get<Index>()) + " vertices, this mesh pair has " + std::to_string(n_) + " / " +
                           std::to_string(m_));
     nn::load_state(store_, z);
-    for (const auto& [name, s] : {std::pair{"coarse", &scale_c_}, std::pair{"fine", &scale_f_}}) {
-      const auto m = z.at(std::string("scaling/") + name + "_mean").template to_vector<double>();
-      const auto c = z.at(std::string("scaling/") + name + "_scale").template to_vector<double>();
+    FeatureScaling sc[2];
+    for (int r = 0; r < 2; ++r) {
+      const std::string name = std::string("scaling/") + (r == 0 ? "coarse" : "fine");
+      if (!z.contains(name + "_mean") || !z.contains(name + "_scale")) throw ParseError(file.string(), 0, "no feature scaling '" + name + "'");
+      const auto m = z.at(name + "_mean").template to_vector<double>();
+      const auto c = z.at(name + "_scale").template to_vector<double>();
       if (m.size() != 9 || c.size() != 9) throw ParseError(file.string(), 0, "feature scaling of the wrong size");
-      for (int k = 0; k < 9; ++k) s->mean[k] = m[std::size_t(k)], s->scale[k] = c[std::size_t(k)];
+      for (int k = 0; k < 9; ++k) {
+        if (!std::isfinite(m[std::size_t(k)]) || !(c[std::size_t(k)] > 0)) throw ParseError(file.string(), 0, "feature scaling '" + name + "' not finite or not positive");
+        sc[r].mean[k] = m[std::size_t(k)], sc[r].scale[k] = c[std::size_t(k)];
+      }
     }
+    set_scaling(sc[0], sc[1]);
   }
 
   /// The options a saved model was built with (so a caller can construct the network to load it).
   static DetailSynthesisOptions saved_options(const std::filesystem::path& file) {
-    const io::NpzArrays z = io::read_npz(file);
-    if (!z.contains("config")) throw ParseError(file.string(), 0, "not a detail-synthesis model (no 'config')");
-    const nlohmann::json j = nlohmann::json::parse(z.at("config").to_strings().at(0));
+    const nlohmann::json j = model_config(io::read_npz(file), file);
     DetailSynthesisOptions o;
     o.codec.latent = j.at("latent").get<Index>();
     o.codec.channels = j.at("channels").get<Index>();
@@ -316,6 +322,15 @@ class DetailSynthesisNet {
   }
 
  private:
+  /// The JSON config of a file save() wrote; ParseError when the file is not such a model.
+  static nlohmann::json model_config(const io::NpzArrays& z, const std::filesystem::path& file) {
+    if (!z.contains("config")) throw ParseError(file.string(), 0, "not a detail-synthesis model (no 'config')");
+    const auto text = z.at("config").to_strings();
+    const nlohmann::json j = text.empty() ? nlohmann::json() : nlohmann::json::parse(text[0], nullptr, false);
+    if (j.is_discarded() || !j.is_object() || j.value("kind", "") != "shell::DetailSynthesisNet")
+      throw ParseError(file.string(), 0, "not a detail-synthesis model");
+    return j;
+  }
   static DetailSynthesisOptions check(DetailSynthesisOptions o) {
     if (o.transformer.latent != o.codec.latent)
       throw ArgumentError("DetailSynthesisNet: the transformer's latent (" + std::to_string(o.transformer.latent) + ") must be the codec's (" +
@@ -323,11 +338,6 @@ class DetailSynthesisNet {
     if (!(o.noise_variance >= 0) || !(o.lr > 0) || !(o.lr_decay > 0) || o.lr_step < 1)
       throw ArgumentError("DetailSynthesisNet: noise_variance >= 0, lr > 0, lr_decay > 0 and lr_step >= 1 are required");
     return o;
-  }
-  void refresh_rest() {
-    nn::Matrix<S> r(m_, ts_acap_feature_dim);
-    scale_f_.normalize(rest_features(m_), r, 0);
-    rest_ = r;
   }
 
   DetailSynthesisOptions opt_;
