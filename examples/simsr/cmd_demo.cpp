@@ -37,6 +37,7 @@ struct DemoArgs {
   CLI::Option* seed_given = nullptr;
   CLI::Option* batch_given = nullptr;
   Index cells = 0, levels = -1;  ///< sheet/disk: 0 / −1 the scene's default
+  std::string fine_target = shell::fine_target_name(shell::DetailSynthesisOptions{}.fine_target);
 };
 
 /// The thin-shell demo (shell/cloth_demo.hpp): progress on stderr, the tables on stdout.
@@ -48,9 +49,10 @@ int cloth_demo_cmd(DemoArgs& a) {
   if (a.seed_given->count() > 0) c.network_seed = c.training.seed = static_cast<std::uint64_t>(a.o.recipe.seed);
   if (a.batch_given->count() > 0) c.training.batch = a.o.recipe.batch_size;
   c.data.size = shell::scene_size(c.scene, a.cells, a.levels);
+  c.network.fine_target = shell::parse_fine_target(a.fine_target);
   const auto report = shell::run_cloth_demo(exec::omp, c, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
   std::cout << shell::cloth_report_text(report) << "report: " << (c.out / "report.json").string() << "; files people open: "
-            << (c.out / "results" / "frame_errors.csv").string() << " (per frame), " << (c.out / "results" / "compare").string()
+            << (c.out / "results" / "frame_errors.csv").string() << " and " << (c.out / "results").string() << "/*_errors.svg (per frame), " << (c.out / "results" / "compare").string()
             << "/*/ (ParaView; scripts/render_comparison.py DIR --out F.png --view oblique)\n";
   return 0;
 }
@@ -90,6 +92,10 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
       ->check(CLI::Range(2, 64));
   cmd->add_option("--levels", a->levels, "sheet/disk: Loop levels from the coarse to the fine cloth (3: the paper's ×64 faces)")
       ->check(CLI::Range(0, 6));
+  cmd->add_option("--fine-target", a->fine_target,
+                  "sheet/disk: what the network's fine side holds: residual (to the subdivided coarse mesh's features) or features (the supplement)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"residual", "features"}));
   cmd->add_option("--preset", a->preset, "face mesh sizes: default, paper-ratio, paper-lr")->capture_default_str();
   cmd->add_option("--frames", o.face.frames, "face: frames per performance")->capture_default_str()->check(CLI::Range(14, 100000));
   cmd->add_option("--train-sequences", o.train_sequences, "face: performances trained on")->delimiter(',')->capture_default_str();

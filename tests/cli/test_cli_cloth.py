@@ -3,7 +3,8 @@
 reduced size (3 cells, one Loop level: 16 / 49 vertices, one sequence), its files, its summary
 and progress lines, a finished run reused, and bad options named; `simsr demo --dataset sheet` at
 the same size (5 sequences, the 5th held out; 3 epochs): its report, per-frame errors and views
-(rendered by scripts/render_comparison.py --view oblique), and a rerun that trains nothing.
+(rendered by scripts/render_comparison.py --view oblique), a rerun that trains nothing, and the
+other --fine-target refused as another run's checkpoint.
 
     /usr/bin/python3 tests/cli/test_cli_cloth.py SIMSR_EXE WORK_DIR
 
@@ -69,7 +70,8 @@ if os.path.exists(os.path.join(demo, "report.json")):
     with open(os.path.join(demo, "report.json")) as f:
         report = json.load(f)
 rm = report.get("rmse_m", {})
-check(all(k in rm and rm[k] > 0 for k in ("subdivided", "synthesized", "synthesized_refined", "decoded_truth")), f"four RMSEs: {rm}")
+check(all(k in rm and rm[k] > 0 for k in ("subdivided", "synthesized", "synthesized_refined", "decoded_truth", "decoded_subdivided")), f"five RMSEs: {rm}")
+check(report.get("fine_target") == "residual", f"the default fine target: {report.get('fine_target')}")
 check(report.get("coarse_vertices") == 16 and report.get("fine_vertices") == 49, "the pair's sizes")
 check(len(report.get("training", [])) == 3, "the training history")
 sec = report.get("seconds_per_frame", {})
@@ -82,6 +84,8 @@ check(test_frames > 0 and len(rows) == test_frames + 1 and all(r.startswith("she
 if len(rows) > 1:
     sub = np.array([float(r.split(",")[2]) for r in rows[1:]])
     check(abs(np.sqrt(np.mean(sub ** 2)) - rm.get("subdivided", 0)) < 1e-9, "the csv and the report agree")
+svg = os.path.join(demo, "results", "sheet_004_errors.svg")
+check(os.path.exists(svg) and open(svg).read().count("<polyline") >= 3, "the held-out sequence's per-frame plot, three series")
 cmp_root = os.path.join(demo, "results", "compare")
 views = sorted(os.listdir(cmp_root)) if os.path.isdir(cmp_root) else []
 check(len(views) == 1 and views[0].startswith("sheet_004_"), f"one view folder for the held-out sequence: {views}")
@@ -98,4 +102,9 @@ check("train: epoch" not in d2.stderr and "data: sheet_" not in d2.stderr, f"a r
 if os.path.exists(os.path.join(demo, "report.json")):
     with open(os.path.join(demo, "report.json")) as f:
         check(json.load(f).get("rmse_m") == rm, "the rerun's figures are the first run's")
+# the other fine target is another run: its checkpoint is refused, not resumed into
+d3 = simsr(*dargs, "--fine-target", "features", expect=1)
+check("another run" in d3.stderr, f"a checkpoint of the other fine target refused: {d3.stderr.strip()[-300:]}")
+bad = simsr(*dargs, "--fine-target", "both", expect=1)
+check("fine-target" in bad.stderr, f"an unknown fine target is named: {bad.stderr.strip()[-200:]}")
 finish()

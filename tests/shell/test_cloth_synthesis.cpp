@@ -73,6 +73,62 @@ TEST_CASE("read_cloth_data: the pair, the split and every frame; the obstacle at
   CHECK(test::typed_error_of<ParseError>([&] { read_cloth_data(empty.path); }).find("cloth_data.json") != std::string::npos);
 }
 
+/// RMS distance to the fine simulation of sequence t's subdivided coarse frames' features decoded
+/// with the pins where the coarse frames have them, computed here from the parts.
+double decoded_subdivided_rmse(const ClothSynthesis& run, const ClothData& d, const ClothSequenceFrames& t) {
+  double sum = 0;
+  TsAcapState<double> state;
+  for (Index f = 0; f < t.num_frames(); ++f) {
+    Points<> pins(d.pair.pinned.size(), 3);
+    for (Index p = 0; p < pins.rows(); ++p) pins.row(p) = t.coarse[std::size_t(f)].row(d.pair.pinned[p]);
+    const Points<> sub = d.pair.subdivision * t.coarse[std::size_t(f)];
+    sum += (run.fine_acap().decode_anchored(exec::seq, run.fine_acap().encode(exec::seq, sub, state), pins) - t.fine[std::size_t(f)]).squaredNorm();
+  }
+  return std::sqrt(sum / double(t.num_frames() * d.num_fine()));
+}
+
+TEST_CASE("ClothSynthesis, residual fine target: a network whose residual is zero gives back the subdivided mesh's features decoded") {
+  const ClothData d = read_cloth_data(dataset());
+  const auto& t = d.sequences[4];
+  for (const FineTarget target : {FineTarget::residual, FineTarget::features}) {
+    CAPTURE(fine_target_name(target));
+    DetailSynthesisOptions o = small_net();
+    o.fine_target = target;
+    ClothSynthesis run(exec::seq, d, o, 5);
+    CHECK(run.residual() == (target == FineTarget::residual));
+    // the decoder's last convolution made constant: its output is the normalized zero residual
+    auto& net = run.network();
+    auto& store = net.store();
+    for (const char* w : {"fine_dec.conv2.point.weight", "fine_dec.conv2.neighbor.weight"})
+      for (float& v : store.values(store.at(w))) v = 0;
+    const auto bias = store.values(store.at("fine_dec.conv2.point.bias"));
+    for (Index c = 0; c < 9; ++c) bias[std::size_t(c)] = float(-net.fine_scaling().mean[c] / net.fine_scaling().scale[c]);
+    std::vector<Points<>> raw;
+    run.synthesize(exec::seq, 4, nullptr, nullptr, &raw);
+    const double expected = decoded_subdivided_rmse(run, d, t);
+    double sum = 0;
+    for (Index f = 0; f < t.num_frames(); ++f) sum += (raw[std::size_t(f)] - t.fine[std::size_t(f)]).squaredNorm();
+    const double synthesized = std::sqrt(sum / double(t.num_frames() * d.num_fine()));
+    if (target == FineTarget::residual) {
+      CHECK(synthesized == doctest::Approx(expected).epsilon(1e-5));  // the residual passes through float
+    } else {
+      // the same zero output as features is a flat rotation-free sheet, far from the subdivided mesh
+      CHECK(std::abs(synthesized - expected) > 0.1 * expected);
+    }
+  }
+  // a model of one fine target is refused by a network of the other
+  test::ScratchDir dir("simsr_test_cloth_synthesis_target");
+  std::filesystem::create_directories(dir.path);
+  DetailSynthesisOptions o = small_net();
+  ClothSynthesis run(exec::seq, d, o, 5);
+  run.network().save(dir.path / "model.npz");
+  CHECK(DetailSynthesisNet<float>::saved_options(dir.path / "model.npz").fine_target == FineTarget::residual);
+  o.fine_target = FineTarget::features;
+  DetailSynthesisNet<float> other(vertex_adjacency(d.pair.coarse.F, 16), vertex_adjacency(d.pair.fine.F, 49), o, 1);
+  CHECK(test::typed_error_of<ArgumentError>([&] { other.load(dir.path / "model.npz"); }).find("'residual'") != std::string::npos);
+  CHECK(test::typed_error_of<ArgumentError>([] { parse_fine_target("residuals"); }).find("residuals") != std::string::npos);
+}
+
 TEST_CASE("ClothSynthesis: training lowers the loss; a killed run resumes bitwise; another run is refused; the evaluation's figures") {
   const ClothData d = read_cloth_data(dataset());
   test::ScratchDir state("simsr_test_cloth_synthesis_state");
@@ -129,6 +185,7 @@ TEST_CASE("ClothSynthesis: training lowers the loss; a killed run resumes bitwis
   CHECK(ev.refined_rmse == doctest::Approx(std::sqrt(c / n)).epsilon(1e-6));
   CHECK(ev.decoded_truth_rmse == doctest::Approx(std::sqrt(fl / n)).epsilon(1e-9));
   CHECK(ev.decoded_truth_rmse < ev.subdivided_rmse);  // the features carry more than subdivision
+  CHECK(ev.decoded_subdivided_rmse == doctest::Approx(decoded_subdivided_rmse(whole, d, t)).epsilon(1e-9));
   CHECK(ev.sequences[0].inside_before == e.inside_before);
   // every training frame's features were counted (fine: training sequences only)
   Index train_frames = 0, all_frames = 0;

@@ -9,6 +9,7 @@
 ///   OUT/network/model.npz         the trained network (DetailSynthesisNet::save)
 ///   OUT/network/train.npz         the training checkpoint
 ///   OUT/results/frame_errors.csv  per held-out frame: RMS distance of subdivided / synthesized / refined
+///   OUT/results/<seq>_errors.svg  the same per held-out sequence as a plot (any browser)
 ///   OUT/results/compare/<seq>_<f>/  lr_input.vtu (coarse), subdivided / synthesized / refined.vtu
 ///                                 with their per-vertex `error` (m), truth.vtu: each held-out
 ///                                 sequence's frame where subdivision errs most (ParaView;
@@ -24,6 +25,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../eval/report.hpp"
 #include "../io/atomic_file.hpp"
 #include "../io/vtu.hpp"
 #include "cloth_datagen.hpp"
@@ -85,6 +87,9 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   const ClothEvaluation e = run.evaluate(policy, [&](Index q, const std::vector<Points<>>& raw, const std::vector<Points<>>& refined,
                                                      const ClothSequenceEvaluation& ev) {
     const ClothSequenceFrames& s = data.sequences[std::size_t(q)];
+    eval::write_svg_plot(results / (s.name + "_errors.svg"),
+                         {{"subdivided", ev.frame_subdivided}, {"synthesized", ev.frame_synthesized}, {"refined", ev.frame_refined}},
+                         s.name + ": RMS distance to the fine simulation per frame", "RMS distance (m)");
     const auto worst = std::size_t(std::max_element(ev.frame_subdivided.begin(), ev.frame_subdivided.end()) - ev.frame_subdivided.begin());
     const auto dir = results / "compare" / (s.name + "_" + std::to_string(worst));
     std::filesystem::create_directories(dir);
@@ -130,11 +135,13 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   r["fine_vertices"] = data.num_fine();
   r["test_frames"] = e.frames;
   r["rmse_m"] = {{"subdivided", e.subdivided_rmse}, {"synthesized", e.synthesized_rmse}, {"synthesized_refined", e.refined_rmse},
-                  {"decoded_truth", e.decoded_truth_rmse}};
+                  {"decoded_truth", e.decoded_truth_rmse}, {"decoded_subdivided", e.decoded_subdivided_rmse}};
+  r["fine_target"] = fine_target_name(o.network.fine_target);
   nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
   for (const auto& s : e.sequences)
     seqs.push_back({{"name", s.name}, {"frames", s.frames}, {"subdivided_m", s.subdivided_rmse}, {"synthesized_m", s.synthesized_rmse},
-                    {"refined_m", s.refined_rmse}, {"decoded_truth_m", s.decoded_truth_rmse}, {"inside_before_vertex_frames", s.inside_before}, {"projected_vertex_frames", s.projected},
+                    {"refined_m", s.refined_rmse}, {"decoded_truth_m", s.decoded_truth_rmse},
+                    {"decoded_subdivided_m", s.decoded_subdivided_rmse}, {"inside_before_vertex_frames", s.inside_before}, {"projected_vertex_frames", s.projected},
                     {"deepest_before_m", s.deepest_before}, {"deepest_after_m", s.deepest_after}});
   r["sequences"] = seqs;
   const FeatureJumps& j = run.feature_jumps();
@@ -165,8 +172,10 @@ inline std::string cloth_report_text(const nlohmann::ordered_json& r) {
   std::snprintf(buf, sizeof buf, "%s: %lld coarse / %lld fine vertices, %lld held-out frames\n\n", r.at("scene").get<std::string>().c_str(),
                 (long long)r.at("coarse_vertices").get<Index>(), (long long)r.at("fine_vertices").get<Index>(), (long long)r.at("test_frames").get<Index>());
   s += buf;
-  s += "RMSE to the fine simulation (m; decoded_truth: the true fine features decoded, the features' floor)\n";
-  for (const char* k : {"subdivided", "synthesized", "synthesized_refined", "decoded_truth"}) {
+  s += "RMSE to the fine simulation (m; network's fine side: " + r.at("fine_target").get<std::string>() +
+       "; decoded_truth: the true fine features decoded, the features' floor; decoded_subdivided: the subdivided mesh's features "
+       "decoded, a residual network's start)\n";
+  for (const char* k : {"subdivided", "synthesized", "synthesized_refined", "decoded_truth", "decoded_subdivided"}) {
     std::snprintf(buf, sizeof buf, "  %-22s %.5f\n", k, r.at("rmse_m").at(k).get<double>());
     s += buf;
   }

@@ -49,6 +49,9 @@ struct ClothSequenceEvaluation {
   double synthesized_rmse = 0;  ///< the network's, before collision refinement
   double refined_rmse = 0;      ///< after it
   double decoded_truth_rmse = 0;  ///< the true fine features decoded the same way: the representation's floor
+  /// the subdivided coarse mesh's features decoded the same way: what a residual network that
+  /// outputs zero gives (it differs from subdivided_rmse by what the decoding moves)
+  double decoded_subdivided_rmse = 0;
   Index inside_before = 0, projected = 0;  ///< vertex-frames inside the obstacle before; left to projection
   double deepest_before = 0, deepest_after = 0;
   std::vector<double> frame_subdivided, frame_synthesized, frame_refined;  ///< per-frame RMS distances
@@ -64,7 +67,7 @@ struct ClothTimings {
 struct ClothEvaluation {
   std::vector<ClothSequenceEvaluation> sequences;
   double subdivided_rmse = 0, synthesized_rmse = 0, refined_rmse = 0;  ///< over all held-out vertex-frames
-  double decoded_truth_rmse = 0;
+  double decoded_truth_rmse = 0, decoded_subdivided_rmse = 0;
   ClothTimings timings;
   Index frames = 0;
 };
@@ -119,12 +122,23 @@ class ClothSynthesis {
     // the pinned vertices (the fine mesh's first vertices are the coarse ones: Loop keeps them)
     // anchor the Poisson solve; where a scene pins none, the subdivided coarse centroid places it
     if (data.pair.pinned.size() > 0) fine_acap_.set_anchors(data.pair.pinned);
-    // TS-ACAP of every frame; the scaling from the training sequences; normalized float copies
+    // TS-ACAP of every frame (the fine side of the training sequences only, as the residual to
+    // the subdivided coarse frames' features where the network holds residuals); the scaling from
+    // the training sequences; normalized float copies
     std::vector<std::vector<TsAcapFeatures<double>>> coarse, fine;
     std::vector<const TsAcapFeatures<double>*> train_c, train_f;
     for (const auto& s : data.sequences) {
       coarse.push_back(coarse_acap_.encode_sequence(policy, s.coarse));
-      fine.push_back(s.test ? std::vector<TsAcapFeatures<double>>{} : fine_acap_.encode_sequence(policy, s.fine));
+      feature_jumps_.coarse.add(coarse.back(), coarse_acap_.edges());
+      fine.emplace_back();
+      if (!s.test) {
+        fine.back() = fine_acap_.encode_sequence(policy, s.fine);
+        feature_jumps_.fine.add(fine.back(), fine_acap_.edges());
+        if (residual()) {
+          const std::vector<TsAcapFeatures<double>> base = fine_acap_.encode_sequence(policy, subdivided(s.coarse));
+          for (std::size_t f = 0; f < base.size(); ++f) fine.back()[f] -= base[f];
+        }
+      }
       if (on_encode) on_encode(s.name, Index(coarse.size()), Index(data.sequences.size()));
     }
     for (std::size_t q = 0; q < data.sequences.size(); ++q)
@@ -134,11 +148,18 @@ class ClothSynthesis {
       }
     if (train_c.empty()) throw ArgumentError("ClothSynthesis: the dataset has no training sequence");
     net_.set_scaling(FeatureScaling::fit(train_c), FeatureScaling::fit(train_f));
-    for (std::size_t q = 0; q < data.sequences.size(); ++q) {
-      feature_jumps_.coarse.add(coarse[q], coarse_acap_.edges());
-      feature_jumps_.fine.add(fine[q], fine_acap_.edges());
-      features_.push_back(net_.normalize(coarse[q], fine[q]));
-    }
+    for (std::size_t q = 0; q < data.sequences.size(); ++q) features_.push_back(net_.normalize(coarse[q], fine[q]));
+  }
+
+  /// Whether the network's fine side holds residuals to the subdivided coarse mesh's features.
+  bool residual() const { return net_.options().fine_target == FineTarget::residual; }
+
+  /// The coarse frames Loop-subdivided to the fine topology.
+  std::vector<Points<>> subdivided(const std::vector<Points<>>& coarse) const {
+    std::vector<Points<>> out;
+    out.reserve(coarse.size());
+    for (const auto& V : coarse) out.emplace_back(data_->pair.subdivision * V);
+    return out;
   }
 
   /// How smooth the integer steps left the rotation features of the training data (see FeatureJumps).
@@ -155,7 +176,7 @@ class ClothSynthesis {
     f.add(std::int64_t(data_->scene)).add(data_->pair.coarse.F).add(data_->pair.fine.F).add(data_->seed).add(net_.store().num_parameters());
     for (const auto& s : data_->sequences) f.add(s.num_frames()).add(std::int64_t(s.test)).add(s.coarse.front()).add(s.fine.back());
     f.add(o.batch).add(o.seed).add(net_.options().lr).add(net_.options().lr_decay).add(net_.options().lr_step);
-    f.add(net_.options().noise_variance);
+    f.add(net_.options().noise_variance).add(std::int64_t(net_.options().fine_target));
     return f.hex();
   }
 
@@ -210,19 +231,26 @@ class ClothSynthesis {
     using clock = std::chrono::steady_clock;
     const ClothSequenceFrames& s = data_->sequences.at(std::size_t(q));
     const Index F = s.num_frames();
-    // TS-ACAP extraction of the coarse frames, as a new simulation would be read
+    // TS-ACAP extraction of the coarse frames, as a new simulation would be read (and of the
+    // subdivided coarse frames where the network adds residuals to them)
     auto t0 = clock::now();
-    TsAcapState<double> state;
-    std::vector<TsAcapFeatures<double>> coarse;
+    TsAcapState<double> state, base_state;
+    std::vector<TsAcapFeatures<double>> coarse, base;
     coarse.reserve(std::size_t(F));
-    for (const auto& V : s.coarse) coarse.push_back(coarse_acap_.encode(policy, V, state));
+    for (const auto& V : s.coarse) {
+      coarse.push_back(coarse_acap_.encode(policy, V, state));
+      if (residual()) base.push_back(fine_acap_.encode(policy, Points<>(data_->pair.subdivision * V), base_state));
+    }
     auto t1 = clock::now();
     const SequenceFeatures<float> in = net_.normalize(coarse, {});
     const nn::Matrix<float> fine = net_.synthesize(policy, in.coarse);
     std::vector<Points<>> out(static_cast<std::size_t>(F));
     const Index M = data_->num_fine();
-    for (Index f = 0; f < F; ++f)
-      out[std::size_t(f)] = positions(policy, net_.fine_scaling().denormalize<float>(fine.middleRows(f * M, M)), s.coarse[std::size_t(f)]);
+    for (Index f = 0; f < F; ++f) {
+      TsAcapFeatures<double> features = net_.fine_scaling().denormalize<float>(fine.middleRows(f * M, M));
+      if (residual()) features += base[std::size_t(f)];
+      out[std::size_t(f)] = positions(policy, features, s.coarse[std::size_t(f)]);
+    }
     auto t2 = clock::now();
     if (unrefined) *unrefined = out;
     for (Index f = 0; f < F; ++f)
@@ -265,7 +293,7 @@ class ClothSynthesis {
   template <exec::HostPolicy P>
   ClothEvaluation evaluate(P policy, const SequenceSink& sink = {}) {
     ClothEvaluation e;
-    double sub = 0, syn = 0, ref = 0, flo = 0;
+    double sub = 0, syn = 0, ref = 0, flo = 0, dsub = 0;
     for (std::size_t q = 0; q < data_->sequences.size(); ++q) {
       const ClothSequenceFrames& s = data_->sequences[q];
       if (!s.test) continue;
@@ -274,13 +302,15 @@ class ClothSynthesis {
       r.frames = s.num_frames();
       std::vector<Points<>> raw;
       const std::vector<Points<>> refined = synthesize(policy, Index(q), &e.timings, &r, &raw);
-      double a = 0, b = 0, c = 0, d = 0;
-      TsAcapState<double> truth_state;
+      double a = 0, b = 0, c = 0, d = 0, g = 0;
+      TsAcapState<double> truth_state, sub_state;
       for (Index f = 0; f < r.frames; ++f) {
         const Points<>& truth = s.fine[std::size_t(f)];
         const double floor = detail::rms_distance(positions(policy, fine_acap_.encode(policy, truth, truth_state), s.coarse[std::size_t(f)]), truth);
         d += floor * floor;
         const Points<> subdivided = data_->pair.subdivision * s.coarse[std::size_t(f)];
+        const double zero = detail::rms_distance(positions(policy, fine_acap_.encode(policy, subdivided, sub_state), s.coarse[std::size_t(f)]), truth);
+        g += zero * zero;
         r.frame_subdivided.push_back(detail::rms_distance(subdivided, truth));
         r.frame_synthesized.push_back(detail::rms_distance(raw[std::size_t(f)], truth));
         r.frame_refined.push_back(detail::rms_distance(refined[std::size_t(f)], truth));
@@ -292,7 +322,8 @@ class ClothSynthesis {
       r.synthesized_rmse = std::sqrt(b / double(r.frames));
       r.refined_rmse = std::sqrt(c / double(r.frames));
       r.decoded_truth_rmse = std::sqrt(d / double(r.frames));
-      sub += a, syn += b, ref += c, flo += d;
+      r.decoded_subdivided_rmse = std::sqrt(g / double(r.frames));
+      sub += a, syn += b, ref += c, flo += d, dsub += g;
       e.frames += r.frames;
       if (sink) sink(Index(q), raw, refined, r);
       e.sequences.push_back(std::move(r));
@@ -302,6 +333,7 @@ class ClothSynthesis {
     e.synthesized_rmse = std::sqrt(syn / double(e.frames));
     e.refined_rmse = std::sqrt(ref / double(e.frames));
     e.decoded_truth_rmse = std::sqrt(flo / double(e.frames));
+    e.decoded_subdivided_rmse = std::sqrt(dsub / double(e.frames));
     e.timings.ts_acap /= double(e.frames);
     e.timings.synthesis /= double(e.frames);
     e.timings.refinement /= double(e.frames);

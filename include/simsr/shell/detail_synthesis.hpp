@@ -83,6 +83,23 @@ inline TsAcapFeatures<double> rest_features(Index n) {
   return f;
 }
 
+/// What the fine side of the network (the fine encoder's input, the decoder's output) holds.
+enum class FineTarget {
+  features,  ///< the fine TS-ACAP features themselves (the supplement)
+  /// their difference from the TS-ACAP features of the Loop-subdivided coarse frame: a network
+  /// that outputs zero gives back (the Poisson solve of) the subdivided mesh, so what it learns
+  /// is the fine simulation's departure from it, not the whole shape through a 16-d bottleneck
+  residual,
+};
+
+inline const char* fine_target_name(FineTarget t) { return t == FineTarget::residual ? "residual" : "features"; }
+/// ArgumentError for a name other than "features" or "residual".
+inline FineTarget parse_fine_target(const std::string& name) {
+  if (name == "features") return FineTarget::features;
+  if (name == "residual") return FineTarget::residual;
+  throw ArgumentError("fine target '" + name + "': expected 'features' or 'residual'");
+}
+
 struct DetailSynthesisOptions {
   MeshCodecOptions codec;  ///< encoders and decoder: 9 channels, 16-d latent
   DeformTransformerOptions transformer;
@@ -90,6 +107,7 @@ struct DetailSynthesisOptions {
   double lr = 1e-3;               ///< Adam; ×lr_decay every lr_step epochs (supplement §3)
   double lr_decay = 0.1;
   Index lr_step = 20;
+  FineTarget fine_target = FineTarget::residual;  ///< see FineTarget; the README gives both's figures
 };
 
 /// One training batch: `windows` (sequence, first frame) pairs into the sequences' features.
@@ -133,11 +151,13 @@ class DetailSynthesisNet {
   nn::ParameterStore<S>& store() { return store_; }
   const nn::ParameterStore<S>& store() const { return store_; }
   /// The feature scalings (from the training frames: FeatureScaling::fit); the rest mesh's
-  /// normalized features, the fine input before a sequence's first frame, follow from the fine one.
+  /// normalized features, the fine input before a sequence's first frame, follow from the fine one
+  /// (as a residual the rest mesh is zero: the subdivided rest mesh is the fine rest mesh).
   void set_scaling(const FeatureScaling& coarse, const FeatureScaling& fine) {
     scale_c_ = coarse;
     scale_f_ = fine;
-    scale_f_.normalize(rest_features(m_), rest_, 0);
+    if (opt_.fine_target == FineTarget::residual) scale_f_.normalize(TsAcapFeatures<double>::Zero(m_, ts_acap_feature_dim), rest_, 0);
+    else scale_f_.normalize(rest_features(m_), rest_, 0);
   }
   const FeatureScaling& coarse_scaling() const { return scale_c_; }
   const FeatureScaling& fine_scaling() const { return scale_f_; }
@@ -272,7 +292,8 @@ class DetailSynthesisNet {
     nlohmann::json j{{"kind", "shell::DetailSynthesisNet"}, {"coarse_vertices", n_}, {"fine_vertices", m_},
                      {"latent", opt_.codec.latent}, {"channels", opt_.codec.channels}, {"d_model", opt_.transformer.d_model},
                      {"feed_forward", opt_.transformer.feed_forward}, {"heads", opt_.transformer.heads},
-                     {"blocks", opt_.transformer.blocks}, {"frames", opt_.transformer.frames}};
+                     {"blocks", opt_.transformer.blocks}, {"frames", opt_.transformer.frames},
+                     {"fine_target", fine_target_name(opt_.fine_target)}};
     z["config"] = io::make_npy(std::vector<std::string>{j.dump()});
     for (const auto& [name, s] : {std::pair{"coarse", &scale_c_}, std::pair{"fine", &scale_f_}}) {
       z[std::string("scaling/") + name + "_mean"] = io::make_npy<double>({ts_acap_feature_dim}, s->mean.data());
@@ -290,6 +311,9 @@ class DetailSynthesisNet {
       throw ArgumentError(file.string() + ": a model of " + std::to_string(j["coarse_vertices"].get<Index>()) + " / " +
                           std::to_string(j["fine_vertices"].get<Index>()) + " vertices, this mesh pair has " + std::to_string(n_) + " / " +
                           std::to_string(m_));
+    if (const FineTarget t = target_of(j, file); t != opt_.fine_target)
+      throw ArgumentError(file.string() + ": a model whose fine side holds '" + fine_target_name(t) + "', this network's holds '" +
+                          fine_target_name(opt_.fine_target) + "'");
     nn::load_state(store_, z);
     FeatureScaling sc[2];
     for (int r = 0; r < 2; ++r) {
@@ -318,6 +342,7 @@ class DetailSynthesisNet {
     o.transformer.heads = j.at("heads").get<Index>();
     o.transformer.blocks = j.at("blocks").get<Index>();
     o.transformer.frames = j.at("frames").get<Index>();
+    o.fine_target = target_of(j, file);
     return o;
   }
 
@@ -330,6 +355,15 @@ class DetailSynthesisNet {
     if (j.is_discarded() || !j.is_object() || j.value("kind", "") != "shell::DetailSynthesisNet")
       throw ParseError(file.string(), 0, "not a detail-synthesis model");
     return j;
+  }
+  /// A saved model's fine target; files written before the option hold features.
+  static FineTarget target_of(const nlohmann::json& j, const std::filesystem::path& file) {
+    if (!j.contains("fine_target")) return FineTarget::features;
+    try {
+      return parse_fine_target(j.at("fine_target").get<std::string>());
+    } catch (const std::exception& e) {
+      throw ParseError(file.string(), 0, std::string("the model's fine_target: ") + e.what());
+    }
   }
   static DetailSynthesisOptions check(DetailSynthesisOptions o) {
     if (o.transformer.latent != o.codec.latent)
