@@ -50,6 +50,7 @@ int cloth_demo_cmd(DemoArgs& a) {
   if (a.batch_given->count() > 0) c.training.batch = a.o.recipe.batch_size;
   c.data.size = shell::scene_size(c.scene, a.cells, a.levels);
   c.network.fine_target = shell::parse_fine_target(a.fine_target);
+  if (c.baselines == std::vector<std::string>{"none"}) c.baselines.clear();
   const auto report = shell::run_cloth_demo(exec::omp, c, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
   std::cout << shell::cloth_report_text(report) << "report: " << (c.out / "report.json").string() << "; files people open: "
             << (c.out / "results" / "frame_errors.csv").string() << " and " << (c.out / "results").string() << "/*_errors.svg (per frame), " << (c.out / "results" / "compare").string()
@@ -96,6 +97,10 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
                   "sheet/disk: what the network's fine side holds: residual (to the subdivided coarse mesh's features) or features (the supplement)")
       ->capture_default_str()
       ->check(CLI::IsMember({"residual", "features"}));
+  cmd->add_option("--baselines", cl.baselines,
+                  "sheet/disk: the core paper's upsampling methods evaluated beside: local_linear, network (none: neither)")
+      ->delimiter(',')
+      ->capture_default_str();
   cmd->add_option("--preset", a->preset, "face mesh sizes: default, paper-ratio, paper-lr")->capture_default_str();
   cmd->add_option("--frames", o.face.frames, "face: frames per performance")->capture_default_str()->check(CLI::Range(14, 100000));
   cmd->add_option("--train-sequences", o.train_sequences, "face: performances trained on")->delimiter(',')->capture_default_str();

@@ -3,8 +3,9 @@
 reduced size (3 cells, one Loop level: 16 / 49 vertices, one sequence), its files, its summary
 and progress lines, a finished run reused, and bad options named; `simsr demo --dataset sheet` at
 the same size (5 sequences, the 5th held out; 3 epochs): its report, per-frame errors and views
-(rendered by scripts/render_comparison.py --view oblique), a rerun that trains nothing, and the
-other --fine-target refused as another run's checkpoint.
+(rendered by scripts/render_comparison.py --view oblique), the core paper's local-linear map and
+network beside, a rerun that trains nothing, and the other --fine-target refused as another run's
+checkpoint.
 
     /usr/bin/python3 tests/cli/test_cli_cloth.py SIMSR_EXE WORK_DIR
 
@@ -72,6 +73,10 @@ if os.path.exists(os.path.join(demo, "report.json")):
 rm = report.get("rmse_m", {})
 check(all(k in rm and rm[k] > 0 for k in ("subdivided", "synthesized", "synthesized_refined", "decoded_truth", "decoded_subdivided")), f"five RMSEs: {rm}")
 check(report.get("fine_target") == "residual", f"the default fine target: {report.get('fine_target')}")
+check(all(k in rm and rm[k] > 0 for k in ("local_linear", "upsampling_network")), f"the core paper's methods beside: {rm}")
+check(d.stderr.count("baselines: network epoch ") == 8, "the upsampling network's epochs (8) as progress lines")
+seq0 = (report.get("sequences") or [{}])[0]
+check("local_linear_m" in seq0 and "upsampling_network_m" in seq0, f"their per-sequence figures: {seq0}")
 check(report.get("coarse_vertices") == 16 and report.get("fine_vertices") == 49, "the pair's sizes")
 check(len(report.get("training", [])) == 3, "the training history")
 sec = report.get("seconds_per_frame", {})
@@ -98,13 +103,16 @@ if views:
     check(r.returncode == 0 and os.path.exists(png) and os.path.getsize(png) > 1000, f"render_comparison.py --view oblique: {r.stderr.strip()[-300:]}")
 # a rerun: the data reused, the training resumed at its end (no epoch trained), the same figures
 d2 = simsr(*dargs)
-check("train: epoch" not in d2.stderr and "data: sheet_" not in d2.stderr, f"a rerun simulates and trains nothing: {d2.stderr[-300:]}")
+check("train: epoch" not in d2.stderr and "data: sheet_" not in d2.stderr and "network epoch" not in d2.stderr,
+      f"a rerun simulates and trains nothing: {d2.stderr[-300:]}")
 if os.path.exists(os.path.join(demo, "report.json")):
     with open(os.path.join(demo, "report.json")) as f:
         check(json.load(f).get("rmse_m") == rm, "the rerun's figures are the first run's")
 # the other fine target is another run: its checkpoint is refused, not resumed into
 d3 = simsr(*dargs, "--fine-target", "features", expect=1)
 check("another run" in d3.stderr, f"a checkpoint of the other fine target refused: {d3.stderr.strip()[-300:]}")
+bad = simsr(*dargs, "--baselines", "kriging", expect=1)
+check("kriging" in bad.stderr, f"an unknown baseline is named: {bad.stderr.strip()[-200:]}")
 bad = simsr(*dargs, "--fine-target", "both", expect=1)
 check("fine-target" in bad.stderr, f"an unknown fine target is named: {bad.stderr.strip()[-200:]}")
 finish()

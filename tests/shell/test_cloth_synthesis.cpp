@@ -6,6 +6,10 @@
 #include <simsr/shell/cloth_datagen.hpp>
 #include <simsr/mesh/generators.hpp>
 #include <simsr/shell/cloth_synthesis.hpp>
+#include <simsr/shell/cloth_upsampling.hpp>
+#include <simsr/interp/learned.hpp>
+#include <simsr/interp/local_linear.hpp>
+#include <simsr/interp/network_recipe.hpp>
 
 #include <numbers>
 
@@ -212,6 +216,69 @@ TEST_CASE("ClothSynthesis: training lowers the loss; a killed run resumes bitwis
 
   MESSAGE("held out (12 epochs): subdivided ", ev.subdivided_rmse, " m, synthesized ", ev.synthesized_rmse, " m, refined ", ev.refined_rmse,
           " m, true features decoded ", ev.decoded_truth_rmse, " m");
+}
+
+TEST_CASE("evaluate_upsampling: the core paper's methods on a cloth pair, whose LR mesh is a surface") {
+  const ClothData d = read_cloth_data(dataset());
+  auto problem = cloth_upsampling_problem(exec::seq, d, 12, 5);
+  CHECK(problem.lr.T.rows() == 0);
+  // the LR graph runs along the coarse triangles' edges: self first, then a mesh neighbour
+  REQUIRE(problem.lr_graph);
+  const Adjacency A = vertex_adjacency(d.pair.coarse.F, 16);
+  for (Index i = 0; i < 16; ++i) {
+    CHECK((*problem.lr_graph)(i, 0) == i);
+    const auto nb = A[i];
+    CHECK(std::find(nb.begin(), nb.end(), VIndex((*problem.lr_graph)(i, 1))) != nb.end());
+  }
+  const data::PairedFrames<> train = cloth_paired_frames(d, false), test = cloth_paired_frames(d, true);
+  CHECK(train.sequence_names.size() == 4);
+  CHECK(test.num_frames() == d.sequences[4].num_frames());
+  CHECK(test.hr(3) == d.sequences[4].fine[3]);
+
+  // A fine cloth that IS the subdivided coarse one is a linear map of each vertex's few nearest
+  // coarse vertices (Loop's stencil: at most 7, within the 12 geodesically nearest on this grid,
+  // whose diagonal ties would cut 8): the local-linear map learns it exactly from the training
+  // sequences and reproduces the held-out ones
+  ClothData loop = d;
+  for (auto& s : loop.sequences)
+    for (std::size_t f = 0; f < s.coarse.size(); ++f) s.fine[f] = d.pair.subdivision * s.coarse[f];
+  interp::LocalLinear<> exact({.k = 12});
+  const auto e0 = evaluate_upsampling(exec::seq, loop, problem, exact, "local_linear", interp::LocalLinearTrainOptions{.lambda = 1e-12});
+  CHECK(e0.rmse < 1e-6);
+
+  // on the simulated fine cloth: the figures are the per-frame distances of the method's output
+  interp::LocalLinear<> local({.k = 8});
+  const auto e1 = evaluate_upsampling(exec::omp, d, problem, local, "local_linear");
+  REQUIRE(e1.sequences.size() == 1);
+  CHECK(e1.sequences[0].name == d.sequences[4].name);
+  CHECK(e1.frames == d.sequences[4].num_frames());
+  double sum = 0;
+  Points<> hr(49, 3);
+  for (Index f = 0; f < test.num_frames(); ++f) {
+    local.apply(exec::seq, Points<>(test.lr(f) - problem.lr.V), hr);
+    sum += (problem.hr.V + hr - test.hr(f)).squaredNorm();
+  }
+  CHECK(e1.rmse == doctest::Approx(std::sqrt(sum / double(test.num_frames() * 49))).epsilon(1e-9));
+  CHECK(e1.rmse > e0.rmse);
+
+  // the super-resolution network itself: its first EdgeConv reads the graph from the triangles
+  interp::NetworkRecipe recipe;
+  recipe.epochs = 1;
+  recipe.up_k = 8;
+  recipe.residual_base = "local_linear";
+  recipe.displacement_scale = 0;
+  auto cfg = recipe.config(data::displacements(train, problem.lr.V, problem.hr.V));
+  cfg.residual_base_k = 8;
+  interp::Learned<> net(cfg, 1);
+  const auto e2 = evaluate_upsampling(exec::omp, d, problem, net, "network");
+  CHECK(std::isfinite(e2.rmse));
+  CHECK(e2.rmse > 0);
+  CHECK(e2.seconds_per_frame > 0);
+  MESSAGE("held out: local-linear ", e1.rmse, " m, network (1 epoch) ", e2.rmse, " m");
+
+  problem.hr.V.conservativeResize(48, 3);
+  CHECK(test::typed_error_of<ShapeError>([&] { evaluate_upsampling(exec::seq, d, problem, local, "x"); }).find("evaluate_upsampling") !=
+        std::string::npos);
 }
 
 TEST_CASE("FeatureJumps: counts rotation-vector jumps beyond pi in time and across edges, nothing below") {

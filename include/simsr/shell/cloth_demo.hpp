@@ -8,13 +8,15 @@
 ///   OUT/data/                     the dataset (cloth_data.json, <scene>_NNN.npz, rest meshes)
 ///   OUT/network/model.npz         the trained network (DetailSynthesisNet::save)
 ///   OUT/network/train.npz         the training checkpoint
+///   OUT/network/upsampling_network.npz  the core paper's network's checkpoint (the "network" baseline)
 ///   OUT/results/frame_errors.csv  per held-out frame: RMS distance of subdivided / synthesized / refined
 ///   OUT/results/<seq>_errors.svg  the same per held-out sequence as a plot (any browser)
 ///   OUT/results/compare/<seq>_<f>/  lr_input.vtu (coarse), subdivided / synthesized / refined.vtu
 ///                                 with their per-vertex `error` (m), truth.vtu: each held-out
 ///                                 sequence's frame where subdivision errs most (ParaView;
 ///                                 scripts/render_comparison.py --view oblique draws the panel)
-///   OUT/report.json               the RMSE table, the Table 1 timings, the training history
+///   OUT/report.json               the RMSE table (with the core paper's upsampling methods beside:
+///                                 cloth_upsampling.hpp), the Table 1 timings, the training history
 
 #include <algorithm>
 #include <cstdio>
@@ -28,8 +30,12 @@
 #include "../eval/report.hpp"
 #include "../io/atomic_file.hpp"
 #include "../io/vtu.hpp"
+#include "../interp/learned.hpp"
+#include "../interp/local_linear.hpp"
+#include "../interp/network_recipe.hpp"
 #include "cloth_datagen.hpp"
 #include "cloth_synthesis.hpp"
+#include "cloth_upsampling.hpp"
 
 namespace simsr::shell {
 
@@ -40,7 +46,25 @@ struct ClothDemoOptions {
   DetailSynthesisOptions network;      ///< the supplement's sizes by default
   ClothTrainingOptions training;       ///< epochs, batch, seed (the checkpoint is OUT/network/train.npz)
   std::uint64_t network_seed = 1;      ///< the initial weights
+  /// The core paper's upsampling methods evaluated beside (cloth_upsampling.hpp): "local_linear"
+  /// (interp::LocalLinear, λ by leave-one-sequence-out) and "network" (interp::Learned, the face
+  /// demo's recipe: residual over the local-linear map, displacements scaled to unit RMS).
+  std::vector<std::string> baselines = {"local_linear", "network"};
+  Index baseline_k = 20;  ///< their §3.2 upsampling neighbours per fine vertex
+  interp::NetworkRecipe baseline_network = [] {
+    interp::NetworkRecipe r;
+    r.epochs = 8;
+    r.residual_base = "local_linear";
+    r.displacement_scale = 0;
+    return r;
+  }();
 };
+
+/// ArgumentError unless every name is a baseline run_cloth_demo knows.
+inline void check_cloth_baselines(const std::vector<std::string>& names) {
+  for (const auto& b : names)
+    if (b != "local_linear" && b != "network") throw ArgumentError("cloth demo: unknown baseline '" + b + "' (local_linear, network)");
+}
 
 /// Runs the demo (see the file comment); `say` receives progress lines. Returns OUT/report.json.
 template <exec::HostPolicy P>
@@ -48,6 +72,7 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   auto tell = [&](const std::string& s) {
     if (say) say(s);
   };
+  check_cloth_baselines(o.baselines);
   const auto data_dir = o.out / "data", net_dir = o.out / "network", results = o.out / "results";
   std::filesystem::create_directories(net_dir);
   std::filesystem::create_directories(results);
@@ -109,6 +134,35 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
     view("refined", refined[worst]);
   });
 
+  // the core paper's upsampling methods on the same held-out sequences
+  std::vector<ClothUpsamplingEvaluation> baselines;
+  if (!o.baselines.empty()) {
+    tell("baselines: the core paper's upsampling neighbourhoods (k = " + std::to_string(o.baseline_k) + ")");
+    interp::UpsamplingProblem<> problem = cloth_upsampling_problem(policy, data, o.baseline_k);
+    for (const auto& name : o.baselines) {
+      tell("baselines: " + name);
+      if (name == "local_linear") {
+        interp::LocalLinear<> m({.k = o.baseline_k});
+        baselines.push_back(evaluate_upsampling(policy, data, problem, m, name));
+      } else {
+        const data::PairedFrames<> train = data::displacements(cloth_paired_frames(data, false), problem.lr.V, problem.hr.V);
+        nn::NetworkConfig cfg = o.baseline_network.config(train);
+        cfg.residual_base_k = o.baseline_k;
+        interp::Learned<> net(cfg, o.baseline_network.seed);
+        interp::NetworkTrainOptions to;
+        to.trainer.seed = o.baseline_network.seed;
+        to.trainer.lr_decay_epochs = o.baseline_network.lr_decay_epochs;
+        to.trainer.progress = false;
+        to.trainer.on_epoch = [&](const nn::EpochReport& r) {
+          tell("baselines: network epoch " + std::to_string(r.epoch) + "/" + std::to_string(cfg.epochs) + " loss " + std::to_string(r.loss));
+        };
+        to.checkpoint = net_dir / "upsampling_network.npz";
+        if (std::filesystem::exists(to.checkpoint)) to.resume = to.checkpoint;  // refused, naming what differs, when of another run
+        baselines.push_back(evaluate_upsampling(policy, data, problem, net, "upsampling_network", to));
+      }
+    }
+  }
+
   std::ostringstream csv;
   csv.precision(17);
   csv << "sequence,frame,subdivided_m,synthesized_m,refined_m\n";
@@ -136,6 +190,7 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   r["test_frames"] = e.frames;
   r["rmse_m"] = {{"subdivided", e.subdivided_rmse}, {"synthesized", e.synthesized_rmse}, {"synthesized_refined", e.refined_rmse},
                   {"decoded_truth", e.decoded_truth_rmse}, {"decoded_subdivided", e.decoded_subdivided_rmse}};
+  for (const auto& b : baselines) r["rmse_m"][b.method] = b.rmse;
   r["fine_target"] = fine_target_name(o.network.fine_target);
   nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
   for (const auto& s : e.sequences)
@@ -143,7 +198,12 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
                     {"refined_m", s.refined_rmse}, {"decoded_truth_m", s.decoded_truth_rmse},
                     {"decoded_subdivided_m", s.decoded_subdivided_rmse}, {"inside_before_vertex_frames", s.inside_before}, {"projected_vertex_frames", s.projected},
                     {"deepest_before_m", s.deepest_before}, {"deepest_after_m", s.deepest_after}});
+  for (const auto& b : baselines)
+    for (std::size_t q = 0; q < b.sequences.size(); ++q) seqs[q][b.method + "_m"] = b.sequences[q].rmse;
   r["sequences"] = seqs;
+  nlohmann::ordered_json bt = nlohmann::ordered_json::object();
+  for (const auto& b : baselines) bt[b.method] = {{"fit_seconds", b.fit_seconds}, {"seconds_per_frame", b.seconds_per_frame}};
+  r["baseline_timings"] = bt;
   const FeatureJumps& j = run.feature_jumps();
   auto counts = [](const FeatureJumps::Counts& c) {
     return nlohmann::ordered_json{{"temporal", c.temporal}, {"spatial", c.spatial}, {"vertex_frames", c.vertex_frames},
@@ -174,9 +234,9 @@ inline std::string cloth_report_text(const nlohmann::ordered_json& r) {
   s += buf;
   s += "RMSE to the fine simulation (m; network's fine side: " + r.at("fine_target").get<std::string>() +
        "; decoded_truth: the true fine features decoded, the features' floor; decoded_subdivided: the subdivided mesh's features "
-       "decoded, a residual network's start)\n";
-  for (const char* k : {"subdivided", "synthesized", "synthesized_refined", "decoded_truth", "decoded_subdivided"}) {
-    std::snprintf(buf, sizeof buf, "  %-22s %.5f\n", k, r.at("rmse_m").at(k).get<double>());
+       "decoded, a residual network's start; local_linear, upsampling_network: the core paper's methods)\n";
+  for (const auto& [k, v] : r.at("rmse_m").items()) {
+    std::snprintf(buf, sizeof buf, "  %-22s %.5f\n", k.c_str(), v.get<double>());
     s += buf;
   }
   const auto& j = r.at("feature_jumps");
