@@ -50,7 +50,9 @@ struct ClothDemoOptions {
   /// (interp::LocalLinear, λ by leave-one-sequence-out) and "network" (interp::Learned, the face
   /// demo's recipe: residual over the local-linear map, displacements scaled to unit RMS).
   std::vector<std::string> baselines = {"local_linear", "network"};
-  Index baseline_k = 20;  ///< their §3.2 upsampling neighbours per fine vertex
+  /// Their §3.2 upsampling neighbours per fine vertex; 0: 20, or every coarse vertex when the
+  /// cloth has fewer (a reduced scene); a k above the coarse vertex count is an ArgumentError.
+  Index baseline_k = 0;
   interp::NetworkRecipe baseline_network = [] {
     interp::NetworkRecipe r;
     r.epochs = 8;
@@ -137,17 +139,21 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   // the core paper's upsampling methods on the same held-out sequences
   std::vector<ClothUpsamplingEvaluation> baselines;
   if (!o.baselines.empty()) {
-    tell("baselines: the core paper's upsampling neighbourhoods (k = " + std::to_string(o.baseline_k) + ")");
-    interp::UpsamplingProblem<> problem = cloth_upsampling_problem(policy, data, o.baseline_k);
+    const Index k = o.baseline_k > 0 ? o.baseline_k : std::min<Index>(20, data.num_coarse());
+    tell("baselines: the core paper's upsampling neighbourhoods (k = " + std::to_string(k) + ")");
+    interp::UpsamplingProblem<> problem = cloth_upsampling_problem(policy, data, k);
     for (const auto& name : o.baselines) {
       tell("baselines: " + name);
       if (name == "local_linear") {
-        interp::LocalLinear<> m({.k = o.baseline_k});
+        interp::LocalLinear<> m({.k = k});
         baselines.push_back(evaluate_upsampling(policy, data, problem, m, name));
       } else {
         const data::PairedFrames<> train = data::displacements(cloth_paired_frames(data, false), problem.lr.V, problem.hr.V);
-        nn::NetworkConfig cfg = o.baseline_network.config(train);
-        cfg.residual_base_k = o.baseline_k;
+        // its interpolation neighbours: the recipe's (the preset's 20), at most the k computed
+        interp::NetworkRecipe recipe = o.baseline_network;
+        if (recipe.up_k <= 0) recipe.up_k = std::min<Index>(nn::NetworkConfig::preset(recipe.profile).up_k, k);
+        nn::NetworkConfig cfg = recipe.config(train);
+        cfg.residual_base_k = k;
         interp::Learned<> net(cfg, o.baseline_network.seed);
         interp::NetworkTrainOptions to;
         to.trainer.seed = o.baseline_network.seed;
