@@ -97,6 +97,9 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
                   "sheet/disk: what the network's fine side holds: residual (to the subdivided coarse mesh's features) or features (the supplement)")
       ->capture_default_str()
       ->check(CLI::IsMember({"residual", "features"}));
+  cmd->add_option("--baseline-epochs", cl.baseline_network.epochs, "sheet/disk: epochs of the core paper's network (the network baseline)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--baselines", cl.baselines,
                   "sheet/disk: the core paper's upsampling methods evaluated beside: local_linear, network (none: neither)")
       ->delimiter(',')

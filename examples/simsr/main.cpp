@@ -34,6 +34,10 @@
 #include <cstring>
 
 int main(int argc, char** argv) {
+  // stdout carries one JSON document or a command's final tables. Fully buffered (also on a
+  // terminal or under `stdbuf -oL`), a failed write shows at the flush below with its errno; line
+  // buffered, it failed at a newline and its errno was gone by then ("write failed", no reason).
+  std::setvbuf(stdout, nullptr, _IOFBF, std::size_t(1) << 16);
   CLI::App app{"simsr: physics-based simulation super-resolution tools"};
   app.require_subcommand(1);
   std::function<int()> action;

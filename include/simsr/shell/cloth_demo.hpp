@@ -149,7 +149,7 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
         baselines.push_back(evaluate_upsampling(policy, data, problem, m, name));
       } else {
         const data::PairedFrames<> train = data::displacements(cloth_paired_frames(data, false), problem.lr.V, problem.hr.V);
-        // its interpolation neighbours: the recipe's (the preset's 20), at most the k computed
+        // its interpolation neighbours: the recipe's (else the preset's: official 10, paper 20), at most the k computed
         interp::NetworkRecipe recipe = o.baseline_network;
         if (recipe.up_k <= 0) recipe.up_k = std::min<Index>(nn::NetworkConfig::preset(recipe.profile).up_k, k);
         nn::NetworkConfig cfg = recipe.config(train);
