@@ -243,12 +243,12 @@ TEST_CASE("evaluate_upsampling: the core paper's methods on a cloth pair, whose 
   for (auto& s : loop.sequences)
     for (std::size_t f = 0; f < s.coarse.size(); ++f) s.fine[f] = d.pair.subdivision * s.coarse[f];
   interp::LocalLinear<> exact({.k = 12});
-  const auto e0 = evaluate_upsampling(exec::seq, loop, problem, exact, "local_linear", interp::LocalLinearTrainOptions{.lambda = 1e-12});
+  const auto e0 = evaluate_upsampling(exec::seq, loop, problem, cloth_paired_frames(loop, false), exact, "local_linear", interp::LocalLinearTrainOptions{.lambda = 1e-12});
   CHECK(e0.rmse < 1e-6);
 
   // on the simulated fine cloth: the figures are the per-frame distances of the method's output
   interp::LocalLinear<> local({.k = 8});
-  const auto e1 = evaluate_upsampling(exec::omp, d, problem, local, "local_linear");
+  const auto e1 = evaluate_upsampling(exec::omp, d, problem, train, local, "local_linear");
   REQUIRE(e1.sequences.size() == 1);
   CHECK(e1.sequences[0].name == d.sequences[4].name);
   CHECK(e1.frames == d.sequences[4].num_frames());
@@ -270,14 +270,14 @@ TEST_CASE("evaluate_upsampling: the core paper's methods on a cloth pair, whose 
   auto cfg = recipe.config(data::displacements(train, problem.lr.V, problem.hr.V));
   cfg.residual_base_k = 8;
   interp::Learned<> net(cfg, 1);
-  const auto e2 = evaluate_upsampling(exec::omp, d, problem, net, "network");
+  const auto e2 = evaluate_upsampling(exec::omp, d, problem, train, net, "network");
   CHECK(std::isfinite(e2.rmse));
   CHECK(e2.rmse > 0);
   CHECK(e2.seconds_per_frame > 0);
   MESSAGE("held out: local-linear ", e1.rmse, " m, network (1 epoch) ", e2.rmse, " m");
 
   problem.hr.V.conservativeResize(48, 3);
-  CHECK(test::typed_error_of<ShapeError>([&] { evaluate_upsampling(exec::seq, d, problem, local, "x"); }).find("evaluate_upsampling") !=
+  CHECK(test::typed_error_of<ShapeError>([&] { evaluate_upsampling(exec::seq, d, problem, train, local, "x"); }).find("evaluate_upsampling") !=
         std::string::npos);
 }
 

@@ -68,6 +68,45 @@ inline void check_cloth_baselines(const std::vector<std::string>& names) {
     if (b != "local_linear" && b != "network") throw ArgumentError("cloth demo: unknown baseline '" + b + "' (local_linear, network)");
 }
 
+/// The demo's baselines (o.baselines) on the held-out sequences: the problem and the training
+/// frames built once for all of them; the network checkpointed in `net_dir` and resumed.
+template <exec::HostPolicy P>
+std::vector<ClothUpsamplingEvaluation> run_cloth_baselines(P policy, const ClothDemoOptions& o, const ClothData& data,
+                                                           const std::filesystem::path& net_dir, const std::function<void(const std::string&)>& tell) {
+  std::vector<ClothUpsamplingEvaluation> out;
+  if (o.baselines.empty()) return out;
+  const Index k = o.baseline_k > 0 ? o.baseline_k : std::min<Index>(20, data.num_coarse());
+  tell("baselines: the core paper's upsampling neighbourhoods (k = " + std::to_string(k) + ")");
+  interp::UpsamplingProblem<> problem = cloth_upsampling_problem(policy, data, k);
+  const data::PairedFrames<> train = cloth_paired_frames(data, false);
+  for (const auto& name : o.baselines) {
+    tell("baselines: " + name);
+    if (name == "local_linear") {
+      interp::LocalLinear<> m({.k = k});
+      out.push_back(evaluate_upsampling(policy, data, problem, train, m, name));
+      continue;
+    }
+    // the network: its interpolation neighbours the recipe's (else the preset's: official 10,
+    // paper 20), at most the k computed; its displacement scale from the training frames
+    interp::NetworkRecipe recipe = o.baseline_network;
+    if (recipe.up_k <= 0) recipe.up_k = std::min<Index>(nn::NetworkConfig::preset(recipe.profile).up_k, k);
+    nn::NetworkConfig cfg = recipe.config(data::displacements(train, problem.lr.V, problem.hr.V));
+    cfg.residual_base_k = k;
+    interp::Learned<> net(cfg, recipe.seed);
+    interp::NetworkTrainOptions to;
+    to.trainer.seed = recipe.seed;
+    to.trainer.lr_decay_epochs = recipe.lr_decay_epochs;
+    to.trainer.progress = false;
+    to.trainer.on_epoch = [&](const nn::EpochReport& r) {
+      tell("baselines: network epoch " + std::to_string(r.epoch) + "/" + std::to_string(cfg.epochs) + " loss " + std::to_string(r.loss));
+    };
+    to.checkpoint = net_dir / "upsampling_network.npz";
+    if (std::filesystem::exists(to.checkpoint)) to.resume = to.checkpoint;  // refused, naming what differs, when of another run
+    out.push_back(evaluate_upsampling(policy, data, problem, train, net, "upsampling_network", to));
+  }
+  return out;
+}
+
 /// Runs the demo (see the file comment); `say` receives progress lines. Returns OUT/report.json.
 template <exec::HostPolicy P>
 nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const std::function<void(const std::string&)>& say = {}) {
@@ -137,37 +176,7 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   });
 
   // the core paper's upsampling methods on the same held-out sequences
-  std::vector<ClothUpsamplingEvaluation> baselines;
-  if (!o.baselines.empty()) {
-    const Index k = o.baseline_k > 0 ? o.baseline_k : std::min<Index>(20, data.num_coarse());
-    tell("baselines: the core paper's upsampling neighbourhoods (k = " + std::to_string(k) + ")");
-    interp::UpsamplingProblem<> problem = cloth_upsampling_problem(policy, data, k);
-    for (const auto& name : o.baselines) {
-      tell("baselines: " + name);
-      if (name == "local_linear") {
-        interp::LocalLinear<> m({.k = k});
-        baselines.push_back(evaluate_upsampling(policy, data, problem, m, name));
-      } else {
-        const data::PairedFrames<> train = data::displacements(cloth_paired_frames(data, false), problem.lr.V, problem.hr.V);
-        // its interpolation neighbours: the recipe's (else the preset's: official 10, paper 20), at most the k computed
-        interp::NetworkRecipe recipe = o.baseline_network;
-        if (recipe.up_k <= 0) recipe.up_k = std::min<Index>(nn::NetworkConfig::preset(recipe.profile).up_k, k);
-        nn::NetworkConfig cfg = recipe.config(train);
-        cfg.residual_base_k = k;
-        interp::Learned<> net(cfg, o.baseline_network.seed);
-        interp::NetworkTrainOptions to;
-        to.trainer.seed = o.baseline_network.seed;
-        to.trainer.lr_decay_epochs = o.baseline_network.lr_decay_epochs;
-        to.trainer.progress = false;
-        to.trainer.on_epoch = [&](const nn::EpochReport& r) {
-          tell("baselines: network epoch " + std::to_string(r.epoch) + "/" + std::to_string(cfg.epochs) + " loss " + std::to_string(r.loss));
-        };
-        to.checkpoint = net_dir / "upsampling_network.npz";
-        if (std::filesystem::exists(to.checkpoint)) to.resume = to.checkpoint;  // refused, naming what differs, when of another run
-        baselines.push_back(evaluate_upsampling(policy, data, problem, net, "upsampling_network", to));
-      }
-    }
-  }
+  const std::vector<ClothUpsamplingEvaluation> baselines = run_cloth_baselines(policy, o, data, net_dir, tell);
 
   std::ostringstream csv;
   csv.precision(17);

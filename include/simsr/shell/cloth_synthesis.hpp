@@ -237,9 +237,13 @@ class ClothSynthesis {
     TsAcapState<double> state, base_state;
     std::vector<TsAcapFeatures<double>> coarse, base;
     coarse.reserve(std::size_t(F));
+    Points<> subdivided_frame(data_->num_fine(), 3);
     for (const auto& V : s.coarse) {
       coarse.push_back(coarse_acap_.encode(policy, V, state));
-      if (residual()) base.push_back(fine_acap_.encode(policy, Points<>(data_->pair.subdivision * V), base_state));
+      if (residual()) {
+        subdivided_frame.noalias() = data_->pair.subdivision * V;
+        base.push_back(fine_acap_.encode(policy, subdivided_frame, base_state));
+      }
     }
     auto t1 = clock::now();
     const SequenceFeatures<float> in = net_.normalize(coarse, {});

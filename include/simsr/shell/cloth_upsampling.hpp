@@ -8,8 +8,9 @@
 /// triangles' edges; the §3.2 neighbourhoods need only the LR points and the HR surface.
 ///
 ///     auto problem = shell::cloth_upsampling_problem(exec::omp, data);
+///     const auto train = shell::cloth_paired_frames(data, false);   // built once for every method
 ///     interp::LocalLinear<> method;
-///     const auto e = shell::evaluate_upsampling(exec::omp, data, problem, method, "local_linear");
+///     const auto e = shell::evaluate_upsampling(exec::omp, data, problem, train, method, "local_linear");
 ///
 /// Trained (a method that learns) on the training sequences' frames as displacements from the
 /// rest pair; applied to every held-out coarse frame on its own (these methods are per frame: no
@@ -82,12 +83,12 @@ struct ClothUpsamplingEvaluation {
   Index frames = 0;
 };
 
-/// Fits `method` on the problem, trains it (when it learns) on the training sequences with
-/// `options` (its train_options; none: the defaults), and applies it to every held-out coarse
-/// frame (see the file comment).
+/// Fits `method` on the problem, trains it (when it learns) on `train` (the training sequences'
+/// frames: cloth_paired_frames(d, false)) with `options` (its train_options; none: the
+/// defaults), and applies it to every held-out coarse frame (see the file comment).
 template <exec::HostPolicy P, interp::Interpolator I, class... TrainOptions>
-ClothUpsamplingEvaluation evaluate_upsampling(P policy, const ClothData& d, interp::UpsamplingProblem<>& problem, I& method,
-                                              const std::string& name, const TrainOptions&... options) {
+ClothUpsamplingEvaluation evaluate_upsampling(P policy, const ClothData& d, interp::UpsamplingProblem<>& problem, const data::PairedFrames<>& train,
+                                              I& method, const std::string& name, const TrainOptions&... options) {
   static_assert(sizeof...(TrainOptions) <= 1, "evaluate_upsampling: at most one train_options");
   static_assert(interp::TrainableInterpolator<I> || sizeof...(TrainOptions) == 0, "evaluate_upsampling: this method does not train; pass no options");
   using clock = std::chrono::steady_clock;
@@ -96,7 +97,7 @@ ClothUpsamplingEvaluation evaluate_upsampling(P policy, const ClothData& d, inte
   ClothUpsamplingEvaluation e;
   e.method = name;
   const auto t0 = clock::now();
-  if constexpr (interp::TrainableInterpolator<I>) interp::prepare(policy, method, problem, cloth_paired_frames(d, false), options...);
+  if constexpr (interp::TrainableInterpolator<I>) interp::prepare(policy, method, problem, train, options...);
   else interp::prepare(policy, method, problem);
   e.fit_seconds = std::chrono::duration<double>(clock::now() - t0).count();
   Points<> lr_disp(d.num_coarse(), 3), hr_disp(d.num_fine(), 3);

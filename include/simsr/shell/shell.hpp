@@ -20,3 +20,8 @@
 #include "cloth_scenes.hpp"
 #include "cloth_datagen.hpp"
 #include "collision_refinement.hpp"
+#include "cloth_data.hpp"
+#include "detail_synthesis.hpp"
+#include "cloth_synthesis.hpp"
+#include "cloth_upsampling.hpp"
+#include "cloth_demo.hpp"
