@@ -102,6 +102,36 @@ TEST_CASE("paired frames: select and displacements") {
   CHECK(!error_of([&] { data::displacements(p, Points<>(Points<>::Zero(5, 3)), hr_rest); }).empty());
 }
 
+TEST_CASE("paired frames: one_sequence is a valid set of one named sequence, written and read back whole") {
+  std::mt19937 rng(11);
+  for (Index F : {1, 3, 8}) {
+    auto p = data::PairedFrames<>::one_sequence(F, 4, 7, "seq_" + std::to_string(F));
+    REQUIRE(p.num_frames() == F);
+    CHECK(p.num_lr() == 4);
+    CHECK(p.num_hr() == 7);
+    CHECK(p.num_controls() == 0);
+    for (Index f = 0; f < F; ++f) {
+      CHECK(p.ids[std::size_t(f)] == f);
+      CHECK(p.sequence_name(f) == "seq_" + std::to_string(F));
+    }
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (Index f = 0; f < F; ++f) {
+      for (Index i = 0; i < 4; ++i)
+        for (int c = 0; c < 3; ++c) p.lr(f)(i, c) = u(rng);
+      for (Index i = 0; i < 7; ++i)
+        for (int c = 0; c < 3; ++c) p.hr(f)(i, c) = u(rng);
+    }
+    const auto path = tmp("one_sequence_" + std::to_string(F) + ".npz");
+    data::write_paired_frames(path, p);
+    const auto q = data::read_paired_frames(path, 4, 7);
+    CHECK(q.lowres == p.lowres);
+    CHECK(q.highres == p.highres);
+    CHECK(q.ids == p.ids);
+    CHECK(q.sequence == p.sequence);
+    CHECK(q.sequence_names == p.sequence_names);
+  }
+}
+
 TEST_CASE("paired frames: every malformed file is an error naming the file and what") {
   std::mt19937 rng(7);
   const auto good = random_frames(rng, 5, 4, 6, 2, true);

@@ -26,6 +26,7 @@
 #include <span>
 #include <string>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "../core/error.hpp"
@@ -52,6 +53,19 @@ struct PairedFrames {
   FrameMatrix<S> controls;                  ///< F×C control vectors (C = 0: none)
   std::vector<std::int32_t> sequence;       ///< F sequence indices into sequence_names (empty: none)
   std::vector<std::string> sequence_names;  ///< names of the sequences
+
+  /// F frames of one sequence named `name`, N LR and M HR vertices, ids 0..F−1, positions to be
+  /// filled (uninitialized): what a simulation of one sequence writes into.
+  static PairedFrames one_sequence(Index F, Index N, Index M, std::string name) {
+    PairedFrames out;
+    out.lowres.resize(F, 3 * N);
+    out.highres.resize(F, 3 * M);
+    out.ids.resize(std::size_t(F));
+    for (Index f = 0; f < F; ++f) out.ids[std::size_t(f)] = f;
+    out.sequence.assign(std::size_t(F), 0);
+    out.sequence_names = {std::move(name)};
+    return out;
+  }
 
   Index num_frames() const { return lowres.rows(); }
   Index num_lr() const { return lowres.cols() / 3; }

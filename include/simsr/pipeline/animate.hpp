@@ -112,13 +112,7 @@ void animate_performances(P policy, const AnimateOptions& o, const scenario::Fac
     nlohmann::ordered_json pj;
     pj["name"] = perf.name;
     pj["frames"] = F;
-    data::PairedFrames<> frames;
-    frames.lowres.resize(F, 3 * N);
-    frames.highres.resize(F, 3 * M);
-    frames.ids.resize(std::size_t(F));
-    for (Index f = 0; f < F; ++f) frames.ids[std::size_t(f)] = f;
-    frames.sequence.assign(std::size_t(F), 0);
-    frames.sequence_names = {perf.name};
+    data::PairedFrames<> frames = data::PairedFrames<>::one_sequence(F, N, M, perf.name);
     frames.controls = perf.weights;
 
     data::FrameMatrix<Scalar> unpiped;

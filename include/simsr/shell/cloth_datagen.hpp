@@ -121,6 +121,157 @@ ClothFrameReport advance_frame(P policy, Sim& sim, const Move& move, const std::
   }
 }
 
+/// What generate_cloth_data hands each scene's simulation: the meshes, options, paths, and per
+/// sequence its frame count, fingerprint and checkpoint (read and checked before anything runs).
+struct ClothDatagenRun {
+  ClothDataset dataset;
+  const ClothPair& pair;
+  const ClothDatagenOptions& opt;
+  const std::filesystem::path& dir;
+  const std::filesystem::path& state;  ///< DIR/.state
+  const std::vector<Index>& frames;
+  const std::vector<std::string>& prints;
+  const std::vector<std::optional<io::NpzArrays>>& checkpoints;
+  const std::string& settle_print;
+  Index coarse_vertices() const { return pair.coarse.V.rows(); }
+  Index fine_vertices() const { return pair.fine.V.rows(); }
+};
+
+/// Both cloths' state: positions, the previous step's, the last step length ([0] coarse, [1] fine).
+struct ClothPairState {
+  Points<> x[2], previous[2];
+  double last_step[2] = {0, 0};
+  template <class O>
+  static ClothPairState of(const ClothSimulator<O>& coarse, const ClothSimulator<O>& fine) {
+    ClothPairState s;
+    s.x[0] = coarse.positions(), s.previous[0] = coarse.previous_positions(), s.last_step[0] = coarse.last_step();
+    s.x[1] = fine.positions(), s.previous[1] = fine.previous_positions(), s.last_step[1] = fine.last_step();
+    return s;
+  }
+  /// Read from a settle file or a sequence checkpoint (`file` names it in errors).
+  static ClothPairState read(const io::NpzArrays& z, Index N, Index M, const std::string& file) {
+    ClothPairState s;
+    s.x[0] = io::points_of(z, "coarse", N, file), s.previous[0] = io::points_of(z, "coarse_previous", N, file);
+    s.x[1] = io::points_of(z, "fine", M, file), s.previous[1] = io::points_of(z, "fine_previous", M, file);
+    s.last_step[0] = io::scalar_of(z, "coarse_last_step", file), s.last_step[1] = io::scalar_of(z, "fine_last_step", file);
+    return s;
+  }
+  void add_to(io::NpzArrays& z) const {
+    z["coarse"] = io::make_npy(x[0]);
+    z["coarse_previous"] = io::make_npy(previous[0]);
+    z["fine"] = io::make_npy(x[1]);
+    z["fine_previous"] = io::make_npy(previous[1]);
+    z["coarse_last_step"] = io::make_npy<double>({}, &last_step[0]);
+    z["fine_last_step"] = io::make_npy<double>({}, &last_step[1]);
+  }
+  template <class O>
+  void set(ClothSimulator<O>& coarse, ClothSimulator<O>& fine, Index steps) const {
+    coarse.set_state(x[0], previous[0], steps, last_step[0]);
+    fine.set_state(x[1], previous[1], steps, last_step[1]);
+  }
+};
+
+/// The settled start of every sequence: read from DIR/.state/settled.npz when it is this run's,
+/// else settled (`settle_frames` with the obstacle `still`) and written there.
+template <exec::HostPolicy P, class O>
+ClothPairState settled_cloth_start(P policy, const ClothDatagenRun& run, ClothSimulator<O>& coarse, ClothSimulator<O>& fine,
+                                   const std::function<void(O&, double)>& still) {
+  const auto file = run.state / "settled.npz";
+  if (std::filesystem::exists(file)) {
+    const auto z = io::read_npz(file);
+    if (io::fingerprint_of(z) == run.settle_print) return ClothPairState::read(z, run.coarse_vertices(), run.fine_vertices(), file.string());
+  }
+  for (Index f = 0; f < run.opt.settle_frames; ++f) {
+    advance_frame(policy, coarse, still, "settle", f, "coarse");
+    advance_frame(policy, fine, still, "settle", f, "fine");
+  }
+  const ClothPairState s = ClothPairState::of(coarse, fine);
+  io::NpzArrays z;
+  s.add_to(z);
+  io::set_fingerprint(z, run.settle_print);
+  io::write_npz(file, z);
+  return s;
+}
+
+/// Sequence k from `start` (or its checkpoint) into DIR/<name>.npz, checkpointing as it goes;
+/// a finished file of this run is reused. Returns its figures.
+template <exec::HostPolicy P, class O, class AirFor>
+ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run, Index k, ClothSimulator<O>& coarse, ClothSimulator<O>& fine,
+                                           const ClothPairState& start_state, const std::function<void(O&, double)>& move, const AirFor& air_for) {
+  const Index N = run.coarse_vertices(), M = run.fine_vertices();
+  const ClothDatagenOptions& opt = run.opt;
+  ClothSequenceStats st;
+  st.name = cloth_sequence_name(run.dataset, k);
+  st.test = cloth_sequence_is_test(k);
+  const Index F = run.frames[std::size_t(k)];
+  st.frames = F;
+  const std::string& print = run.prints[std::size_t(k)];
+  const auto final_file = run.dir / (st.name + ".npz");
+  const auto partial = run.state / (st.name + ".npz");
+  if (std::filesystem::exists(final_file)) {
+    const auto z = io::read_npz(final_file);
+    if (io::fingerprint_of(z) == print) {
+      st.reused = true;
+      st.subdivided_rmse = subdivided_rmse(data::read_paired_frames(final_file, N, M), run.pair.subdivision);
+      return st;
+    }
+  }
+  data::PairedFrames<> out = data::PairedFrames<>::one_sequence(F, N, M, st.name);
+  Index start = 0;
+  start_state.set(coarse, fine, 0);
+  if (const auto& checkpoint = run.checkpoints[std::size_t(k)]) {
+    start = data::resume_frames(*checkpoint, partial.string(), out);
+    ClothPairState::read(*checkpoint, N, M, partial.string()).set(coarse, fine, start * opt.simulation.substeps);
+  }
+  for (Index f = start; f < F; ++f) {
+    coarse.set_air(air_for(k, coarse.time()));
+    fine.set_air(air_for(k, fine.time()));
+    const auto t0 = std::chrono::steady_clock::now();
+    const ClothFrameReport rc = advance_frame(policy, coarse, move, st.name, f, "coarse");
+    const auto t1 = std::chrono::steady_clock::now();
+    const ClothFrameReport rf = advance_frame(policy, fine, move, st.name, f, "fine");
+    const auto t2 = std::chrono::steady_clock::now();
+    const double sc = std::chrono::duration<double>(t1 - t0).count(), sf = std::chrono::duration<double>(t2 - t1).count();
+    out.lr(f) = coarse.positions();
+    out.hr(f) = fine.positions();
+    st.coarse_seconds += sc;
+    st.fine_seconds += sf;
+    st.coarse_iterations += rc.newton_iterations;
+    st.fine_iterations += rf.newton_iterations;
+    st.halvings += rc.halvings + rf.halvings;
+    st.deepest = std::min({st.deepest, rc.deepest, rf.deepest});
+    ++st.simulated;
+    if (opt.on_frame) opt.on_frame(st.name, f, F, rc, rf, sc, sf);
+    const Index done = f + 1;
+    if (done < F && done % opt.checkpoint_every == 0) {
+      io::NpzArrays z = data::frames_checkpoint(out, done, print);
+      ClothPairState::of(coarse, fine).add_to(z);
+      io::write_npz(partial, z);
+    }
+  }
+  st.subdivided_rmse = subdivided_rmse(out, run.pair.subdivision);
+  auto arrays = data::paired_frame_arrays(out);
+  io::set_fingerprint(arrays, print);
+  io::write_npz(run.dir / (st.name + ".npz"), arrays);
+  std::filesystem::remove(partial);
+  return st;
+}
+
+/// One scene's sequences (a function template over the obstacle type, since SHEET's and DISK's
+/// differ): make_obstacle(k) the obstacle at the start of sequence k (k < 0: while settling),
+/// move_for(k) its motion, air_for(k, t) the air. Appends each sequence's figures to `stats`.
+template <exec::HostPolicy P, class MakeObstacle, class MoveFor, class AirFor>
+void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstacle& make_obstacle, const MoveFor& move_for, const AirFor& air_for,
+                          std::vector<ClothSequenceStats>& stats) {
+  using O = std::decay_t<decltype(make_obstacle(Index(0)))>;
+  ClothSimulator<O> coarse(run.pair.coarse, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
+  ClothSimulator<O> fine(run.pair.fine, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
+  const std::function<void(O&, double)> still = [&](O& o, double) { o = make_obstacle(-1); };
+  const ClothPairState start = settled_cloth_start(policy, run, coarse, fine, still);
+  for (Index k = 0; k < Index(run.frames.size()); ++k)
+    stats.push_back(simulate_cloth_sequence(policy, run, k, coarse, fine, start, std::function<void(O&, double)>(move_for(k)), air_for));
+}
+
 }  // namespace detail
 
 /// Simulates the dataset into `dir` (see the file comment). Returns the figures of this run,
@@ -177,137 +328,20 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   // SHEET settles with the first sequence's obstacle at its start (above the sheet)
   const std::string settle_print =
       detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames, d == ClothDataset::sheet ? parameters_of(0) : std::vector<double>{});
+
+  std::vector<Index> frames(static_cast<std::size_t>(count));
+  for (Index k = 0; k < count; ++k) frames[std::size_t(k)] = frames_of(k);
+  const detail::ClothDatagenRun run{d, pair, opt, dir, state, frames, prints, checkpoints, settle_print};
   std::vector<ClothSequenceStats> stats;
-
-  // one scene's simulators (their obstacle types differ): make_obstacle(k) the obstacle at the
-  // start of sequence k (k < 0: while settling), move_for(k) its motion, air_for(k, t) the air
-  auto run = [&](auto make_obstacle, auto move_for, auto air_for) {
-    using O = std::decay_t<decltype(make_obstacle(Index(0)))>;
-    ClothSimulator<O> coarse(pair.coarse, pair.pinned, make_obstacle(-1), opt.material, opt.simulation);
-    ClothSimulator<O> fine(pair.fine, pair.pinned, make_obstacle(-1), opt.material, opt.simulation);
-    // the settled start state
-    Points<> settled[2][2];  // [coarse, fine][x, previous]
-    double settled_step[2] = {0, 0};
-    const auto settle_file = state / "settled.npz";
-    bool have = false;
-    if (std::filesystem::exists(settle_file)) {
-      const auto z = io::read_npz(settle_file);
-      if (io::fingerprint_of(z) == settle_print) {
-        settled[0][0] = io::points_of(z, "coarse", N, settle_file.string());
-        settled[0][1] = io::points_of(z, "coarse_previous", N, settle_file.string());
-        settled[1][0] = io::points_of(z, "fine", M, settle_file.string());
-        settled[1][1] = io::points_of(z, "fine_previous", M, settle_file.string());
-        settled_step[0] = io::scalar_of(z, "coarse_last_step", settle_file.string());
-        settled_step[1] = io::scalar_of(z, "fine_last_step", settle_file.string());
-        have = true;
-      }
-    }
-    if (!have) {
-      const std::function<void(O&, double)> still = [&](O& o, double) { o = make_obstacle(-1); };
-      for (Index f = 0; f < opt.settle_frames; ++f) {
-        detail::advance_frame(policy, coarse, still, "settle", f, "coarse");
-        detail::advance_frame(policy, fine, still, "settle", f, "fine");
-      }
-      settled[0][0] = coarse.positions(), settled[0][1] = coarse.previous_positions();
-      settled[1][0] = fine.positions(), settled[1][1] = fine.previous_positions();
-      settled_step[0] = coarse.last_step(), settled_step[1] = fine.last_step();
-      io::NpzArrays z;
-      z["coarse"] = io::make_npy(settled[0][0]);
-      z["coarse_previous"] = io::make_npy(settled[0][1]);
-      z["fine"] = io::make_npy(settled[1][0]);
-      z["fine_previous"] = io::make_npy(settled[1][1]);
-      z["coarse_last_step"] = io::make_npy<double>({}, &settled_step[0]);
-      z["fine_last_step"] = io::make_npy<double>({}, &settled_step[1]);
-      io::set_fingerprint(z, settle_print);
-      io::write_npz(settle_file, z);
-    }
-
-    for (Index k = 0; k < count; ++k) {
-      ClothSequenceStats st;
-      st.name = cloth_sequence_name(d, k);
-      st.test = cloth_sequence_is_test(k);
-      const Index F = frames_of(k);
-      st.frames = F;
-      const std::string& print = prints[std::size_t(k)];
-      const auto final_file = dir / (st.name + ".npz");
-      const auto partial = state / (st.name + ".npz");
-      if (std::filesystem::exists(final_file)) {
-        const auto z = io::read_npz(final_file);
-        if (io::fingerprint_of(z) == print) {
-          st.reused = true;
-          st.subdivided_rmse = detail::subdivided_rmse(data::read_paired_frames(final_file, N, M), pair.subdivision);
-          stats.push_back(st);
-          continue;
-        }
-      }
-      data::PairedFrames<> out;
-      out.lowres.resize(F, 3 * N);
-      out.highres.resize(F, 3 * M);
-      out.ids.resize(std::size_t(F));
-      for (Index f = 0; f < F; ++f) out.ids[std::size_t(f)] = f;
-      out.sequence.assign(std::size_t(F), 0);
-      out.sequence_names = {st.name};
-      Index start = 0;
-      coarse.set_state(settled[0][0], settled[0][1], 0, settled_step[0]);
-      fine.set_state(settled[1][0], settled[1][1], 0, settled_step[1]);
-      if (checkpoints[std::size_t(k)]) {
-        const io::NpzArrays& z = *checkpoints[std::size_t(k)];
-        start = data::resume_frames(z, partial.string(), out);
-        const Index steps = start * opt.simulation.substeps;
-        coarse.set_state(io::points_of(z, "coarse", N, partial.string()), io::points_of(z, "coarse_previous", N, partial.string()), steps,
-                         io::scalar_of(z, "coarse_last_step", partial.string()));
-        fine.set_state(io::points_of(z, "fine", M, partial.string()), io::points_of(z, "fine_previous", M, partial.string()), steps,
-                       io::scalar_of(z, "fine_last_step", partial.string()));
-      }
-      const std::function<void(O&, double)> move = move_for(k);
-      for (Index f = start; f < F; ++f) {
-        coarse.set_air(air_for(k, coarse.time()));
-        fine.set_air(air_for(k, fine.time()));
-        const auto t0 = std::chrono::steady_clock::now();
-        const ClothFrameReport rc = detail::advance_frame(policy, coarse, move, st.name, f, "coarse");
-        const auto t1 = std::chrono::steady_clock::now();
-        const ClothFrameReport rf = detail::advance_frame(policy, fine, move, st.name, f, "fine");
-        const auto t2 = std::chrono::steady_clock::now();
-        const double sc = std::chrono::duration<double>(t1 - t0).count(), sf = std::chrono::duration<double>(t2 - t1).count();
-        out.lr(f) = coarse.positions();
-        out.hr(f) = fine.positions();
-        st.coarse_seconds += sc;
-        st.fine_seconds += sf;
-        st.coarse_iterations += rc.newton_iterations;
-        st.fine_iterations += rf.newton_iterations;
-        st.halvings += rc.halvings + rf.halvings;
-        st.deepest = std::min({st.deepest, rc.deepest, rf.deepest});
-        ++st.simulated;
-        if (opt.on_frame) opt.on_frame(st.name, f, F, rc, rf, sc, sf);
-        const Index done = f + 1;
-        if (done < F && done % opt.checkpoint_every == 0) {
-          io::NpzArrays z = data::frames_checkpoint(out, done, print);
-          z["coarse"] = io::make_npy(coarse.positions());
-          z["coarse_previous"] = io::make_npy(coarse.previous_positions());
-          z["fine"] = io::make_npy(fine.positions());
-          z["fine_previous"] = io::make_npy(fine.previous_positions());
-          const double steps[2] = {coarse.last_step(), fine.last_step()};
-          z["coarse_last_step"] = io::make_npy<double>({}, &steps[0]);
-          z["fine_last_step"] = io::make_npy<double>({}, &steps[1]);
-          io::write_npz(partial, z);
-        }
-      }
-      st.subdivided_rmse = detail::subdivided_rmse(out, pair.subdivision);
-      auto arrays = data::paired_frame_arrays(out);
-      io::set_fingerprint(arrays, print);
-      io::write_npz(final_file, arrays);
-      std::filesystem::remove(partial);
-      stats.push_back(st);
-    }
-  };
-
   if (d == ClothDataset::sheet) {
-    run([&](Index k) { return k < 0 ? sheets[0].obstacle_at(0) : sheets[std::size_t(k)].obstacle_at(0); },
+    detail::simulate_cloth_scene(
+        policy, run, [&](Index k) { return k < 0 ? sheets[0].obstacle_at(0) : sheets[std::size_t(k)].obstacle_at(0); },
         [&](Index k) { return std::function<void(physics::Capsule<>&, double)>([&, k](physics::Capsule<>& o, double t) { o = sheets[std::size_t(k)].obstacle_at(t); }); },
-        [](Index, double) { return Air{}; });
+        [](Index, double) { return Air{}; }, stats);
   } else {
-    run([](Index) { return disk_table(); }, [](Index) { return std::function<void(physics::RoundedCylinder<>&, double)>(); },
-        [&](Index k, double t) { return disks[std::size_t(k)].air_at(t); });
+    detail::simulate_cloth_scene(
+        policy, run, [](Index) { return disk_table(); }, [](Index) { return std::function<void(physics::RoundedCylinder<>&, double)>(); },
+        [&](Index k, double t) { return disks[std::size_t(k)].air_at(t); }, stats);
   }
 
   // the summary

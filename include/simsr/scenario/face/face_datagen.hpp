@@ -289,14 +289,8 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
         continue;
       }
     }
-    data::PairedFrames<> out;
-    out.lowres.resize(F, 3 * N);
-    out.highres.resize(F, 3 * M);
+    data::PairedFrames<> out = data::PairedFrames<>::one_sequence(F, N, M, perf.name);
     out.controls = perf.weights;
-    out.ids.resize(std::size_t(F));
-    for (Index f = 0; f < F; ++f) out.ids[std::size_t(f)] = f;
-    out.sequence.assign(std::size_t(F), 0);
-    out.sequence_names = {perf.name};
     Index start = 0;
     std::vector<std::int64_t> lip_pairs(std::size_t(F), 0);  // per frame: intersecting lip triangle pairs at HR
     // positions are taken as solved under the controls set before them (continuation walks from
