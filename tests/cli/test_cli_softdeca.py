@@ -82,7 +82,7 @@ report = json.loads(p.stdout) if p.returncode == 0 else {}
 check((report.get("train_samples"), report.get("validation_samples"), report.get("held_out_samples")) == (7, 1, 2),
       f"of 10 samples 2 held out, 1 of the other 8 picks the epoch, 7 trained on: {report}")
 check(1 <= report.get("best_epoch", 0) <= 40, "the epoch kept is one of the 40")
-for key in ("held_out", "held_out_mean_baseline", "held_out_ridge_baseline"):
+for key in ("held_out", "held_out_mean_baseline", "held_out_ridge_baseline", "validation"):
     check(report.get(key, {}).get("mean_m", -1) > 0, f"report has {key}.mean_m")
 check(report.get("inference_seconds_per_sample", 0) > 0 and report.get("solver_seconds_per_sample", 0) > 0, "inference and solver seconds")
 loss = list(csv.DictReader(open(os.path.join(out, "surrogate_loss.csv")))) if os.path.exists(os.path.join(out, "surrogate_loss.csv")) else []

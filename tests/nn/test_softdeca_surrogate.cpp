@@ -77,6 +77,18 @@ TEST_CASE("SoftDecaSurrogate learns a nonlinear parameter-to-skin map on held-ou
   CHECK(r.held_out.relative < 0.45);
   CHECK(r.inference_seconds > 0);
   CHECK(r.solver_seconds == 1.0);
+  // the validation figures are the kept weights' errors on samples 204..239, in metres
+  {
+    const Eigen::MatrixXd Ytr = data.displacements.topRows(240);
+    const VecX<> mean = Ytr.colwise().mean().transpose();
+    const auto v = nn::surrogate_errors(net.predict(exec::seq, data.parameters.middleRows(204, 36), data.expressions.middleRows(204, 36)),
+                                        data.displacements.middleRows(204, 36), mean);
+    CHECK(r.validation.mean == doctest::Approx(v.mean).epsilon(1e-12));
+    CHECK(r.validation.max == doctest::Approx(v.max).epsilon(1e-12));
+    CHECK(r.validation.relative == doctest::Approx(v.relative).epsilon(1e-12));
+    CHECK(r.validation.mean > 0);
+    CHECK(r.to_json()["validation_linear_base_alone"].is_null());  // no base
+  }
 
   // the saved model predicts what the trained one does
   const auto file = std::filesystem::temp_directory_path() / "simsr_test_surrogate.npz";
@@ -124,6 +136,16 @@ TEST_CASE("SoftDecaSurrogate with a linear base: an exactly linear map before an
   CHECK(r.base_lambda > 0);
   CHECK(r.held_out.mean < r.base_alone.mean);  // the network adds what the linear map cannot
   CHECK(r.held_out.mean < 0.85 * r.ridge_baseline.mean);  // this seed: 0.73 of ridge's error
+  // on the validation samples too, in metres: the base alone against base + network
+  {
+    Eigen::MatrixXd Xv(36, W.rows());
+    Xv << data.expressions.middleRows(204, 36), data.parameters.middleRows(204, 36);
+    const VecX<> mean = data.displacements.topRows(240).colwise().mean().transpose();
+    const auto b = nn::surrogate_errors(net.with_intercept(Xv) * net.linear_base(), data.displacements.middleRows(204, 36), mean);
+    CHECK(r.validation_base_alone.mean == doctest::Approx(b.mean).epsilon(1e-12));
+    CHECK(r.validation.mean < r.validation_base_alone.mean);
+    CHECK(r.to_json()["validation_linear_base_alone"]["mean_m"].get<double>() == r.validation_base_alone.mean);
+  }
   const auto file = std::filesystem::temp_directory_path() / "simsr_test_surrogate_base.npz";
   net.save(file);
   SoftDecaSurrogate loaded = SoftDecaSurrogate::load(file);

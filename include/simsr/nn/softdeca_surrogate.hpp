@@ -327,6 +327,10 @@ struct SoftDecaSurrogateReport {
   double base_lambda = 0;               ///< the linear base's λ (0: no base)
   SurrogateErrors train, held_out, mean_baseline, ridge_baseline;  ///< the last three on the held-out samples
   SurrogateErrors base_alone;  ///< the linear base without the network, on the held-out samples (with a base)
+  /// On the validation samples (none without): the predictor with the kept weights, and the
+  /// linear base alone (with a base). In metres, so settings (widths, decay, with or without a
+  /// base) can be chosen on them and the held-out samples stay unseen by every choice.
+  SurrogateErrors validation, validation_base_alone;
   double train_seconds = 0;
   double inference_seconds = 0;  ///< one sample (batch of 1), median of repeated calls, the policy's threads
   double solver_seconds = 0;     ///< mean simulation time of the held-out samples (from the dataset)
@@ -345,6 +349,8 @@ struct SoftDecaSurrogateReport {
             {"held_out_mean_baseline", mean_baseline.to_json()},
             {"held_out_ridge_baseline", ridge_baseline.to_json()},
             {"held_out_linear_base_alone", base_lambda > 0 ? base_alone.to_json() : nlohmann::ordered_json()},
+            {"validation", validation_samples > 0 ? validation.to_json() : nlohmann::ordered_json()},
+            {"validation_linear_base_alone", validation_samples > 0 && base_lambda > 0 ? validation_base_alone.to_json() : nlohmann::ordered_json()},
             {"train_seconds", train_seconds},
             {"inference_seconds_per_sample", inference_seconds},
             {"solver_seconds_per_sample", solver_seconds},
@@ -467,6 +473,11 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const scenario::SoftD
   r.held_out = surrogate_errors(net.predict(policy, data.parameters.bottomRows(test), data.expressions.bottomRows(test)), Yte, mean);
   r.mean_baseline = surrogate_errors(Eigen::MatrixXd(mean.transpose().replicate(test, 1)), Yte, mean);
   if (o.linear_base) r.base_alone = surrogate_errors(net.with_intercept(Xte) * net.linear_base(), Yte, mean);
+  if (val > 0) {
+    const Eigen::MatrixXd Yval = Ytr.bottomRows(val);
+    r.validation = surrogate_errors(net.predict(policy, data.parameters.middleRows(fit, val), data.expressions.middleRows(fit, val)), Yval, mean);
+    if (o.linear_base) r.validation_base_alone = surrogate_errors(net.with_intercept(Xtr.bottomRows(val)) * net.linear_base(), Yval, mean);
+  }
   // ridge on the same standardized inputs, [1, z] → y, fitted on every training sample
   r.ridge_baseline = surrogate_errors(net.with_intercept(Xte) * SoftDecaSurrogate::ridge_fit(net.with_intercept(Xtr), Ytr, o.ridge_lambda), Yte, mean);
   // speed: one sample at a time, as a solver would be asked
