@@ -193,8 +193,8 @@ ClothPairState settled_cloth_start(P policy, const ClothDatagenRun& run, ClothSi
   return s;
 }
 
-/// Sequence k from `start` (or its checkpoint) into DIR/<name>.npz, checkpointing as it goes;
-/// a finished file of this run is reused. Returns its figures.
+/// Sequence k from `start_state` (or from its checkpoint) into DIR/<name>.npz, checkpointing as
+/// it goes; a finished file of this run is reused. Returns its figures.
 template <exec::HostPolicy P, class O, class AirFor>
 ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run, Index k, ClothSimulator<O>& coarse, ClothSimulator<O>& fine,
                                            const ClothPairState& start_state, const std::function<void(O&, double)>& move, const AirFor& air_for) {
@@ -252,7 +252,7 @@ ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run,
   st.subdivided_rmse = subdivided_rmse(out, run.pair.subdivision);
   auto arrays = data::paired_frame_arrays(out);
   io::set_fingerprint(arrays, print);
-  io::write_npz(run.dir / (st.name + ".npz"), arrays);
+  io::write_npz(final_file, arrays);
   std::filesystem::remove(partial);
   return st;
 }
