@@ -469,14 +469,21 @@ SoftDecaSurrogateReport train_softdeca_surrogate(P policy, const scenario::SoftD
   r.train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const VecX<> mean = Ytr.colwise().mean().transpose();
-  r.train = surrogate_errors(net.predict(policy, data.parameters.topRows(train), data.expressions.topRows(train)), Ytr, mean);
-  r.held_out = surrogate_errors(net.predict(policy, data.parameters.bottomRows(test), data.expressions.bottomRows(test)), Yte, mean);
+  // the surrogate's (or the linear base's alone) errors on samples [first, first + n)
+  const auto surrogate_on = [&](Index first, Index n) {
+    return surrogate_errors(net.predict(policy, data.parameters.middleRows(first, n), data.expressions.middleRows(first, n)),
+                            data.displacements.middleRows(first, n), mean);
+  };
+  const auto base_on = [&](Index first, Index n) {
+    return surrogate_errors(net.with_intercept(X.middleRows(first, n)) * net.linear_base(), data.displacements.middleRows(first, n), mean);
+  };
+  r.train = surrogate_on(0, train);
+  r.held_out = surrogate_on(train, test);
   r.mean_baseline = surrogate_errors(Eigen::MatrixXd(mean.transpose().replicate(test, 1)), Yte, mean);
-  if (o.linear_base) r.base_alone = surrogate_errors(net.with_intercept(Xte) * net.linear_base(), Yte, mean);
+  if (o.linear_base) r.base_alone = base_on(train, test);
   if (val > 0) {
-    const Eigen::MatrixXd Yval = Ytr.bottomRows(val);
-    r.validation = surrogate_errors(net.predict(policy, data.parameters.middleRows(fit, val), data.expressions.middleRows(fit, val)), Yval, mean);
-    if (o.linear_base) r.validation_base_alone = surrogate_errors(net.with_intercept(Xtr.bottomRows(val)) * net.linear_base(), Yval, mean);
+    r.validation = surrogate_on(fit, val);
+    if (o.linear_base) r.validation_base_alone = base_on(fit, val);
   }
   // ridge on the same standardized inputs, [1, z] → y, fitted on every training sample
   r.ridge_baseline = surrogate_errors(net.with_intercept(Xte) * SoftDecaSurrogate::ridge_fit(net.with_intercept(Xtr), Ytr, o.ridge_lambda), Yte, mean);

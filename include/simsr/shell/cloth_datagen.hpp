@@ -290,10 +290,11 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   // the sequences, their frame counts and fingerprints; another run's checkpoints refused first
   const auto sheets = d == ClothDataset::sheet ? sheet_sequences(count, opt.seed) : std::vector<SheetSequence>{};
   const auto disks = d == ClothDataset::disk ? disk_sequences(count, opt.seed) : std::vector<DiskSequence>{};
-  auto frames_of = [&](Index k) {
+  std::vector<Index> frames(static_cast<std::size_t>(count));
+  for (Index k = 0; k < count; ++k) {
     const double seconds = d == ClothDataset::sheet ? sheets[std::size_t(k)].duration() + opt.extra_seconds : disks[std::size_t(k)].duration();
-    return std::max<Index>(1, Index(std::llround(seconds / dt)));
-  };
+    frames[std::size_t(k)] = std::max<Index>(1, Index(std::llround(seconds / dt)));
+  }
   auto parameters_of = [&](Index k) {
     if (d == ClothDataset::sheet) {
       const SheetSequence& q = sheets[std::size_t(k)];
@@ -306,7 +307,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   std::vector<std::string> prints;
   std::vector<std::optional<io::NpzArrays>> checkpoints;
   for (Index k = 0; k < count; ++k) {
-    prints.push_back(detail::cloth_fingerprint(d, pair, opt, k, frames_of(k), parameters_of(k)));
+    prints.push_back(detail::cloth_fingerprint(d, pair, opt, k, frames[std::size_t(k)], parameters_of(k)));
     const auto partial = state / (cloth_sequence_name(d, k) + ".npz");
     checkpoints.emplace_back();
     if (!std::filesystem::exists(partial)) continue;
@@ -329,8 +330,6 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   const std::string settle_print =
       detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames, d == ClothDataset::sheet ? parameters_of(0) : std::vector<double>{});
 
-  std::vector<Index> frames(static_cast<std::size_t>(count));
-  for (Index k = 0; k < count; ++k) frames[std::size_t(k)] = frames_of(k);
   const detail::ClothDatagenRun run{d, pair, opt, dir, state, frames, prints, checkpoints, settle_print};
   std::vector<ClothSequenceStats> stats;
   if (d == ClothDataset::sheet) {
