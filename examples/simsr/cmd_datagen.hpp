@@ -23,9 +23,7 @@
 #if defined(SIMSR_HAVE_CGAL)
 #include "remeshed_wrap.hpp"
 #endif
-#if defined(SIMSR_HAVE_CHOLMOD)
-#include <simsr/physics/linear_solvers/cholmod_cholesky.hpp>
-#endif
+#include "linear_solver_choice.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -66,13 +64,9 @@ struct DatagenArgs {
 template <class Template>
 nlohmann::ordered_json softdeca_dataset_with(const DatagenArgs& a, const Template& tpl, const std::string& name, const scenario::SoftDecaDatagenOptions& o,
                                              const std::function<void(const std::string&)>& say) {
-  if (a.linear_solver == "simplicial") return scenario::generate_softdeca_dataset(exec::omp, tpl, name, o, a.out, say);
-  if (a.linear_solver != "cholmod") throw ArgumentError("--linear-solver: simplicial or cholmod (got '" + a.linear_solver + "')");
-#if defined(SIMSR_HAVE_CHOLMOD)
-  return scenario::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<physics::CholmodCholesky<>>>(exec::omp, tpl, name, o, a.out, say);
-#else
-  throw ArgumentError("--linear-solver cholmod: this simsr was built without CHOLMOD (configure with -DSIMSR_WITH_CHOLMOD=ON)");
-#endif
+  return with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) {
+    return scenario::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<typename L::type>>(exec::omp, tpl, name, o, a.out, say);
+  });
 }
 
 inline int datagen_softdeca(const DatagenArgs& a) {
@@ -152,7 +146,7 @@ inline int datagen_cloth(const DatagenArgs& a) {
                  static_cast<long long>(f + 1), static_cast<long long>(frames), sc, static_cast<long long>(rc.newton_iterations), sf,
                  static_cast<long long>(rf.newton_iterations), 1e3 * std::min(rc.deepest, rf.deepest), elapsed);
   };
-  shell::generate_cloth_data(exec::omp, d, a.out, o);
+  with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) { shell::generate_cloth_data<typename L::type>(exec::omp, d, a.out, o); });
   std::ifstream summary(std::filesystem::path(a.out) / "cloth_data.json");
   std::cout << nlohmann::ordered_json::parse(summary).dump() << '\n';
   return 0;
@@ -214,7 +208,10 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
       ->check(CLI::Range(1, 10000000));
   cmd->add_flag("--stop-on-unconverged", a->stop_on_unconverged,
                "softdeca: a sample no solver converges stops the run (default: it is left out, written to samples/*.failed.json and listed)");
-  cmd->add_option("--linear-solver", a->linear_solver, "softdeca: simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD)")->capture_default_str();
+  cmd->add_option("--linear-solver", a->linear_solver,
+                  "softdeca, sheet, disk: the Newton steps' linear solver, simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD; the same "
+                  "data to round-off, faster at the paper's sizes)")
+      ->capture_default_str();
   cmd->add_option("--template", a->softdeca_template, "softdeca: ict (the layered head from --kit) or sphere (the stand-in ball with two expressions)")
       ->capture_default_str();
   cmd->add_option("--sphere-level", a->sphere_level, "softdeca --template sphere: icosphere level of the ball (2: 162 skin vertices, 3: 642)")

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The thin-shell pipeline from the command line (issue #14): `simsr datagen --scenario sheet` at a
 reduced size (3 cells, one Loop level: 16 / 49 vertices, one sequence), its files, its summary
-and progress lines, a finished run reused, and bad options named; `simsr demo --dataset sheet` at
+and progress lines, a finished run reused, the same frames with `--linear-solver cholmod`, and bad
+options named; `simsr demo --dataset sheet` at
 the same size (5 sequences, the 5th held out; 3 epochs): its report, per-frame errors and views
 (rendered by scripts/render_comparison.py --view oblique), the core paper's local-linear map and
 network beside, a rerun that trains nothing, and the other --fine-target refused as another run's
@@ -55,6 +56,20 @@ check(lr[:, :, 2].min() < -0.1, f"the sheet was pushed down: lowest {lr[:, :, 2]
 again = simsr(*args)
 s2 = json.loads(again.stdout) if again.returncode == 0 else {}
 check(s2.get("sequences", [{}])[0].get("reused") is True and "frame" not in again.stderr, "a second run reuses the finished sequence")
+# the same data with CHOLMOD factoring the Newton steps (the test run builds the tool with it): the
+# same frames to the factorizations' round-off, and a file the simplicial run reuses (the solver is
+# no part of a dataset's fingerprint)
+chol = os.path.join(WORK, "sheet_cholmod")
+pc = simsr("datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "1", "--linear-solver", "cholmod", "--out", chol)
+if pc.returncode == 0:
+    zc = np.load(os.path.join(chol, "sheet_000.npz"))
+    gap = max(np.abs(zc["lowres"] - z["lowres"]).max(), np.abs(zc["highres"] - z["highres"]).max())
+    check(gap < 1e-7, f"--linear-solver cholmod: the same frames as simplicial ({gap:.2e} m apart)")
+    shutil.copy(os.path.join(chol, "sheet_000.npz"), os.path.join(data, "sheet_000.npz"))
+    reuse = simsr(*args)
+    check(reuse.returncode == 0 and "frame" not in reuse.stderr, "the simplicial run reuses the CHOLMOD run's file")
+bad = simsr("datagen", "--scenario", "sheet", "--linear-solver", "lu", "--out", os.path.join(WORK, "x"), expect=1)
+check("--linear-solver" in bad.stderr and "lu" in bad.stderr, f"an unknown linear solver is named: {bad.stderr.strip()[-200:]}")
 # bad options
 bad = simsr("datagen", "--scenario", "skirt", "--out", os.path.join(WORK, "x"), expect=1)
 check("skirt" in bad.stderr, f"an unknown scenario is named: {bad.stderr.strip()[-200:]}")

@@ -2,8 +2,13 @@
 // meshes, and short runs of both scenes at reduced sizes (the full sizes are the datagen's).
 #include <doctest/doctest.h>
 
+#include "../support/require.hpp"
+
 #include <simsr/shell/cloth_scenes.hpp>
 #include <simsr/shell/cloth_simulator.hpp>
+#if defined(SIMSR_HAVE_CHOLMOD)
+#include <simsr/physics/linear_solvers/cholmod_cholesky.hpp>
+#endif
 
 #include <cmath>
 #include <random>
@@ -130,6 +135,47 @@ TEST_CASE("ClothSimulator on SHEET (reduced: 25 / 81 vertices): a sphere comes d
   CHECK(halving_gap < 0.02);
   MESSAGE("Newton cut at 5 iterations: " << halvings << " steps halved, at most " << halving_gap << " m from the regular run");
   MESSAGE("SHEET 25/81: lowest " << lowest << " m, deepest " << deepest << " m, subdivided-coarse to fine gap " << worst_gap << " m of " << largest_motion << " m motion");
+}
+
+TEST_CASE("ClothSimulator's linear solver is a type: CHOLMOD steps a sheet into a pole as Eigen's LDLT does, frame after frame, halvings included") {
+#if defined(SIMSR_HAVE_CHOLMOD)
+  // SHEET at 81 fine vertices, a pole pressed into it: contact, the membrane compressed (its exact
+  // Hessian indefinite, so Newton falls back to the projected one) and, with Newton cut at 4
+  // iterations, failed steps halved: every path of a step through the solver
+  const ClothPair pair = cloth_pair(ClothDataset::sheet, {4, 1});
+  SheetSequence seq;
+  seq.pole = true;
+  seq.radius = 0.04;
+  seq.centre = Vec3<>(0.08, 0.02, -0.2);
+  seq.heading = 0.4;
+  seq.descent_time = 0.4;
+  seq.hold_time = 0.1;
+  seq.start_height = 0.3;
+  auto move = [&](physics::Capsule<>& o, double t) { o = seq.obstacle_at(t); };
+  ClothOptions o;
+  o.newton.max_iterations = 4;
+  ClothSimulator<physics::Capsule<>> simplicial(pair.fine, pair.pinned, seq.obstacle_at(0), {}, o);
+  ClothSimulator<physics::Capsule<>, physics::CholmodCholesky<>> cholmod(pair.fine, pair.pinned, seq.obstacle_at(0), {}, o);
+  Index halvings = 0, iterations = 0;
+  double worst = 0, motion = 0;
+  for (Index f = 0; f < 12; ++f) {
+    const ClothFrameReport a = simplicial.advance(exec::omp, move), b = cholmod.advance(exec::omp, move);
+    CHECK(a.newton_iterations == b.newton_iterations);
+    CHECK(a.halvings == b.halvings);
+    halvings += a.halvings;
+    iterations += a.newton_iterations;
+    worst = std::max(worst, (cholmod.positions() - simplicial.positions()).cwiseAbs().maxCoeff());
+    motion = std::max(motion, (simplicial.positions() - pair.fine.V).cwiseAbs().maxCoeff());
+  }
+  CHECK(halvings > 0);
+  CHECK(motion > 0.1);
+  // the same steps to the factorizations' round-off (amplified by the halved steps' unconverged
+  // solves: 1e-15 m where no step is halved, ~1e-9 m here; a wrong solve would be millimetres off)
+  CHECK(worst <= 1e-7 * motion);
+  MESSAGE("CHOLMOD vs LDLT over 12 frames (" << iterations << " Newton iterations, " << halvings << " halvings): " << worst << " m apart of " << motion << " m motion");
+#else
+  SIMSR_MISSING("CHOLMOD: configure with -DSIMSR_WITH_CHOLMOD=ON (apt-get install libsuitesparse-dev) to test ClothSimulator with physics::CholmodCholesky");
+#endif
 }
 
 TEST_CASE("ClothSimulator on DISK (reduced: 37 vertices): the cloth drapes over the table and the wind pushes it downwind; the centre stays") {

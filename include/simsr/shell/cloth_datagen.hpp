@@ -141,8 +141,8 @@ struct ClothDatagenRun {
 struct ClothPairState {
   Points<> x[2], previous[2];
   double last_step[2] = {0, 0};
-  template <class O>
-  static ClothPairState of(const ClothSimulator<O>& coarse, const ClothSimulator<O>& fine) {
+  template <class Sim>
+  static ClothPairState of(const Sim& coarse, const Sim& fine) {
     ClothPairState s;
     s.x[0] = coarse.positions(), s.previous[0] = coarse.previous_positions(), s.last_step[0] = coarse.last_step();
     s.x[1] = fine.positions(), s.previous[1] = fine.previous_positions(), s.last_step[1] = fine.last_step();
@@ -164,8 +164,8 @@ struct ClothPairState {
     z["coarse_last_step"] = io::make_npy<double>({}, &last_step[0]);
     z["fine_last_step"] = io::make_npy<double>({}, &last_step[1]);
   }
-  template <class O>
-  void set(ClothSimulator<O>& coarse, ClothSimulator<O>& fine, Index steps) const {
+  template <class Sim>
+  void set(Sim& coarse, Sim& fine, Index steps) const {
     coarse.set_state(x[0], previous[0], steps, last_step[0]);
     fine.set_state(x[1], previous[1], steps, last_step[1]);
   }
@@ -173,8 +173,8 @@ struct ClothPairState {
 
 /// The settled start of every sequence: read from DIR/.state/settled.npz when it is this run's,
 /// else settled (`settle_frames` with the obstacle `still`) and written there.
-template <exec::HostPolicy P, class O>
-ClothPairState settled_cloth_start(P policy, const ClothDatagenRun& run, ClothSimulator<O>& coarse, ClothSimulator<O>& fine,
+template <exec::HostPolicy P, class O, class Linear>
+ClothPairState settled_cloth_start(P policy, const ClothDatagenRun& run, ClothSimulator<O, Linear>& coarse, ClothSimulator<O, Linear>& fine,
                                    const std::function<void(O&, double)>& still) {
   const auto file = run.state / "settled.npz";
   if (std::filesystem::exists(file)) {
@@ -195,8 +195,8 @@ ClothPairState settled_cloth_start(P policy, const ClothDatagenRun& run, ClothSi
 
 /// Sequence k from `start_state` (or from its checkpoint) into DIR/<name>.npz, checkpointing as
 /// it goes; a finished file of this run is reused. Returns its figures.
-template <exec::HostPolicy P, class O, class AirFor>
-ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run, Index k, ClothSimulator<O>& coarse, ClothSimulator<O>& fine,
+template <exec::HostPolicy P, class O, class Linear, class AirFor>
+ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run, Index k, ClothSimulator<O, Linear>& coarse, ClothSimulator<O, Linear>& fine,
                                            const ClothPairState& start_state, const std::function<void(O&, double)>& move, const AirFor& air_for) {
   const Index N = run.coarse_vertices(), M = run.fine_vertices();
   const ClothDatagenOptions& opt = run.opt;
@@ -260,12 +260,12 @@ ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run,
 /// One scene's sequences (a function template over the obstacle type, since SHEET's and DISK's
 /// differ): make_obstacle(k) the obstacle at the start of sequence k (k < 0: while settling),
 /// move_for(k) its motion, air_for(k, t) the air. Appends each sequence's figures to `stats`.
-template <exec::HostPolicy P, class MakeObstacle, class MoveFor, class AirFor>
+template <class Linear, exec::HostPolicy P, class MakeObstacle, class MoveFor, class AirFor>
 void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstacle& make_obstacle, const MoveFor& move_for, const AirFor& air_for,
                           std::vector<ClothSequenceStats>& stats) {
   using O = std::decay_t<decltype(make_obstacle(Index(0)))>;
-  ClothSimulator<O> coarse(run.pair.coarse, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
-  ClothSimulator<O> fine(run.pair.fine, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
+  ClothSimulator<O, Linear> coarse(run.pair.coarse, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
+  ClothSimulator<O, Linear> fine(run.pair.fine, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
   const std::function<void(O&, double)> still = [&](O& o, double) { o = make_obstacle(-1); };
   const ClothPairState start = settled_cloth_start(policy, run, coarse, fine, still);
   for (Index k = 0; k < Index(run.frames.size()); ++k)
@@ -275,8 +275,12 @@ void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstac
 }  // namespace detail
 
 /// Simulates the dataset into `dir` (see the file comment). Returns the figures of this run,
-/// also written to DIR/cloth_data.json.
-template <exec::HostPolicy P>
+/// also written to DIR/cloth_data.json. Linear is both simulators' Newton linear solver
+/// (ClothSimulator): the data is the same to the solver's round-off whichever it is, so it is no
+/// part of the fingerprint and a run may be resumed with the other one;
+/// `generate_cloth_data<physics::CholmodCholesky<>>(...)` is ~3× faster at the fine SHEET's 4,225
+/// vertices (README).
+template <class Linear = physics::SparseCholesky<>, exec::HostPolicy P>
 std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, const std::filesystem::path& dir, const ClothDatagenOptions& opt = {}) {
   if (opt.checkpoint_every < 1) throw ArgumentError("generate_cloth_data: checkpoint_every must be >= 1");
   if (opt.settle_frames < 0) throw ArgumentError("generate_cloth_data: settle_frames must be >= 0");
@@ -333,12 +337,12 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   const detail::ClothDatagenRun run{d, pair, opt, dir, state, frames, prints, checkpoints, settle_print};
   std::vector<ClothSequenceStats> stats;
   if (d == ClothDataset::sheet) {
-    detail::simulate_cloth_scene(
+    detail::simulate_cloth_scene<Linear>(
         policy, run, [&](Index k) { return k < 0 ? sheets[0].obstacle_at(0) : sheets[std::size_t(k)].obstacle_at(0); },
         [&](Index k) { return std::function<void(physics::Capsule<>&, double)>([&, k](physics::Capsule<>& o, double t) { o = sheets[std::size_t(k)].obstacle_at(t); }); },
         [](Index, double) { return Air{}; }, stats);
   } else {
-    detail::simulate_cloth_scene(
+    detail::simulate_cloth_scene<Linear>(
         policy, run, [](Index) { return disk_table(); }, [](Index) { return std::function<void(physics::RoundedCylinder<>&, double)>(); },
         [&](Index k, double t) { return disks[std::size_t(k)].air_at(t); }, stats);
   }
