@@ -65,7 +65,7 @@ template <class Template>
 nlohmann::ordered_json softdeca_dataset_with(const DatagenArgs& a, const Template& tpl, const std::string& name, const scenario::SoftDecaDatagenOptions& o,
                                              const std::function<void(const std::string&)>& say) {
   return with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) {
-    return scenario::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<typename L::type>>(exec::omp, tpl, name, o, a.out, say);
+    return scenario::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<L>>(exec::omp, tpl, name, o, a.out, say);
   });
 }
 
@@ -146,7 +146,7 @@ inline int datagen_cloth(const DatagenArgs& a) {
                  static_cast<long long>(f + 1), static_cast<long long>(frames), sc, static_cast<long long>(rc.newton_iterations), sf,
                  static_cast<long long>(rf.newton_iterations), 1e3 * std::min(rc.deepest, rf.deepest), elapsed);
   };
-  with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) { shell::generate_cloth_data<typename L::type>(exec::omp, d, a.out, o); });
+  with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) { shell::generate_cloth_data<L>(exec::omp, d, a.out, o); });
   std::ifstream summary(std::filesystem::path(a.out) / "cloth_data.json");
   std::cout << nlohmann::ordered_json::parse(summary).dump() << '\n';
   return 0;

@@ -54,7 +54,7 @@ int cloth_demo_cmd(DemoArgs& a) {
   c.network.fine_target = shell::parse_fine_target(a.fine_target);
   if (c.baselines == std::vector<std::string>{"none"}) c.baselines.clear();
   const auto report = with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) {
-    return shell::run_cloth_demo<typename L::type>(exec::omp, c, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
+    return shell::run_cloth_demo<L>(exec::omp, c, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
   });
   std::cout << shell::cloth_report_text(report) << "report: " << (c.out / "report.json").string() << "; files people open: "
             << (c.out / "results" / "frame_errors.csv").string() << " and " << (c.out / "results").string() << "/*_errors.svg (per frame), " << (c.out / "results" / "compare").string()

@@ -1,0 +1,99 @@
+// The thin-shell cloth simulator (issue #14; Chen et al. 2023's data): one frame of the SHEET
+// scene at each resolution the supplement names, with Eigen's simplicial LDLᵀ (the default) and,
+// built with -DSIMSR_WITH_CHOLMOD=ON, CHOLMOD's supernodal LLᵀ factoring the Newton steps. At the
+// fine sizes the factorization is nearly all of a step, so the ratio of the two is what
+// `simsr datagen --scenario sheet --linear-solver cholmod` saves. The supplement's ARCSim took
+// 2.48 s per frame at SHEET's 4,225 vertices (another machine, another simulator).
+//
+// Scenes: SHEET's coarse 8 × 8 cells (81 vertices) Loop-subdivided to the named fine size:
+//   sheet_81     the coarse cloth itself
+//   sheet_1089   Loop ×2 (the ×16 faces the README's SHEET figures use)
+//   sheet_4225   Loop ×3 (the paper's SHEET: ×64 faces)
+// Each iteration restores the same state (the cloth settled 12 frames under a pole coming down,
+// about to touch it) and simulates the next 4 frames with the pole pressing in: contact, the
+// membrane in compression, halved steps where Newton fails, as in the datagen.
+//
+// Cases (wall clock, ms per 4 frames; counters: newton_per_frame, s_per_newton):
+//   BM_cloth_frames/<scene>/simplicial
+//   BM_cloth_frames/<scene>/cholmod            (-DSIMSR_WITH_CHOLMOD=ON)
+//
+// Run: OMP_NUM_THREADS=2 build/benchmarks/bench_shell [--benchmark_filter=4225]
+// CHOLMOD's supernodal kernels are BLAS: with Debian's reference BLAS they are ~3× slower than
+// with OpenBLAS (scripts/deps.sh test installs libopenblas0-pthread).
+#include <benchmark/benchmark.h>
+
+#if defined(SIMSR_HAVE_CHOLMOD)
+#include <simsr/physics/linear_solvers/cholmod_cholesky.hpp>
+#endif
+#include <simsr/shell/cloth_scenes.hpp>
+#include <simsr/shell/cloth_simulator.hpp>
+
+#include <string>
+
+namespace {
+
+using namespace simsr;
+using namespace simsr::shell;
+
+/// The pole of every case: across the sheet, slightly off centre, pressing 15 cm in.
+SheetSequence pole() {
+  SheetSequence s;
+  s.pole = true;
+  s.radius = 0.04;
+  s.centre = Vec3<>(0.06, -0.04, -0.15);
+  s.heading = 0.5;
+  s.descent_time = 0.6;
+  s.hold_time = 0.5;
+  s.start_height = 0.35;
+  return s;
+}
+
+constexpr Index warmup_frames = 12, timed_frames = 4;
+
+template <class Linear>
+void cloth_frames(benchmark::State& state, Index levels) {
+  const ClothPair pair = cloth_pair(ClothDataset::sheet, {8, levels});
+  const SheetSequence seq = pole();
+  ClothSimulator<physics::Capsule<>, Linear> sim(pair.fine, pair.pinned, seq.obstacle_at(0));
+  const auto move = [&](physics::Capsule<>& o, double t) { o = seq.obstacle_at(t); };
+  for (Index f = 0; f < warmup_frames; ++f) sim.advance(exec::omp, move);
+  const Points<> x = sim.positions(), previous = sim.previous_positions();
+  const Index steps = sim.steps();
+  const double last = sim.last_step();
+  Index newton = 0, frames = 0;
+  for (auto _ : state) {
+    sim.set_state(x, previous, steps, last);
+    for (Index f = 0; f < timed_frames; ++f) newton += sim.advance(exec::omp, move).newton_iterations;
+    frames += timed_frames;
+  }
+  state.counters["newton_per_frame"] = double(newton) / double(frames);
+  state.counters["s_per_newton"] = benchmark::Counter(double(newton), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["vertices"] = double(pair.fine.V.rows());
+}
+
+void register_cases() {
+  for (const auto& [name, levels] : {std::pair<const char*, Index>{"sheet_81", 0}, {"sheet_1089", 2}, {"sheet_4225", 3}}) {
+    const Index l = levels;
+    benchmark::RegisterBenchmark((std::string("BM_cloth_frames/") + name + "/simplicial").c_str(),
+                                 [l](benchmark::State& s) { cloth_frames<physics::SparseCholesky<>>(s, l); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+#if defined(SIMSR_HAVE_CHOLMOD)
+    benchmark::RegisterBenchmark((std::string("BM_cloth_frames/") + name + "/cholmod").c_str(),
+                                 [l](benchmark::State& s) { cloth_frames<physics::CholmodCholesky<>>(s, l); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+#endif
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  register_cases();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
