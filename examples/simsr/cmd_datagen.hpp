@@ -58,6 +58,7 @@ struct DatagenArgs {
   double skin_edge = 0;
   // sheet / disk
   Index sequences = 0, cells = 0, levels = -1;
+  CLI::Option* seed_given = nullptr;  ///< sheet/disk: without --seed, the library's (the demo's) seed
 };
 
 /// The dataset with the linear solver --linear-solver names.
@@ -135,7 +136,7 @@ inline int datagen_cloth(const DatagenArgs& a) {
   shell::ClothDatagenOptions o;
   o.size = shell::scene_size(d, a.cells, a.levels);
   o.sequences = a.sequences;
-  o.seed = a.seed;
+  if (a.seed_given->count() > 0) o.seed = a.seed;  // else ClothDatagenOptions' (7): the data `simsr demo --dataset sheet|disk` simulates
   o.checkpoint_every = a.checkpoint_every;
   const auto start = std::chrono::steady_clock::now();
   o.on_frame = [start](const std::string& seq, Index f, Index frames, const shell::ClothFrameReport& rc, const shell::ClothFrameReport& rf, double sc,
@@ -223,7 +224,10 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
       ->capture_default_str();
   cmd->add_option("--controls", a->controls, "a controls file (.npz: names C strings, weights F×C), simulated as a performance named after the file (less a trailing _controls)");
   cmd->add_option("--frames", a->frames, "frames per built-in performance")->capture_default_str()->check(CLI::Range(14, 100000));
-  cmd->add_option("--seed", a->seed, "seed of the built-in performances (softdeca: of the parameter sampler)")->capture_default_str();
+  a->seed_given = cmd->add_option("--seed", a->seed,
+                                  "seed of the built-in performances (softdeca: of the parameter sampler; sheet/disk: of the sequences, default 7 "
+                                  "as simsr demo's)")
+                       ->capture_default_str();
   cmd->add_option("--preset", a->preset, "mesh sizes: default (LR 10.8k tets, 12.5x fewer than HR), paper-ratio (26x), paper-lr (LR 73k tets, the paper's)")->capture_default_str();
   cmd->add_option("--lr-cell", a->lr_cell, "LR BCC cell size in cm (overrides the preset)")->check(CLI::PositiveNumber);
   cmd->add_option("--skull-lattice", a->skull_lattice, "skull surface resolution in cm (overrides the preset)")->check(CLI::PositiveNumber);

@@ -39,6 +39,7 @@ summary = json.loads(p.stdout) if p.returncode == 0 else {}
 check(summary.get("coarse", {}).get("vertices") == 16 and summary.get("fine", {}).get("vertices") == 49, f"16 / 49 vertices: {summary}")
 seqs = summary.get("sequences", [])
 check(len(seqs) == 1 and seqs[0].get("name") == "sheet_000" and seqs[0].get("split") == "train", f"one training sequence: {seqs}")
+check(summary.get("seed") == 7, f"without --seed the demo's sequences (seed 7): {summary.get('seed')}")
 frames = seqs[0].get("frames", 0) if seqs else 0
 check(frames > 60, f"a sequence of seconds at 30 frames per second: {frames} frames")
 check(p.stderr.count("sheet_000 frame ") >= frames // 10, "a progress line per 10 frames on stderr")
