@@ -9,14 +9,11 @@
 #endif
 
 #include <string>
-#include <type_traits>
 
 namespace simsr::cli {
 
 template <class L>
-struct LinearSolverTag {
-  using type = L;
-};
+struct LinearSolverTag {};
 
 /// f(LinearSolverTag<L>{}) with L the solver `name` names; ArgumentError for another name, or for
 /// cholmod in a build without CHOLMOD.

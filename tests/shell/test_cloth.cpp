@@ -150,7 +150,7 @@ TEST_CASE("ClothSimulator's linear solver is a type: CHOLMOD steps a sheet into 
   seq.heading = 0.4;
   seq.descent_time = 0.4;
   seq.hold_time = 0.1;
-  seq.start_height = 0.3;
+  seq.start_height = 0.05;  // touching within the first frames
   auto move = [&](physics::Capsule<>& o, double t) { o = seq.obstacle_at(t); };
   ClothOptions o;
   o.newton.max_iterations = 4;
@@ -158,7 +158,7 @@ TEST_CASE("ClothSimulator's linear solver is a type: CHOLMOD steps a sheet into 
   ClothSimulator<physics::Capsule<>, physics::CholmodCholesky<>> cholmod(pair.fine, pair.pinned, seq.obstacle_at(0), {}, o);
   Index halvings = 0, iterations = 0;
   double worst = 0, motion = 0;
-  for (Index f = 0; f < 12; ++f) {
+  for (Index f = 0; f < 6; ++f) {
     const ClothFrameReport a = simplicial.advance(exec::omp, move), b = cholmod.advance(exec::omp, move);
     CHECK(a.newton_iterations == b.newton_iterations);
     CHECK(a.halvings == b.halvings);
@@ -168,11 +168,11 @@ TEST_CASE("ClothSimulator's linear solver is a type: CHOLMOD steps a sheet into 
     motion = std::max(motion, (simplicial.positions() - pair.fine.V).cwiseAbs().maxCoeff());
   }
   CHECK(halvings > 0);
-  CHECK(motion > 0.1);
+  CHECK(motion > 0.05);
   // the same steps to the factorizations' round-off (amplified by the halved steps' unconverged
   // solves: 1e-15 m where no step is halved, ~1e-9 m here; a wrong solve would be millimetres off)
   CHECK(worst <= 1e-7 * motion);
-  MESSAGE("CHOLMOD vs LDLT over 12 frames (" << iterations << " Newton iterations, " << halvings << " halvings): " << worst << " m apart of " << motion << " m motion");
+  MESSAGE("CHOLMOD vs LDLT over 6 frames (" << iterations << " Newton iterations, " << halvings << " halvings): " << worst << " m apart of " << motion << " m motion");
 #else
   SIMSR_MISSING("CHOLMOD: configure with -DSIMSR_WITH_CHOLMOD=ON (apt-get install libsuitesparse-dev) to test ClothSimulator with physics::CholmodCholesky");
 #endif
