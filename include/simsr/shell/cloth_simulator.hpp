@@ -75,11 +75,10 @@ struct ClothFrameReport {
 /// step's linear solver (physics::LinearSolver): SparseCholesky (Eigen's simplicial LDLᵀ, the
 /// default) or, built with CHOLMOD, physics::CholmodCholesky (supernodal; the same steps to
 /// round-off, 2.7× faster at the paper's 4,225 fine vertices, where the factorization is nearly
-/// all of a step: benchmarks/bench_shell.cpp).
+/// all of a step: benchmarks/bench_shell.cpp). A Linear that is not a LinearSolver stops the build
+/// with QuasistaticSolver's one sentence.
 template <physics::Obstacle O, class Linear = physics::SparseCholesky<>>
 class ClothSimulator {
-  static_assert(physics::assert_linear_solver<Linear>());
-
  public:
   /// `rest` the cloth at rest (its start), `pinned` the vertices held there. ArgumentError for a
   /// bad material or option (checked by the terms too), MeshError for a bad surface or pin.
