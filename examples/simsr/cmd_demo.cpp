@@ -105,6 +105,10 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
                   "sheet/disk: the data's Newton linear solver, simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD; the same data to "
                   "round-off, ~3x faster at the paper's 4,225 fine vertices)")
       ->capture_default_str();
+  cmd->add_option("--sequence-workers", cl.data.sequence_workers,
+                  "sheet/disk: sequences simulated at once, one thread each (0: OMP_NUM_THREADS; the same data for any count)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   cmd->add_option("--baseline-epochs", cl.baseline_network.epochs, "sheet/disk: epochs of the core paper's network (the network baseline)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

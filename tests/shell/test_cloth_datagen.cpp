@@ -108,4 +108,48 @@ TEST_CASE("cloth datagen (DISK, reduced): the wind's sequences, the draped start
   CHECK_FALSE(again[2].reused);
 }
 
+TEST_CASE("cloth datagen: sequences side by side are bitwise the sequences one at a time; a failed sequence ends the run, the others' kept") {
+  test::ScratchDir one("simsr_test_cloth_one"), three("simsr_test_cloth_three"), failing("simsr_test_cloth_failing");
+  ClothDatagenOptions opt = small_sheet();
+  opt.sequences = 3;
+  opt.sequence_workers = 1;
+  const auto a = generate_cloth_data(exec::omp, ClothDataset::sheet, one.path, opt);
+  opt.sequence_workers = 3;
+  Index calls = 0;
+  opt.on_frame = [&](const std::string&, Index, Index, const ClothFrameReport&, const ClothFrameReport&, double, double) { ++calls; };
+  const auto b = generate_cloth_data(exec::omp, ClothDataset::sheet, three.path, opt);
+  REQUIRE(a.size() == 3);
+  REQUIRE(b.size() == 3);
+  Index frames = 0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    CHECK(a[k].name == b[k].name);  // in sequence order, whichever worker finished first
+    CHECK(a[k].frames == b[k].frames);
+    CHECK(a[k].fine_iterations == b[k].fine_iterations);
+    CHECK(a[k].subdivided_rmse == b[k].subdivided_rmse);
+    frames += b[k].frames;
+    const auto p = data::read_paired_frames(one.path / (a[k].name + ".npz")), q = data::read_paired_frames(three.path / (b[k].name + ".npz"));
+    CHECK(p.lowres == q.lowres);
+    CHECK(p.highres == q.highres);
+  }
+  CHECK(calls == frames);  // every frame reported, the counter never raced (calls are serialized)
+
+  // the first sequence fails at its 3rd frame: its error ends the run after the second sequence,
+  // which another worker had, is finished and written
+  opt.sequence_workers = 2;
+  opt.on_frame = [&](const std::string& seq, Index f, Index, const ClothFrameReport&, const ClothFrameReport&, double, double) {
+    if (seq == a[0].name && f == 2) throw std::runtime_error("sequence 0 failed at frame 2");
+  };
+  CHECK(test::typed_error_of<std::runtime_error>([&] { generate_cloth_data(exec::omp, ClothDataset::sheet, failing.path, opt); }) == "sequence 0 failed at frame 2");
+  CHECK_FALSE(std::filesystem::exists(failing.path / (a[0].name + ".npz")));
+  CHECK(std::filesystem::exists(failing.path / (a[1].name + ".npz")));
+
+  // several workers need exec::omp; a negative count is refused, both before anything is written
+  opt.on_frame = nullptr;
+  test::ScratchDir refused("simsr_test_cloth_refused");
+  CHECK(test::error_of([&] { generate_cloth_data(exec::seq, ClothDataset::sheet, refused.path / "d", opt); }).find("exec::seq") != std::string::npos);
+  opt.sequence_workers = -1;
+  CHECK_THROWS_AS(generate_cloth_data(exec::omp, ClothDataset::sheet, refused.path / "d", opt), ArgumentError);
+  CHECK_FALSE(std::filesystem::exists(refused.path / "d"));
+}
+
 }  // namespace shell_test_cloth_datagen

@@ -75,10 +75,18 @@ class MeshConv {
     const Adjacency& A = *graph_;
     const Index V = A.num_vertices(), R = in.rows();
     const Index nc = exec::chunk_count(R, product_chunks);
+    const Index C = in.cols();
     exec::for_chunks(policy, R, nc, exec::worker_count(policy, nc), [&](Index, Index, Index lo, Index hi) {
+      // raw rows (d_in and d_mean_ are packed R×C): Eigen's row expressions of a few channels
+      // cost more in bookkeeping than in adds; the same operations in the same order
       for (Index r = lo; r < hi; ++r) {
         const Index base = r - r % V, j = r % V;
-        for (const VIndex i : A[j]) d_in->row(r) += d_mean_.row(base + i) / S(A.degree(i));
+        S* d = d_in->data() + r * C;
+        for (const VIndex i : A[j]) {
+          const S* g = d_mean_.data() + (base + i) * C;
+          const S deg = S(A.degree(i));
+          for (Index c = 0; c < C; ++c) d[c] += g[c] / deg;
+        }
       }
     });
   }
@@ -95,12 +103,18 @@ class MeshConv {
     const Index V = A.num_vertices(), R = in.rows();
     ensure_shape(M, R, in.cols());
     const Index nc = exec::chunk_count(R, product_chunks);
+    const Index C = in.cols(), ld = in.outerStride();
     exec::for_chunks(policy, R, nc, exec::worker_count(policy, nc), [&](Index, Index, Index lo, Index hi) {
-      for (Index r = lo; r < hi; ++r) {
+      for (Index r = lo; r < hi; ++r) {  // raw rows, as in backward
         const Index base = r - r % V, i = r % V;
-        M.row(r).setZero();
-        for (const VIndex j : A[i]) M.row(r) += in.row(base + j);
-        M.row(r) /= S(A.degree(i));
+        S* m = M.data() + r * C;
+        for (Index c = 0; c < C; ++c) m[c] = S(0);
+        for (const VIndex j : A[i]) {
+          const S* x = in.data() + (base + j) * ld;
+          for (Index c = 0; c < C; ++c) m[c] += x[c];
+        }
+        const S deg = S(A.degree(i));
+        for (Index c = 0; c < C; ++c) m[c] /= deg;
       }
     });
   }
