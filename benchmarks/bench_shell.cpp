@@ -17,6 +17,14 @@
 //   BM_cloth_frames/<scene>/simplicial
 //   BM_cloth_frames/<scene>/cholmod            (-DSIMSR_WITH_CHOLMOD=ON)
 //
+// The detail-synthesis network's training (shell/detail_synthesis.hpp), the supplement's sizes
+// (9 channels, 16-d latent, 3 input frames) on SHEET's coarse 81 and fine <scene> vertices:
+//   BM_synthesis_train_step/<scene>           one Adam step on 16 windows of random features
+//                                             (an epoch of the 32-sequence SHEET is ~190 steps)
+//   BM_tanh/<scene>/eigen                     nn::Tanh<float> forward on one step's fine-encoder
+//   BM_tanh/<scene>/libm                      input (64 frames × fine vertices × 9); beside it the
+//                                             per-element std::tanh loop nn::Tanh ran before
+//
 // Run: OMP_NUM_THREADS=2 build/benchmarks/bench_shell [--benchmark_filter=4225]
 // CHOLMOD's supernodal kernels are BLAS: with Debian's reference BLAS they are ~3× slower than
 // with OpenBLAS (scripts/deps.sh test installs libopenblas0-pthread).
@@ -27,7 +35,9 @@
 #endif
 #include <simsr/shell/cloth_scenes.hpp>
 #include <simsr/shell/cloth_simulator.hpp>
+#include <simsr/shell/detail_synthesis.hpp>
 
+#include <cmath>
 #include <string>
 
 namespace {
@@ -71,6 +81,42 @@ void cloth_frames(benchmark::State& state, Index levels) {
   state.counters["vertices"] = double(pair.fine.V.rows());
 }
 
+/// One training step of the detail-synthesis network at SHEET's coarse 81 / fine (Loop ×levels)
+/// vertices, on one 40-frame sequence of random normalized features, 16 windows per step.
+void synthesis_train_step(benchmark::State& state, Index levels) {
+  const ClothPair pair = cloth_pair(ClothDataset::sheet, {8, levels});
+  const Index N = pair.coarse.V.rows(), M = pair.fine.V.rows();
+  DetailSynthesisNet<float> net(vertex_adjacency(pair.coarse.F, N), vertex_adjacency(pair.fine.F, M), {}, 1);
+  nn::Rng rng(3);
+  std::vector<SequenceFeatures<float>> seqs(1);
+  seqs[0].frames = 40;
+  seqs[0].coarse = nn::Matrix<float>::Random(40 * N, ts_acap_feature_dim);
+  seqs[0].fine = nn::Matrix<float>::Random(40 * M, ts_acap_feature_dim);
+  SynthesisBatch batch;
+  for (Index i = 0; i < 16; ++i) batch.windows.push_back({0, 2 * i});
+  net.train_step(exec::omp, seqs, batch, rng);  // warm: every buffer sized
+  for (auto _ : state) benchmark::DoNotOptimize(net.train_step(exec::omp, seqs, batch, rng).total());
+  state.counters["fine_vertices"] = double(M);
+}
+
+/// nn::Tanh's forward against the per-element std::tanh loop, on one step's fine-encoder input.
+void tanh_forward(benchmark::State& state, Index levels, bool libm) {
+  const Index M = cloth_pair(ClothDataset::sheet, {8, levels}).fine.V.rows();
+  const nn::Matrix<float> x = nn::Matrix<float>::Random(64 * M, ts_acap_feature_dim) * 3.0f;
+  nn::Matrix<float> y(x.rows(), x.cols());
+  nn::Tanh<float> act;
+  for (auto _ : state) {
+    if (libm) {
+      for (Index i = 0; i < x.size(); ++i) y.data()[i] = std::tanh(x.data()[i]);
+    } else {
+      act.forward(exec::omp, nn::Mode::train, x, y);
+    }
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * x.size());
+}
+
 void register_cases() {
   for (const auto& [name, levels] : {std::pair<const char*, Index>{"sheet_81", 0}, {"sheet_1089", 2}, {"sheet_4225", 3}}) {
     const Index l = levels;
@@ -84,6 +130,17 @@ void register_cases() {
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
 #endif
+  }
+  for (const auto& [name, levels] : {std::pair<const char*, Index>{"sheet_1089", 2}, {"sheet_4225", 3}}) {
+    const Index l = levels;
+    benchmark::RegisterBenchmark((std::string("BM_synthesis_train_step/") + name).c_str(), [l](benchmark::State& s) { synthesis_train_step(s, l); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    for (const bool libm : {false, true})
+      benchmark::RegisterBenchmark((std::string("BM_tanh/") + name + (libm ? "/libm" : "/eigen")).c_str(),
+                                   [l, libm](benchmark::State& s) { tanh_forward(s, l, libm); })
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
   }
 }
 

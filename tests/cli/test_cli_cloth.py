@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The thin-shell pipeline from the command line (issue #14): `simsr datagen --scenario sheet` at a
 reduced size (3 cells, one Loop level: 16 / 49 vertices, one sequence), its files, its summary
-and progress lines, a finished run reused, the same frames with `--linear-solver cholmod`, and bad
+and progress lines, a finished run reused, the same frames with `--linear-solver cholmod` and with
+two sequences side by side (`--sequence-workers 2`), and bad
 options named; `simsr demo --dataset sheet` at
 the same size (5 sequences, the 5th held out; 3 epochs): its report, per-frame errors and views
 (rendered by scripts/render_comparison.py --view oblique), the core paper's local-linear map and
@@ -69,6 +70,19 @@ if pc.returncode == 0:
     shutil.copy(os.path.join(chol, "sheet_000.npz"), os.path.join(data, "sheet_000.npz"))
     reuse = simsr(*args)
     check(reuse.returncode == 0 and "frame" not in reuse.stderr, "the simplicial run reuses the CHOLMOD run's file")
+# two sequences side by side (--sequence-workers 2) and one at a time: bitwise the same files
+side = {}
+for w in ("1", "2"):
+    out = os.path.join(WORK, f"sheet_workers{w}")
+    pw = simsr("datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "2", "--sequence-workers", w, "--out", out)
+    check(pw.returncode == 0 and pw.stderr.count("sheet_001 frame ") > 0, f"--sequence-workers {w}: both sequences simulated")
+    side[w] = out
+if all(os.path.exists(os.path.join(o, "sheet_001.npz")) for o in side.values()):
+    for name in ("sheet_000.npz", "sheet_001.npz"):
+        a, b = np.load(os.path.join(side["1"], name)), np.load(os.path.join(side["2"], name))
+        check((a["lowres"] == b["lowres"]).all() and (a["highres"] == b["highres"]).all(), f"--sequence-workers 2: {name} bitwise as with 1")
+bad = simsr("datagen", "--scenario", "sheet", "--sequence-workers", "-1", "--out", os.path.join(WORK, "x"), expect=1)
+check("--sequence-workers" in bad.stderr, f"a negative worker count is refused: {bad.stderr.strip()[-200:]}")
 bad = simsr("datagen", "--scenario", "sheet", "--linear-solver", "lu", "--out", os.path.join(WORK, "x"), expect=1)
 check("--linear-solver" in bad.stderr and "lu" in bad.stderr, f"an unknown linear solver is named: {bad.stderr.strip()[-200:]}")
 # bad options
