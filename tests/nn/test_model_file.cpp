@@ -1,3 +1,5 @@
+#include <doctest/doctest.h>
+
 #include "network_fixture.hpp"
 
 #include <simsr/nn/model_file.hpp>
