@@ -75,6 +75,7 @@ struct ClothDatagenOptions {
   /// at a time (under a lock); what it throws ends that sequence (its checkpoint kept) and, once
   /// the other workers' sequences are done, the run.
   std::function<void(const std::string&, Index, Index, const ClothFrameReport&, const ClothFrameReport&, double, double)> on_frame;
+  using FrameCallback = decltype(on_frame);
 };
 
 /// One sequence's figures.
@@ -151,6 +152,7 @@ struct ClothDatagenRun {
   const std::vector<std::string>& prints;
   const std::vector<std::optional<io::NpzArrays>>& checkpoints;
   const std::string& settle_print;
+  Index workers;  ///< sequences at once (sequence_worker_count)
   Index coarse_vertices() const { return pair.coarse.V.rows(); }
   Index fine_vertices() const { return pair.fine.V.rows(); }
 };
@@ -212,10 +214,12 @@ ClothPairState settled_cloth_start(P policy, const ClothDatagenRun& run, ClothSi
 }
 
 /// Sequence k from `start_state` (or from its checkpoint) into DIR/<name>.npz, checkpointing as
-/// it goes; a finished file of this run is reused. Returns its figures.
+/// it goes, `on_frame` (may be empty) after every frame; a finished file of this run is reused.
+/// Returns its figures.
 template <exec::HostPolicy P, class O, class Linear, class AirFor>
 ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run, Index k, ClothSimulator<O, Linear>& coarse, ClothSimulator<O, Linear>& fine,
-                                           const ClothPairState& start_state, const std::function<void(O&, double)>& move, const AirFor& air_for) {
+                                           const ClothPairState& start_state, const std::function<void(O&, double)>& move, const AirFor& air_for,
+                                           const ClothDatagenOptions::FrameCallback& on_frame) {
   const Index N = run.coarse_vertices(), M = run.fine_vertices();
   const ClothDatagenOptions& opt = run.opt;
   ClothSequenceStats st;
@@ -259,7 +263,7 @@ ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run,
     st.halvings += rc.halvings + rf.halvings;
     st.deepest = std::min({st.deepest, rc.deepest, rf.deepest});
     ++st.simulated;
-    if (opt.on_frame) opt.on_frame(st.name, f, F, rc, rf, sc, sf);
+    if (on_frame) on_frame(st.name, f, F, rc, rf, sc, sf);
     const Index done = f + 1;
     if (done < F && done % opt.checkpoint_every == 0) {
       io::NpzArrays z = data::frames_checkpoint(out, done, print);
@@ -296,28 +300,30 @@ template <class Linear, exec::HostPolicy P, class MakeObstacle, class MoveFor, c
 void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstacle& make_obstacle, const MoveFor& move_for, const AirFor& air_for,
                           std::vector<ClothSequenceStats>& stats) {
   using O = std::decay_t<decltype(make_obstacle(Index(0)))>;
-  ClothSimulator<O, Linear> coarse(run.pair.coarse, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
-  ClothSimulator<O, Linear> fine(run.pair.fine, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
+  using Sim = ClothSimulator<O, Linear>;
+  auto simulator = [&](const TriMesh<>& cloth) { return Sim(cloth, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation); };
+  auto sequence = [&](auto pol, Index k, Sim& c, Sim& f, const ClothPairState& start, const ClothDatagenOptions::FrameCallback& on_frame) {
+    return simulate_cloth_sequence(pol, run, k, c, f, start, std::function<void(O&, double)>(move_for(k)), air_for, on_frame);
+  };
+  Sim coarse = simulator(run.pair.coarse), fine = simulator(run.pair.fine);
   const std::function<void(O&, double)> still = [&](O& o, double) { o = make_obstacle(-1); };
-  const Index count = Index(run.frames.size());
-  const Index workers = std::min(count, sequence_worker_count(policy, run.opt));
   const ClothPairState start = settled_cloth_start(policy, run, coarse, fine, still);
+  const Index count = Index(run.frames.size()), workers = std::min(count, run.workers);
   if (workers <= 1) {
-    for (Index k = 0; k < count; ++k)
-      stats.push_back(simulate_cloth_sequence(policy, run, k, coarse, fine, start, std::function<void(O&, double)>(move_for(k)), air_for));
+    for (Index k = 0; k < count; ++k) stats.push_back(sequence(policy, k, coarse, fine, start, run.opt.on_frame));
     return;
   }
-  // Side by side: each worker its own pair of simulators and the next sequence not yet taken;
-  // on_frame under a lock. A failed sequence stops its worker; the others finish the sequence
-  // they have and take no new one (nothing simulated is lost), then the first error is thrown.
+  // Side by side: each worker its own pair of simulators and the next sequence not yet taken,
+  // run with exec::seq; on_frame under a lock. A failed sequence stops its worker; the others
+  // finish the sequence they have and take no new one (nothing simulated is lost), then the
+  // first error is thrown.
   std::mutex lock;
-  ClothDatagenOptions locked_opt = run.opt;
+  ClothDatagenOptions::FrameCallback locked;
   if (run.opt.on_frame)
-    locked_opt.on_frame = [&](const std::string& s, Index f, Index F, const ClothFrameReport& c, const ClothFrameReport& fi, double sc, double sf) {
+    locked = [&](const std::string& s, Index f, Index F, const ClothFrameReport& c, const ClothFrameReport& fi, double sc, double sf) {
       const std::lock_guard<std::mutex> hold(lock);
       run.opt.on_frame(s, f, F, c, fi, sc, sf);
     };
-  const ClothDatagenRun worker_run{run.dataset, run.pair, locked_opt, run.dir, run.state, run.frames, run.prints, run.checkpoints, run.settle_print};
   std::vector<ClothSequenceStats> done(static_cast<std::size_t>(count));
   std::atomic<Index> next{0};
   std::atomic<bool> failed{false};
@@ -325,10 +331,8 @@ void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstac
   auto work = [&] {
     try {
       const EigenSingleThreaded eigen_serial;  // this thread's Eigen products stay on it
-      ClothSimulator<O, Linear> c(run.pair.coarse, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
-      ClothSimulator<O, Linear> f(run.pair.fine, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation);
-      for (Index k; !failed.load() && (k = next.fetch_add(1)) < count;)
-        done[std::size_t(k)] = simulate_cloth_sequence(exec::seq, worker_run, k, c, f, start, std::function<void(O&, double)>(move_for(k)), air_for);
+      Sim c = simulator(run.pair.coarse), f = simulator(run.pair.fine);
+      for (Index k; !failed.load() && (k = next.fetch_add(1)) < count;) done[std::size_t(k)] = sequence(exec::seq, k, c, f, start, locked);
     } catch (...) {
       const std::lock_guard<std::mutex> hold(lock);
       if (!error) error = std::current_exception();
@@ -354,7 +358,7 @@ void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstac
 template <class Linear = physics::SparseCholesky<>, exec::HostPolicy P>
 std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, const std::filesystem::path& dir, const ClothDatagenOptions& opt = {}) {
   if (opt.checkpoint_every < 1) throw ArgumentError("generate_cloth_data: checkpoint_every must be >= 1");
-  detail::sequence_worker_count(policy, opt);  // its ArgumentError before anything is written
+  const Index workers = detail::sequence_worker_count(policy, opt);  // its ArgumentError before anything is written
   if (opt.settle_frames < 0) throw ArgumentError("generate_cloth_data: settle_frames must be >= 0");
   if (!(opt.extra_seconds >= 0) || !std::isfinite(opt.extra_seconds)) throw ArgumentError("generate_cloth_data: extra_seconds must be finite and >= 0");
   const ClothSceneSize size = opt.size.levels < 0 ? default_scene_size(d) : opt.size;
@@ -406,7 +410,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   const std::string settle_print =
       detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames, d == ClothDataset::sheet ? parameters_of(0) : std::vector<double>{});
 
-  const detail::ClothDatagenRun run{d, pair, opt, dir, state, frames, prints, checkpoints, settle_print};
+  const detail::ClothDatagenRun run{d, pair, opt, dir, state, frames, prints, checkpoints, settle_print, workers};
   std::vector<ClothSequenceStats> stats;
   if (d == ClothDataset::sheet) {
     detail::simulate_cloth_scene<Linear>(
