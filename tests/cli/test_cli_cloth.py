@@ -117,10 +117,16 @@ rows = open(csv).read().strip().splitlines() if os.path.exists(csv) else []
 check(test_frames > 0 and len(rows) == test_frames + 1 and all(r.startswith("sheet_004,") for r in rows[1:]), f"a csv row per held-out frame: {len(rows)}")
 # the RMSE in the report is the root mean square of the csv's per-frame figures
 if len(rows) > 1:
-    sub = np.array([float(r.split(",")[2]) for r in rows[1:]])
-    check(abs(np.sqrt(np.mean(sub ** 2)) - rm.get("subdivided", 0)) < 1e-9, "the csv and the report agree")
+    header = rows[0].split(",")
+    check(header == ["sequence", "frame", "subdivided_m", "synthesized_m", "refined_m", "local_linear_m", "upsampling_network_m"], f"the csv's columns: {header}")
+    cols = np.array([[float(x) for x in r.split(",")[2:]] for r in rows[1:]])
+    rms = np.sqrt(np.mean(cols ** 2, axis=0))
+    check(abs(rms[0] - rm.get("subdivided", 0)) < 1e-9, "the csv and the report agree")
+    # the baselines' per-frame columns are the frames of their per-sequence figures
+    for j, key in ((3, "local_linear_m"), (4, "upsampling_network_m")):
+        check(cols.shape[1] > j and abs(rms[j] - seq0.get(key, 0)) < 1e-9, f"the csv's {key} column and the report agree")
 svg = os.path.join(demo, "results", "sheet_004_errors.svg")
-check(os.path.exists(svg) and open(svg).read().count("<polyline") >= 3, "the held-out sequence's per-frame plot, three series")
+check(os.path.exists(svg) and open(svg).read().count("<polyline") == 5, "the held-out sequence's per-frame plot, five series (three + two baselines)")
 cmp_root = os.path.join(demo, "results", "compare")
 views = sorted(os.listdir(cmp_root)) if os.path.isdir(cmp_root) else []
 check(len(views) == 1 and views[0].startswith("sheet_004_"), f"one view folder for the held-out sequence: {views}")

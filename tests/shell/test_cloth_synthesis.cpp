@@ -254,9 +254,12 @@ TEST_CASE("evaluate_upsampling: the core paper's methods on a cloth pair, whose 
   CHECK(e1.frames == d.sequences[4].num_frames());
   double sum = 0;
   Points<> hr(49, 3);
+  REQUIRE(e1.sequences[0].frame_rmse.size() == std::size_t(test.num_frames()));
   for (Index f = 0; f < test.num_frames(); ++f) {
     local.apply(exec::seq, Points<>(test.lr(f) - problem.lr.V), hr);
-    sum += (problem.hr.V + hr - test.hr(f)).squaredNorm();
+    const double frame = (problem.hr.V + hr - test.hr(f)).squaredNorm();
+    CHECK(e1.sequences[0].frame_rmse[std::size_t(f)] == doctest::Approx(std::sqrt(frame / 49)).epsilon(1e-9));
+    sum += frame;
   }
   CHECK(e1.rmse == doctest::Approx(std::sqrt(sum / double(test.num_frames() * 49))).epsilon(1e-9));
   CHECK(e1.rmse > e0.rmse);

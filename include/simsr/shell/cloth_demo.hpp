@@ -10,6 +10,7 @@
 ///   OUT/network/train.npz         the training checkpoint
 ///   OUT/network/upsampling_network.npz  the core paper's network's checkpoint (the "network" baseline)
 ///   OUT/results/frame_errors.csv  per held-out frame: RMS distance of subdivided / synthesized / refined
+///                                 and of each baseline (a column `<method>_m`)
 ///   OUT/results/<seq>_errors.svg  the same per held-out sequence as a plot (any browser)
 ///   OUT/results/compare/<seq>_<f>/  lr_input.vtu (coarse), subdivided / synthesized / refined.vtu
 ///                                 with their per-vertex `error` (m), truth.vtu: each held-out
@@ -155,9 +156,6 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   const ClothEvaluation e = run.evaluate(policy, [&](Index q, const std::vector<Points<>>& raw, const std::vector<Points<>>& refined,
                                                      const ClothSequenceEvaluation& ev) {
     const ClothSequenceFrames& s = data.sequences[std::size_t(q)];
-    eval::write_svg_plot(results / (s.name + "_errors.svg"),
-                         {{"subdivided", ev.frame_subdivided}, {"synthesized", ev.frame_synthesized}, {"refined", ev.frame_refined}},
-                         s.name + ": RMS distance to the fine simulation per frame", "RMS distance (m)");
     const auto worst = std::size_t(std::max_element(ev.frame_subdivided.begin(), ev.frame_subdivided.end()) - ev.frame_subdivided.begin());
     const auto dir = results / "compare" / (s.name + "_" + std::to_string(worst));
     std::filesystem::create_directories(dir);
@@ -180,13 +178,25 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   // the core paper's upsampling methods on the same held-out sequences
   const std::vector<ClothUpsamplingEvaluation> baselines = run_cloth_baselines(policy, o, data, net_dir, tell);
 
+  // per held-out frame, every method: the CSV and one plot per sequence
   std::ostringstream csv;
   csv.precision(17);
-  csv << "sequence,frame,subdivided_m,synthesized_m,refined_m\n";
-  for (const auto& s : e.sequences)
-    for (Index f = 0; f < s.frames; ++f)
-      csv << s.name << ',' << f << ',' << s.frame_subdivided[std::size_t(f)] << ',' << s.frame_synthesized[std::size_t(f)] << ','
-          << s.frame_refined[std::size_t(f)] << '\n';
+  csv << "sequence,frame,subdivided_m,synthesized_m,refined_m";
+  for (const auto& b : baselines) csv << ',' << b.method << "_m";
+  csv << '\n';
+  for (std::size_t q = 0; q < e.sequences.size(); ++q) {
+    const ClothSequenceEvaluation& s = e.sequences[q];
+    for (Index f = 0; f < s.frames; ++f) {
+      const auto i = std::size_t(f);
+      csv << s.name << ',' << f << ',' << s.frame_subdivided[i] << ',' << s.frame_synthesized[i] << ',' << s.frame_refined[i];
+      for (const auto& b : baselines) csv << ',' << b.sequences[q].frame_rmse[i];
+      csv << '\n';
+    }
+    std::vector<eval::Series> series{
+        {"subdivided", s.frame_subdivided}, {"synthesized", s.frame_synthesized}, {"refined", s.frame_refined}};
+    for (const auto& b : baselines) series.push_back({b.method, b.sequences[q].frame_rmse});
+    eval::write_svg_plot(results / (s.name + "_errors.svg"), series, s.name + ": RMS distance to the fine simulation per frame", "RMS distance (m)");
+  }
   io::write_file_atomic(results / "frame_errors.csv", csv.str());
 
   // the simulation's cost per frame, from the dataset's summary (frames simulated in any run)

@@ -75,6 +75,7 @@ struct ClothUpsamplingEvaluation {
     std::string name;
     Index frames = 0;
     double rmse = 0;
+    std::vector<double> frame_rmse;  ///< per frame: RMS vertex distance (m)
   };
   std::vector<Sequence> sequences;
   double rmse = 0;
@@ -105,14 +106,18 @@ ClothUpsamplingEvaluation evaluate_upsampling(P policy, const ClothData& d, inte
   for (const auto& s : d.sequences) {
     if (!s.test) continue;
     double sum = 0;
+    std::vector<double> per_frame;
+    per_frame.reserve(std::size_t(s.num_frames()));
     for (Index f = 0; f < s.num_frames(); ++f) {
       lr_disp = s.coarse[std::size_t(f)] - problem.lr.V;
       const auto t = clock::now();
       method.apply(policy, lr_disp, hr_disp);
       apply_seconds += std::chrono::duration<double>(clock::now() - t).count();
-      sum += (problem.hr.V + hr_disp - s.fine[std::size_t(f)]).rowwise().squaredNorm().mean();
+      const double msd = (problem.hr.V + hr_disp - s.fine[std::size_t(f)]).rowwise().squaredNorm().mean();
+      per_frame.push_back(std::sqrt(msd));
+      sum += msd;
     }
-    e.sequences.push_back({s.name, s.num_frames(), std::sqrt(sum / double(s.num_frames()))});
+    e.sequences.push_back({s.name, s.num_frames(), std::sqrt(sum / double(s.num_frames())), std::move(per_frame)});
     total += sum;
     e.frames += s.num_frames();
   }
