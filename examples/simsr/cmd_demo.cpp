@@ -105,6 +105,9 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
                   "sheet/disk: the data's Newton linear solver, simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD; the same data to "
                   "round-off, ~3x faster at the paper's 4,225 fine vertices)")
       ->capture_default_str();
+  cmd->add_option("--substeps", cl.data.simulation.substeps, "sheet/disk: backward-Euler steps per frame (the same for both resolutions)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--sequence-workers", cl.data.sequence_workers,
                   "sheet/disk: sequences simulated at once, one thread each (0: OMP_NUM_THREADS; the same data for any count)")
       ->capture_default_str()

@@ -41,6 +41,8 @@ check(summary.get("coarse", {}).get("vertices") == 16 and summary.get("fine", {}
 seqs = summary.get("sequences", [])
 check(len(seqs) == 1 and seqs[0].get("name") == "sheet_000" and seqs[0].get("split") == "train", f"one training sequence: {seqs}")
 check(summary.get("seed") == 7, f"without --seed the demo's sequences (seed 7): {summary.get('seed')}")
+check(summary.get("substeps") == 2, f"without --substeps the scene's own (sheet 2): {summary.get('substeps')}")
+check(seqs and seqs[0].get("scene", {}).get("obstacle") == "pole", f"the sequence's parameters (sequence 0: the pole): {seqs[:1]}")
 frames = seqs[0].get("frames", 0) if seqs else 0
 check(frames > 60, f"a sequence of seconds at 30 frames per second: {frames} frames")
 check(p.stderr.count("sheet_000 frame ") >= frames // 10, "a progress line per 10 frames on stderr")
@@ -81,6 +83,12 @@ if all(os.path.exists(os.path.join(o, "sheet_001.npz")) for o in side.values()):
     for name in ("sheet_000.npz", "sheet_001.npz"):
         a, b = np.load(os.path.join(side["1"], name)), np.load(os.path.join(side["2"], name))
         check((a["lowres"] == b["lowres"]).all() and (a["highres"] == b["highres"]).all(), f"--sequence-workers 2: {name} bitwise as with 1")
+# --substeps: another step is another run (simulated again), and its count is in the summary
+p3 = simsr("datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "1", "--substeps", "3", "--out", os.path.join(WORK, "sheet_substeps3"))
+s3 = json.loads(p3.stdout) if p3.returncode == 0 else {}
+check(s3.get("substeps") == 3 and s3.get("sequences", [{}])[0].get("simulated") == frames, f"--substeps 3: {s3.get('substeps')}")
+bad = simsr("datagen", "--scenario", "sheet", "--substeps", "-1", "--out", os.path.join(WORK, "x"), expect=1)
+check("--substeps" in bad.stderr, f"a negative substep count is refused: {bad.stderr.strip()[-200:]}")
 bad = simsr("datagen", "--scenario", "sheet", "--sequence-workers", "-1", "--out", os.path.join(WORK, "x"), expect=1)
 check("--sequence-workers" in bad.stderr, f"a negative worker count is refused: {bad.stderr.strip()[-200:]}")
 bad = simsr("datagen", "--scenario", "sheet", "--linear-solver", "lu", "--out", os.path.join(WORK, "x"), expect=1)

@@ -51,6 +51,17 @@ TEST_CASE("cloth datagen (SHEET, reduced): every sequence at both resolutions, t
   CHECK(json["coarse"]["vertices"] == 16);
   CHECK(json["fine"]["vertices"] == 49);
   CHECK(json["sequences"].size() == 2);
+  CHECK(json["substeps"] == 2);  // SHEET's own (opt leaves it 0)
+  // each sequence's parameters, as sheet_sequences drew them
+  const auto drawn = sheet_sequences(2, opt.seed);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& scene = json["sequences"][k]["scene"];
+    CHECK(scene["obstacle"] == (drawn[k].pole ? "pole" : "sphere"));
+    CHECK(scene["radius_m"].get<double>() == drawn[k].radius);
+    CHECK(scene["heading_rad"].get<double>() == drawn[k].heading);
+    CHECK(scene["centre_m"][2].get<double>() == drawn[k].centre.z());
+    CHECK(scene["hold_s"].get<double>() == drawn[k].hold_time);
+  }
   CHECK(cloth_sequence_is_test(4));
   CHECK_FALSE(cloth_sequence_is_test(3));
 
@@ -98,6 +109,29 @@ TEST_CASE("cloth datagen (DISK, reduced): the wind's sequences, the draped start
   MESSAGE("DISK 19/61: mean fine-vertex motion over the sequence, 1 m/s wind " << moved_a << " m, 8 m/s " << moved_b << " m");
   CHECK(moved_b > moved_a);
   CHECK(stats[0].deepest > -0.01);
+  // the step count and each sequence's wind in the summary
+  const auto json = nlohmann::json::parse(std::ifstream(dir.path / "cloth_data.json"));
+  CHECK(json["substeps"] == 2);
+  CHECK(json["sequences"][1]["scene"]["wind_m_per_s"].get<double>() == doctest::Approx(8));
+  CHECK(json["sequences"][0]["scene"]["heading_rad"].get<double>() == disk_sequences(2, opt.seed)[0].heading);
+  // another step count is another run (a copy of the first file is not reused) with other frames
+  {
+    test::ScratchDir four_dir("simsr_test_cloth_disk_four");
+    std::filesystem::create_directories(four_dir.path);
+    std::filesystem::copy_file(dir.path / "disk_000.npz", four_dir.path / "disk_000.npz");
+    ClothDatagenOptions four = opt;
+    four.sequences = 1;
+    four.simulation.substeps = 4;
+    const auto other = generate_cloth_data(exec::omp, ClothDataset::disk, four_dir.path, four);
+    CHECK_FALSE(other[0].reused);
+    CHECK(nlohmann::json::parse(std::ifstream(four_dir.path / "cloth_data.json"))["substeps"] == 4);
+    const auto c = data::read_paired_frames(four_dir.path / "disk_000.npz");
+    CHECK((c.hr(c.num_frames() - 1) - a.hr(a.num_frames() - 1)).cwiseAbs().maxCoeff() > 0);
+    ClothDatagenOptions none = four;
+    none.simulation.substeps = 0;
+    CHECK(test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::seq, ClothDataset::disk, four_dir.path, none); }).find("substeps") !=
+          std::string::npos);
+  }
   // three sequences spread the speeds 1, 4.5, 8 m/s: the first file is the same sequence and is
   // reused, the second (8 m/s before) is another one and is simulated again
   opt.sequences = 3;

@@ -69,7 +69,7 @@ struct ClothDatagenOptions {
   /// fingerprint: the frames are bitwise the same for any count.
   Index sequence_workers = 0;
   ClothMaterial material;
-  ClothOptions simulation;
+  ClothOptions simulation;  ///< frame time, substeps (`simsr datagen --substeps`), Newton's options, ...
   /// Called after every simulated frame: sequence, frame, frames, both reports, seconds (coarse,
   /// fine). With several workers it is called from the worker simulating that sequence, one call
   /// at a time (under a lock); what it throws ends that sequence (its checkpoint kept) and, once
@@ -102,6 +102,15 @@ inline std::string cloth_sequence_name(ClothDataset d, Index k) {
 
 /// Held out: every 5th sequence (4, 9, 14, ...), so each SHEET obstacle kind is in both sets.
 inline bool cloth_sequence_is_test(Index k) { return k % 5 == 4; }
+
+/// A sequence's parameters as JSON (the dataset summary's record of what was simulated).
+inline nlohmann::ordered_json to_json(const SheetSequence& s) {
+  return {{"obstacle", s.pole ? "pole" : "sphere"}, {"radius_m", s.radius}, {"centre_m", {s.centre.x(), s.centre.y(), s.centre.z()}},
+          {"heading_rad", s.heading}, {"descent_s", s.descent_time}, {"hold_s", s.hold_time}, {"start_height_m", s.start_height}};
+}
+inline nlohmann::ordered_json to_json(const DiskSequence& s) {
+  return {{"wind_m_per_s", s.speed}, {"heading_rad", s.heading}, {"gust", s.gust}, {"gust_period_s", s.gust_period}, {"duration_s", s.duration_s}};
+}
 
 namespace detail {
 
@@ -357,6 +366,7 @@ void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstac
 /// vertices (README).
 template <class Linear = physics::SparseCholesky<>, exec::HostPolicy P>
 std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, const std::filesystem::path& dir, const ClothDatagenOptions& opt = {}) {
+  if (opt.simulation.substeps < 1) throw ArgumentError("generate_cloth_data: substeps must be >= 1, got " + std::to_string(opt.simulation.substeps));
   if (opt.checkpoint_every < 1) throw ArgumentError("generate_cloth_data: checkpoint_every must be >= 1");
   const Index workers = detail::sequence_worker_count(policy, opt);  // its ArgumentError before anything is written
   if (opt.settle_frames < 0) throw ArgumentError("generate_cloth_data: settle_frames must be >= 0");
@@ -431,12 +441,15 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   j["fine"] = {{"vertices", M}, {"triangles", pair.fine.F.rows()}, {"loop_levels", size.levels}};
   j["seed"] = opt.seed;
   j["frame_time_s"] = dt;
+  j["substeps"] = opt.simulation.substeps;
   nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
   Index train_frames = 0, test_frames = 0;
-  for (const auto& s : stats) {
+  for (std::size_t k = 0; k < stats.size(); ++k) {
+    const ClothSequenceStats& s = stats[k];
     (s.test ? test_frames : train_frames) += s.frames;
     nlohmann::ordered_json e{{"name", s.name}, {"split", s.test ? "test" : "train"}, {"frames", s.frames}, {"reused", s.reused},
                              {"simulated", s.simulated}, {"subdivided_rmse_m", s.subdivided_rmse}};
+    e["scene"] = d == ClothDataset::sheet ? to_json(sheets[k]) : to_json(disks[k]);
     if (s.simulated > 0) {
       e["coarse_seconds_per_frame"] = s.coarse_seconds / double(s.simulated);
       e["fine_seconds_per_frame"] = s.fine_seconds / double(s.simulated);

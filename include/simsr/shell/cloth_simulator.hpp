@@ -58,7 +58,10 @@ struct ClothOptions {
   double damping = 0.02;         ///< ImplicitInertia β (s): velocity-proportional damping
   Vec3<> gravity{0, 0, -9.81};   ///< m/s²
   double contact_stiffness = 2e6;  ///< κ (N/m³): vertex i's penalty stiffness is κ A_i, a triangle point's κ A_t / 4
-  physics::NewtonOptions newton{.relative_tolerance = 1e-6, .max_iterations = 30, .progress = {}};
+  /// Newton's options. The Hessian `regularized` (shifted where it is indefinite, not projected):
+  /// a hanging cloth buckles, and with the projected fallback Newton stalled and halved steps
+  /// (physics::NewtonOptions::Hessian).
+  physics::NewtonOptions newton{.relative_tolerance = 1e-6, .max_iterations = 30, .hessian = physics::NewtonOptions::Hessian::regularized, .progress = {}};
   /// A step whose Newton solve fails is taken as two half steps, recursively, at most this deep
   /// (1/16 of a step at 4); beyond it the ConvergenceError is thrown.
   Index max_halvings = 4;
