@@ -5,7 +5,6 @@
 #include <simsr/physics/elastic_energy.hpp>
 #include <simsr/physics/forces/bone_attachment.hpp>
 #include <simsr/physics/forces/gravity.hpp>
-#include <simsr/physics/forces/implicit_inertia.hpp>
 #include <simsr/physics/forces/triangle_membrane.hpp>
 #include <simsr/physics/materials/materials.hpp>
 #include <simsr/physics/quasistatic.hpp>
