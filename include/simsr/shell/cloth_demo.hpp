@@ -126,8 +126,9 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   gen.on_frame = [&](const std::string& s, Index f, Index F, const ClothFrameReport& c, const ClothFrameReport& fi, double sc, double sf) {
     if (user_frame) user_frame(s, f, F, c, fi, sc, sf);
     if ((f + 1) % 20 == 0 || f + 1 == F) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "data: %s frame %lld/%lld (coarse %.3f s, fine %.3f s)", s.c_str(), (long long)(f + 1), (long long)F, sc, sf);
+      char buf[240];
+      std::snprintf(buf, sizeof buf, "data: %s frame %lld/%lld (this frame: coarse %.3f s, fine %.3f s, %lld Newton iterations, %lld steps halved)",
+                    s.c_str(), (long long)(f + 1), (long long)F, sc, sf, (long long)fi.newton_iterations, (long long)fi.halvings);
       tell(buf);
     }
   };
