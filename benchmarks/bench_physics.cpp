@@ -461,7 +461,9 @@ BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid, exec::omp_t, false)->Name("BM_linear
 // towards the centre, up to 3 cm out of plane; the same start every iteration) solved back to
 // its flat rest to ‖g‖ ≤ 1e-10 × force scale. The compression makes the exact Hessian indefinite,
 // as in DISK's hanging tablecloth (README, "Thin shells"); counters: Newton iterations, how many
-// used the projected Hessian and how many the shifted one.
+// used the projected Hessian and how many the shifted one. One run (OMP_NUM_THREADS=1, another
+// job beside it): adaptive 41 iterations (8 projected) in 0.78 s, regularized 119 (87 shifted) in
+// 5.5 s: far from the solution without inertia, the shifted steps are too short.
 template <NewtonOptions::Hessian mode>
 void BM_newton_crumpled(benchmark::State& state) {
   const TriMesh<> sheet = square_sheet(1.0, 32);
