@@ -42,7 +42,7 @@ seqs = summary.get("sequences", [])
 check(len(seqs) == 1 and seqs[0].get("name") == "sheet_000" and seqs[0].get("split") == "train", f"one training sequence: {seqs}")
 check(summary.get("seed") == 7, f"without --seed the demo's sequences (seed 7): {summary.get('seed')}")
 check(summary.get("substeps") == 2, f"without --substeps the scene's own (sheet 2): {summary.get('substeps')}")
-check(seqs and seqs[0].get("scene", {}).get("obstacle") == "pole", f"the sequence's parameters (sequence 0: the pole): {seqs[:1]}")
+check(seqs and seqs[0].get("scene", {}).get("pole") == 1 and "heading_rad" in seqs[0]["scene"], f"the sequence's parameters (sequence 0: the pole): {seqs[:1]}")
 frames = seqs[0].get("frames", 0) if seqs else 0
 check(frames > 60, f"a sequence of seconds at 30 frames per second: {frames} frames")
 check(p.stderr.count("sheet_000 frame ") >= frames // 10, "a progress line per 10 frames on stderr")

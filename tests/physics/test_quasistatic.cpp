@@ -11,6 +11,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "stvk_material.hpp"
@@ -205,11 +206,12 @@ TEST_CASE("Hessian::regularized: where the exact Hessian is indefinite it is shi
   const TriMesh<> sheet = square_sheet(1.0, 8);
   const Index n = sheet.V.rows();
   const TriangleMembrane<> stretch(n, sheet.V, sheet.F, 50.0);
-  DirichletBoundary<> rim;
-  std::vector<VIndex> ids;
-  for (Index i = 0; i < n; ++i)
-    if (sheet.V(i, 0) < 1e-9 || sheet.V(i, 0) > 1 - 1e-9 || sheet.V(i, 1) < 1e-9 || sheet.V(i, 1) > 1 - 1e-9) ids.push_back(VIndex(i));
-  rim.vertices = Eigen::Map<IndexVector>(ids.data(), Index(ids.size()));
+  const Edges rim_edges = boundary_edges(sheet.F);
+  std::vector<VIndex> ids(rim_edges.data(), rim_edges.data() + rim_edges.size());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  REQUIRE(ids.size() == 32);  // the 8×8-cell sheet's rim
+  DirichletBoundary<> rim{Eigen::Map<IndexVector>(ids.data(), Index(ids.size())), Points<>()};
   rim.targets = sheet.V(rim.vertices, Eigen::all);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1, 1);

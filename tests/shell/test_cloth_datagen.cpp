@@ -52,16 +52,18 @@ TEST_CASE("cloth datagen (SHEET, reduced): every sequence at both resolutions, t
   CHECK(json["fine"]["vertices"] == 49);
   CHECK(json["sequences"].size() == 2);
   CHECK(json["substeps"] == 2);  // SHEET's own (opt leaves it 0)
-  // each sequence's parameters, as sheet_sequences drew them
+  // each sequence's parameters, as sheet_sequences drew them (the fingerprint's values, named)
   const auto drawn = sheet_sequences(2, opt.seed);
   for (std::size_t k = 0; k < 2; ++k) {
     const auto& scene = json["sequences"][k]["scene"];
-    CHECK(scene["obstacle"] == (drawn[k].pole ? "pole" : "sphere"));
+    CHECK(scene.size() == 9);
+    CHECK(scene["pole"].get<double>() == double(drawn[k].pole));
     CHECK(scene["radius_m"].get<double>() == drawn[k].radius);
     CHECK(scene["heading_rad"].get<double>() == drawn[k].heading);
-    CHECK(scene["centre_m"][2].get<double>() == drawn[k].centre.z());
+    CHECK(scene["centre_z_m"].get<double>() == drawn[k].centre.z());
     CHECK(scene["hold_s"].get<double>() == drawn[k].hold_time);
   }
+  CHECK(json["sequences"][0]["scene"]["pole"] == 1);  // sequence 0 is the pole
   CHECK(cloth_sequence_is_test(4));
   CHECK_FALSE(cloth_sequence_is_test(3));
 

@@ -156,6 +156,9 @@ class BlockHessian {
     return scalar_;
   }
 
+  /// The matrix the last assemble() returned (its values as assembled then).
+  const SparseMatrix<S>& assembled() const { return scalar_; }
+
   /// Whether every block is a multiple of the identity, c·I (exactly: the terms of projective
   /// dynamics add only such blocks). Then the matrix is A ⊗ I₃ with A the #V×#V matrix of the
   /// c's, and a solver can factor A (a third of the unknowns, a ninth of the nonzeros) and

@@ -243,23 +243,29 @@ class QuasistaticSolver {
     return one.converged || d == Definiteness::project;
   }
 
-  /// Hessian::regularized: after the exact Hessian (still in H_) failed, solves (H + τ m I) d =
-  /// rhs_ for τ = 10⁻³, 10⁻², … ≤ 10², the first that factors and descends. Returns that τ, or 0
-  /// when none did (the caller then projects).
+  /// Hessian::regularized: after the exact Hessian failed (the matrix H_ last assembled), solves
+  /// (H + τ m I) d = rhs_ for τ = 10⁻³, 10⁻², … ≤ 10², the first that factors and descends.
+  /// Returns that τ, or 0 when none did (the caller then projects).
   template <class P>
   double shifted_direction(P policy, LinearSolveInfo& info) {
-    const SparseMatrix<S>& A = H_.assemble(policy, fixed_);
-    shifted_ = A;
-    const Index N = A.rows();
+    const SparseMatrix<S>& A = H_.assembled();
+    shifted_ = A;  // the same pattern: its storage is reused after the first call
+    shifted_diagonal_.clear();
     double m = 0;
-    Index free = 0;
-    for (Index i = 0; i < N; ++i)
-      if (!fixed_[std::size_t(i)]) m += std::abs(double(A.coeff(i, i))), ++free;
-    if (free == 0 || !(m > 0)) return 0;
-    m /= double(free);
+    for (Index i = 0; i < A.rows(); ++i) {  // the stored diagonal entries (no insertion: the pointers stay valid)
+      if (fixed_[std::size_t(i)]) continue;
+      const auto* begin = shifted_.innerIndexPtr() + shifted_.outerIndexPtr()[i];
+      const auto* end = shifted_.innerIndexPtr() + shifted_.outerIndexPtr()[i + 1];
+      const auto* at = std::lower_bound(begin, end, i);
+      if (at == end || *at != i) continue;
+      S* a = shifted_.valuePtr() + (at - shifted_.innerIndexPtr());
+      shifted_diagonal_.push_back({a, *a});
+      m += std::abs(double(*a));
+    }
+    if (shifted_diagonal_.empty() || !(m > 0)) return 0;
+    m /= double(shifted_diagonal_.size());
     for (double tau = 1e-3; tau <= 1e2 * (1 + 1e-9); tau *= 10) {
-      for (Index i = 0; i < N; ++i)
-        if (!fixed_[std::size_t(i)]) shifted_.coeffRef(i, i) = A.coeff(i, i) + S(tau * m);
+      for (auto& [entry, exact] : shifted_diagonal_) *entry = exact + S(tau * m);
       try {
         linear_.compute(policy, shifted_, H_.pattern_version());
       } catch (const ConvergenceError&) {
@@ -284,6 +290,7 @@ class QuasistaticSolver {
   Points<S> term_grad_, trial_;
   VecX<S> g_, rhs_, d_;
   SparseMatrix<S> shifted_;  ///< Hessian::regularized's H + τ m I (kept: its storage is reused)
+  std::vector<std::pair<S*, S>> shifted_diagonal_;  ///< its free diagonal entries and their exact values
   double magnitude_ = 0;
 };
 

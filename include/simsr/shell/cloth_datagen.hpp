@@ -103,15 +103,6 @@ inline std::string cloth_sequence_name(ClothDataset d, Index k) {
 /// Held out: every 5th sequence (4, 9, 14, ...), so each SHEET obstacle kind is in both sets.
 inline bool cloth_sequence_is_test(Index k) { return k % 5 == 4; }
 
-/// A sequence's parameters as JSON (the dataset summary's record of what was simulated).
-inline nlohmann::ordered_json to_json(const SheetSequence& s) {
-  return {{"obstacle", s.pole ? "pole" : "sphere"}, {"radius_m", s.radius}, {"centre_m", {s.centre.x(), s.centre.y(), s.centre.z()}},
-          {"heading_rad", s.heading}, {"descent_s", s.descent_time}, {"hold_s", s.hold_time}, {"start_height_m", s.start_height}};
-}
-inline nlohmann::ordered_json to_json(const DiskSequence& s) {
-  return {{"wind_m_per_s", s.speed}, {"heading_rad", s.heading}, {"gust", s.gust}, {"gust_period_s", s.gust_period}, {"duration_s", s.duration_s}};
-}
-
 namespace detail {
 
 /// The fingerprint of a sequence's (or the settled start's: sequence −1) file: the meshes, the
@@ -366,7 +357,7 @@ void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstac
 /// vertices (README).
 template <class Linear = physics::SparseCholesky<>, exec::HostPolicy P>
 std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, const std::filesystem::path& dir, const ClothDatagenOptions& opt = {}) {
-  if (opt.simulation.substeps < 1) throw ArgumentError("generate_cloth_data: substeps must be >= 1, got " + std::to_string(opt.simulation.substeps));
+  checked_cloth_options(opt.simulation);  // before anything is written
   if (opt.checkpoint_every < 1) throw ArgumentError("generate_cloth_data: checkpoint_every must be >= 1");
   const Index workers = detail::sequence_worker_count(policy, opt);  // its ArgumentError before anything is written
   if (opt.settle_frames < 0) throw ArgumentError("generate_cloth_data: settle_frames must be >= 0");
@@ -385,19 +376,17 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     const double seconds = d == ClothDataset::sheet ? sheets[std::size_t(k)].duration() + opt.extra_seconds : disks[std::size_t(k)].duration();
     frames[std::size_t(k)] = std::max<Index>(1, Index(std::llround(seconds / dt)));
   }
-  auto parameters_of = [&](Index k) {
-    if (d == ClothDataset::sheet) {
-      const SheetSequence& q = sheets[std::size_t(k)];
-      return std::vector<double>{double(q.pole), q.radius, q.centre.x(), q.centre.y(), q.centre.z(), q.heading, q.descent_time, q.hold_time, q.start_height};
-    }
-    const DiskSequence& q = disks[std::size_t(k)];
-    return std::vector<double>{q.speed, q.heading, q.gust, q.gust_period, q.duration_s};
+  auto parameters_of = [&](Index k) { return d == ClothDataset::sheet ? sequence_parameters(sheets[std::size_t(k)]) : sequence_parameters(disks[std::size_t(k)]); };
+  auto values_of = [&](Index k) {
+    std::vector<double> v;
+    for (const auto& p : parameters_of(k)) v.push_back(p.value);
+    return v;
   };
   const auto state = dir / ".state";
   std::vector<std::string> prints;
   std::vector<std::optional<io::NpzArrays>> checkpoints;
   for (Index k = 0; k < count; ++k) {
-    prints.push_back(detail::cloth_fingerprint(d, pair, opt, k, frames[std::size_t(k)], parameters_of(k)));
+    prints.push_back(detail::cloth_fingerprint(d, pair, opt, k, frames[std::size_t(k)], values_of(k)));
     const auto partial = state / (cloth_sequence_name(d, k) + ".npz");
     checkpoints.emplace_back();
     if (!std::filesystem::exists(partial)) continue;
@@ -418,7 +407,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
 
   // SHEET settles with the first sequence's obstacle at its start (above the sheet)
   const std::string settle_print =
-      detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames, d == ClothDataset::sheet ? parameters_of(0) : std::vector<double>{});
+      detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames, d == ClothDataset::sheet ? values_of(0) : std::vector<double>{});
 
   const detail::ClothDatagenRun run{d, pair, opt, dir, state, frames, prints, checkpoints, settle_print, workers};
   std::vector<ClothSequenceStats> stats;
@@ -449,7 +438,8 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     (s.test ? test_frames : train_frames) += s.frames;
     nlohmann::ordered_json e{{"name", s.name}, {"split", s.test ? "test" : "train"}, {"frames", s.frames}, {"reused", s.reused},
                              {"simulated", s.simulated}, {"subdivided_rmse_m", s.subdivided_rmse}};
-    e["scene"] = d == ClothDataset::sheet ? to_json(sheets[k]) : to_json(disks[k]);
+    nlohmann::ordered_json& scene = e["scene"] = nlohmann::ordered_json::object();
+    for (const auto& p : parameters_of(Index(k))) scene[p.name] = p.value;
     if (s.simulated > 0) {
       e["coarse_seconds_per_frame"] = s.coarse_seconds / double(s.simulated);
       e["fine_seconds_per_frame"] = s.fine_seconds / double(s.simulated);

@@ -147,6 +147,23 @@ struct DiskSequence {
   double duration() const { return duration_s; }
 };
 
+/// One parameter of a sequence, named with its unit.
+struct SequenceParameter {
+  const char* name;
+  double value;
+};
+
+/// What a sequence was drawn with, in one fixed order: its data's fingerprint holds the values,
+/// the dataset summary (cloth_data.json) the names and values.
+inline std::vector<SequenceParameter> sequence_parameters(const SheetSequence& q) {
+  return {{"pole", double(q.pole)}, {"radius_m", q.radius},       {"centre_x_m", q.centre.x()}, {"centre_y_m", q.centre.y()},
+          {"centre_z_m", q.centre.z()}, {"heading_rad", q.heading}, {"descent_s", q.descent_time}, {"hold_s", q.hold_time},
+          {"start_height_m", q.start_height}};
+}
+inline std::vector<SequenceParameter> sequence_parameters(const DiskSequence& q) {
+  return {{"wind_m_per_s", q.speed}, {"heading_rad", q.heading}, {"gust", q.gust}, {"gust_period_s", q.gust_period}, {"duration_s", q.duration_s}};
+}
+
 /// The table of the DISK scene: a rounded cylinder of radius 0.4 m, its top at z = 0.
 inline physics::RoundedCylinder<> disk_table() { return physics::RoundedCylinder<>(Vec3<>(0, 0, -0.4), Vec3<>::UnitZ(), 0.39, 0.39, 0.01); }
 

@@ -67,6 +67,17 @@ struct ClothOptions {
   Index max_halvings = 4;
 };
 
+/// `o` itself; ArgumentError naming the first option out of range (the simulator's check, which
+/// generate_cloth_data also runs before it writes anything).
+inline ClothOptions checked_cloth_options(ClothOptions o) {
+  if (!(o.frame_time > 0) || !std::isfinite(o.frame_time)) throw ArgumentError("ClothSimulator: frame time must be finite and > 0");
+  if (o.substeps < 1) throw ArgumentError("ClothSimulator: substeps must be >= 1, got " + std::to_string(o.substeps));
+  if (o.max_halvings < 0) throw ArgumentError("ClothSimulator: max_halvings must be >= 0, got " + std::to_string(o.max_halvings));
+  if (!(o.contact_stiffness >= 0) || !std::isfinite(o.contact_stiffness))
+    throw ArgumentError("ClothSimulator: contact stiffness must be finite and >= 0");
+  return o;
+}
+
 /// One frame's figures.
 struct ClothFrameReport {
   Index newton_iterations = 0;  ///< over the frame's substeps (failed solves included)
@@ -87,7 +98,7 @@ class ClothSimulator {
   /// bad material or option (checked by the terms too), MeshError for a bad surface or pin.
   ClothSimulator(TriMesh<> rest, IndexVector pinned, O obstacle, ClothMaterial material = {}, ClothOptions options = {})
       : rest_(std::move(rest)),
-        options_(checked(options)),
+        options_(checked_cloth_options(options)),
         areas_(voronoi_areas(rest_.V, rest_.F)),
         membrane_(rest_.V.rows(), rest_.V, rest_.F, material.stretch),
         bending_(rest_.V.rows(), rest_.V, rest_.F, material.bending),
@@ -204,14 +215,6 @@ class ClothSimulator {
     previous_.swap(x_);
     x_.swap(trial_);
     last_step_ = h;
-  }
-  static ClothOptions checked(ClothOptions o) {
-    if (!(o.frame_time > 0) || !std::isfinite(o.frame_time)) throw ArgumentError("ClothSimulator: frame time must be finite and > 0");
-    if (o.substeps < 1) throw ArgumentError("ClothSimulator: substeps must be >= 1, got " + std::to_string(o.substeps));
-    if (o.max_halvings < 0) throw ArgumentError("ClothSimulator: max_halvings must be >= 0, got " + std::to_string(o.max_halvings));
-    if (!(o.contact_stiffness >= 0) || !std::isfinite(o.contact_stiffness))
-      throw ArgumentError("ClothSimulator: contact stiffness must be finite and >= 0");
-    return o;
   }
   /// Barycentric weight of corner c at a triangle's point k: the centroid (k = 0) and the points
   /// halfway from it to each corner (k = 1, 2, 3: 2/3 at that corner, 1/6 at the others).
