@@ -66,10 +66,11 @@ TEST_CASE("EmbeddedObstacleContact: gradient and Hessian against finite differen
   CHECK(min_eig > -1e-12);
 }
 
-TEST_CASE("EmbeddedObstacleContact: a point at one vertex is ObstacleContact on that vertex, exactly") {
+TEST_CASE("EmbeddedObstacleContact: a point at one vertex is ObstacleContact on that vertex, exactly (with and without an onset)") {
   std::mt19937 rng(3);
   const Index n = 10;
-  for (int trial = 0; trial < 20; ++trial) {
+  for (int trial = 0; trial < 40; ++trial) {
+    const double onset = trial < 20 ? 0.0 : 0.3;
     const Points<> x = test::random_points(n, -1, 1, rng);
     IndexVector v(4);
     v << 0, 3, 5, 8;
@@ -81,8 +82,11 @@ TEST_CASE("EmbeddedObstacleContact: a point at one vertex is ObstacleContact on 
     }
     const VecX<> k = VecX<>::LinSpaced(4, 5, 50);
     const Sphere<> s(test::random_points(1, -0.5, 0.5, rng).row(0).transpose(), 0.8);
-    const EmbeddedObstacleContact emb(s, a, w, n, k);
-    const ObstacleContact direct(s, v, n, k);
+    EmbeddedObstacleContact emb(s, a, w, n, k);
+    ObstacleContact direct(s, v, n, k);
+    emb.set_onset(onset);
+    direct.set_onset(onset);
+    CHECK(emb.onset() == onset);
     CHECK(emb.energy(exec::seq, x) == direct.energy(exec::seq, x));
     CHECK(test::gradient(emb, x) == test::gradient(direct, x));
     CHECK(test::assembled_hessian(emb, x) == test::assembled_hessian(direct, x));

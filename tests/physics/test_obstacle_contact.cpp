@@ -173,3 +173,68 @@ TEST_CASE("ObstacleContact: the local-global stand-in is k_i I on every contact 
     for (int c = 0; c < 3; ++c) CHECK(D(3 * i + c, 3 * i + c) == (i % 2 == 0 ? 7.0 : 0.0));
   CHECK((D - Eigen::MatrixXd(D.diagonal().asDiagonal())).norm() == 0.0);
 }
+
+TEST_CASE("ObstacleContact onset: the profile is C² at 0 and −δ, and gradient and Hessian match finite differences of the energy") {
+  // the profile itself: values, slopes and curvatures meet where the pieces do, slope and
+  // curvature are the derivatives of the value (central differences), δ = 0 is k/2 d²
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uk(1, 1e3), ud(1e-4, 1e-2);
+  double worst_join = 0, worst_fd = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const double k = uk(rng), delta = ud(rng);
+    const auto at = [&](double d) { return detail::penalty_profile(d, k, delta); };
+    const double e = 1e-9 * delta;
+    for (const double join : {0.0, -delta}) {
+      const auto a = at(join - e), b = at(join + e);
+      worst_join = std::max({worst_join, std::abs(a.value - b.value) / (k * delta * delta), std::abs(a.slope - b.slope) / (k * delta),
+                             std::abs(a.curvature - b.curvature) / k});
+    }
+    for (const double d : {-0.3 * delta, -0.9 * delta, -1.7 * delta, -6 * delta}) {
+      const double h = 1e-6 * delta;
+      const auto p = at(d), up = at(d + h), down = at(d - h);
+      worst_fd = std::max({worst_fd, std::abs((up.value - down.value) / (2 * h) - p.slope) / (k * delta),
+                           std::abs((up.slope - down.slope) / (2 * h) - p.curvature) / k});
+    }
+    CHECK(at(1e-3).value == 0.0);
+    CHECK(at(-delta).curvature == k);
+    CHECK(detail::penalty_profile(-0.2, k, 0.0).value == doctest::Approx(k / 2 * 0.04));
+  }
+  MESSAGE("penalty onset: worst jump at the joins " << worst_join << ", worst finite-difference error " << worst_fd);
+  CHECK(worst_join < 1e-7);
+  CHECK(worst_fd < 1e-6);
+
+  // the term: gradient by differences of the energy, Hessian by differences of the gradient
+  // against a plane (exact) and the bowl (PSD where inside), points spread across the ramp
+  double worst_g = 0, worst_h = 0;
+  Index in_ramp = 0, past_ramp = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const Index n = 12;
+    const Points<> x = test::random_points(n, -0.05, 0.05, rng);
+    const IndexVector v = every_other(n);
+    const VecX<> k = random_stiffness(v.size(), rng);
+    const Vec3<> dir = test::random_points(1, -1, 1, rng).row(0).transpose();
+    ObstacleContact plane(Plane<>(Vec3<>::Zero(), dir), v, n, k);
+    ObstacleContact bowl(Bowl{Vec3<>(0.03, 0, 0), 0.06}, v, n, k);
+    plane.set_onset(0.03);
+    bowl.set_onset(0.03);
+    for (Index i = 0; i < v.size(); ++i) {
+      const double d = plane.obstacle().distance(x.row(v[i]).transpose());
+      in_ramp += d < 0 && d > -0.03;
+      past_ramp += d <= -0.03;
+    }
+    worst_g = std::max(worst_g, test::rel_error(test::gradient(plane, x), test::fd_gradient(plane, x, 1e-7)));
+    worst_h = std::max(worst_h, test::rel_error(test::assembled_hessian(plane, x), test::fd_hessian(plane, x, 1e-7)));
+    worst_g = std::max(worst_g, test::rel_error(test::gradient(bowl, x), test::fd_gradient(bowl, x, 1e-7)));
+    worst_h = std::max(worst_h, test::rel_error(test::assembled_hessian(bowl, x), test::fd_hessian(bowl, x, 1e-7)));
+  }
+  MESSAGE("contact with onset 0.03 m: gradient " << worst_g << ", Hessian " << worst_h << "; points in the ramp " << in_ramp << ", past it " << past_ramp);
+  CHECK(in_ramp > 20);
+  CHECK(past_ramp > 5);
+  CHECK(worst_g < 1e-6);
+  CHECK(worst_h < 1e-5);
+
+  ObstacleContact c(Sphere<>(Vec3<>::Zero(), 1.0), every_other(4), 4, 1.0);
+  CHECK(c.onset() == 0.0);
+  CHECK_THROWS_AS(c.set_onset(-1e-3), ArgumentError);
+  CHECK_THROWS_AS(c.set_onset(std::nan("")), ArgumentError);
+}

@@ -133,6 +133,14 @@ TEST_CASE("cloth datagen (DISK, reduced): the wind's sequences, the draped start
     none.simulation.substeps = 0;
     CHECK(test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::seq, ClothDataset::disk, four_dir.path, none); }).find("substeps") !=
           std::string::npos);
+    // a C² contact (an onset depth) is another run too, and a negative one is refused by name
+    ClothDatagenOptions smooth = four;
+    smooth.simulation.contact_onset = 2e-3;
+    CHECK_FALSE(generate_cloth_data(exec::omp, ClothDataset::disk, four_dir.path, smooth)[0].reused);
+    CHECK(generate_cloth_data(exec::omp, ClothDataset::disk, four_dir.path, smooth)[0].reused);
+    smooth.simulation.contact_onset = -1e-3;
+    CHECK(test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::seq, ClothDataset::disk, four_dir.path, smooth); }).find("onset") !=
+          std::string::npos);
   }
   // three sequences spread the speeds 1, 4.5, 8 m/s: the first file is the same sequence and is
   // reused, the second (8 m/s before) is another one and is simulated again

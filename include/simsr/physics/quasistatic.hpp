@@ -139,6 +139,7 @@ class QuasistaticSolver {
     NewtonReport report;
     detail::GradientTest test(options_.relative_tolerance, options_.absolute_tolerance, options_.reference_force);
     const double size = double((x.colwise().maxCoeff() - x.colwise().minCoeff()).norm());
+    last_shift_ = 0;
     for (Index it = 0;; ++it) {
       const double E = total_energy(policy, x, terms...);
       if (!std::isfinite(E)) throw ConvergenceError("quasistatic Newton (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
@@ -159,20 +160,28 @@ class QuasistaticSolver {
       bool projected = options_.hessian == NewtonOptions::Hessian::projected;
       LinearSolveInfo info;
       double slope = 0, shift = 0;
-      if (!projected) {
+      const bool regularized = options_.hessian == NewtonOptions::Hessian::regularized;
+      if (!projected && regularized && last_shift_ > 1e-3 * (1 + 1e-9)) {
+        // the last iteration needed τ > 10⁻³: the exact Hessian is not tried, the search starts at τ/10
+        assemble_hessian(policy, x, Definiteness::exact, terms...);
+        shift = shifted_direction(policy, info, last_shift_ / 10);
+        if (shift > 0) slope = double(g_.dot(d_));
+        projected = !(shift > 0);
+      } else if (!projected) {
         projected = !newton_direction(policy, x, Definiteness::exact, info, terms...);
         if (!projected) {
           slope = double(g_.dot(d_));
           projected = !(slope < 0) || !d_.allFinite();
         }
-        if (projected && options_.hessian == NewtonOptions::Hessian::regularized) {
-          shift = shifted_direction(policy, info);
+        if (projected && regularized) {
+          shift = shifted_direction(policy, info, 1e-3);
           if (shift > 0) {
             slope = double(g_.dot(d_));
             projected = false;
           }
         }
       }
+      last_shift_ = shift;
       if (projected) {
         newton_direction(policy, x, Definiteness::project, info, terms...);
         slope = double(g_.dot(d_));
@@ -225,9 +234,7 @@ class QuasistaticSolver {
   /// H d = rhs_. False when the system turned out not positive definite.
   template <class P, class... Terms>
   bool newton_direction(P policy, const Points<S>& x, Definiteness d, LinearSolveInfo& info, const Terms&... terms) {
-    H_.set_zero();
-    (terms.add_hessian(policy, x, H_, d), ...);
-    const SparseMatrix<S>& A = H_.assemble(policy, fixed_);
+    const SparseMatrix<S>& A = assemble_hessian(policy, x, d, terms...);
     try {
       linear_.compute(policy, A, H_.pattern_version());
     } catch (const ConvergenceError&) {
@@ -243,11 +250,19 @@ class QuasistaticSolver {
     return one.converged || d == Definiteness::project;
   }
 
-  /// Hessian::regularized: after the exact Hessian failed (the matrix H_ last assembled), solves
-  /// (H + τ m I) d = rhs_ for τ = 10⁻³, 10⁻², … ≤ 10², the first that factors and descends.
-  /// Returns that τ, or 0 when none did (the caller then projects).
+  /// Every term's Hessian blocks at x (definiteness d) into H_, assembled over the free DOFs.
+  template <class P, class... Terms>
+  const SparseMatrix<S>& assemble_hessian(P policy, const Points<S>& x, Definiteness d, const Terms&... terms) {
+    H_.set_zero();
+    (terms.add_hessian(policy, x, H_, d), ...);
+    return H_.assemble(policy, fixed_);
+  }
+
+  /// Hessian::regularized: with the exact Hessian H (the matrix H_ last assembled) not positive
+  /// definite, solves (H + τ m I) d = rhs_ for τ = first, 10·first, … ≤ 10², the first that
+  /// factors and descends. Returns that τ, or 0 when none did (the caller then projects).
   template <class P>
-  double shifted_direction(P policy, LinearSolveInfo& info) {
+  double shifted_direction(P policy, LinearSolveInfo& info, double first) {
     const SparseMatrix<S>& A = H_.assembled();
     shifted_ = A;  // the same pattern: its storage is reused after the first call
     shifted_diagonal_.clear();
@@ -264,7 +279,7 @@ class QuasistaticSolver {
     }
     if (shifted_diagonal_.empty() || !(m > 0)) return 0;
     m /= double(shifted_diagonal_.size());
-    for (double tau = 1e-3; tau <= 1e2 * (1 + 1e-9); tau *= 10) {
+    for (double tau = first; tau <= 1e2 * (1 + 1e-9); tau *= 10) {
       for (auto& [entry, exact] : shifted_diagonal_) *entry = exact + S(tau * m);
       try {
         linear_.compute(policy, shifted_, H_.pattern_version());
@@ -292,6 +307,7 @@ class QuasistaticSolver {
   SparseMatrix<S> shifted_;  ///< Hessian::regularized's H + τ m I (kept: its storage is reused)
   std::vector<std::pair<S*, S>> shifted_diagonal_;  ///< its free diagonal entries and their exact values
   double magnitude_ = 0;
+  double last_shift_ = 0;  ///< Hessian::regularized: the τ of the last iteration (0: unshifted), reset by each solve
 };
 
 }  // namespace simsr::physics

@@ -117,6 +117,7 @@ inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, cons
   f.add(m.areal_density).add(m.stretch).add(m.bending).add(s.frame_time).add(s.substeps).add(s.damping).add(s.gravity).add(s.contact_stiffness);
   f.add(s.newton.relative_tolerance).add(s.newton.absolute_tolerance).add(s.newton.max_iterations).add(std::int64_t(s.newton.hessian)).add(s.max_halvings);
   f.add(o.settle_frames).add(o.seed).add(o.extra_seconds).add(sequence).add(frames).add(parameters);
+  if (s.contact_onset != 0) f.add(s.contact_onset);  // added after the data of earlier runs: 0 hashes as before, so that data stays valid
   return f.hex();
 }
 

@@ -58,6 +58,9 @@ struct ClothOptions {
   double damping = 0.02;         ///< ImplicitInertia β (s): velocity-proportional damping
   Vec3<> gravity{0, 0, -9.81};   ///< m/s²
   double contact_stiffness = 2e6;  ///< κ (N/m³): vertex i's penalty stiffness is κ A_i, a triangle point's κ A_t / 4
+  /// The depth (m) over which the contact stiffness ramps up from 0 (physics::ObstacleContact::set_onset):
+  /// 0 is the C¹ quadratic penalty, > 0 a C² one.
+  double contact_onset = 0;
   /// Newton's options. The Hessian `regularized` (shifted where it is indefinite, not projected):
   /// a hanging cloth buckles, and with the projected fallback Newton stalled and halved steps
   /// (physics::NewtonOptions::Hessian).
@@ -75,6 +78,7 @@ inline ClothOptions checked_cloth_options(ClothOptions o) {
   if (o.max_halvings < 0) throw ArgumentError("ClothSimulator: max_halvings must be >= 0, got " + std::to_string(o.max_halvings));
   if (!(o.contact_stiffness >= 0) || !std::isfinite(o.contact_stiffness))
     throw ArgumentError("ClothSimulator: contact stiffness must be finite and >= 0");
+  if (!(o.contact_onset >= 0) || !std::isfinite(o.contact_onset)) throw ArgumentError("ClothSimulator: contact onset must be finite and >= 0");
   return o;
 }
 
@@ -119,6 +123,8 @@ class ClothSimulator {
         throw MeshError("pinned vertex", k, "ClothSimulator: vertex id " + std::to_string(boundary_.vertices[k]) + " outside [0, " +
                                                 std::to_string(rest_.V.rows()) + ")");
     boundary_.targets = rest_.V(boundary_.vertices, Eigen::all);
+    contact_.set_onset(options_.contact_onset);
+    face_contact_.set_onset(options_.contact_onset);
     last_step_ = step_time();
   }
 

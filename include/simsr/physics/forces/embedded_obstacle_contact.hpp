@@ -54,6 +54,13 @@ class EmbeddedObstacleContact {
 
   O& obstacle() { return o_; }  ///< to move the obstacle between frames
   const O& obstacle() const { return o_; }
+  /// The penalty's onset depth δ (m), as ObstacleContact::set_onset: 0 (the default) is C¹,
+  /// δ > 0 ramps the stiffness over the first δ of depth (C²).
+  void set_onset(S onset) {
+    detail::require_nonnegative("EmbeddedObstacleContact: onset", onset);
+    onset_ = onset;
+  }
+  S onset() const { return onset_; }
   Index num_points() const { return pts_.size(); }
   Index num_vertices() const { return pts_.num_vertices; }
 
@@ -74,7 +81,7 @@ class EmbeddedObstacleContact {
   S energy(P, const Points<S>& x) const {
     detail::require_positions("EmbeddedObstacleContact: x", x, num_vertices());
     S e = S(0);
-    for (Index q = 0; q < num_points(); ++q) e += detail::obstacle_penalty_energy(o_, pts_.point(x, q), k_[q]);
+    for (Index q = 0; q < num_points(); ++q) e += detail::obstacle_penalty_energy(o_, pts_.point(x, q), k_[q], onset_);
     return e;
   }
 
@@ -84,7 +91,7 @@ class EmbeddedObstacleContact {
     detail::require_positions("EmbeddedObstacleContact: gradient", g, num_vertices());
     Vec3<S> f;
     for (Index q = 0; q < num_points(); ++q)
-      if (detail::obstacle_penalty_force(o_, pts_.point(x, q), k_[q], f)) pts_.add_force(g, q, f);
+      if (detail::obstacle_penalty_force(o_, pts_.point(x, q), k_[q], f, onset_)) pts_.add_force(g, q, f);
   }
 
   /// w_qi w_qj B_q with B_q the PSD-projected block of obstacle_contact.hpp (both Definiteness values).
@@ -93,7 +100,7 @@ class EmbeddedObstacleContact {
     detail::require_positions("EmbeddedObstacleContact: x", x, num_vertices());
     Mat3<S> B;
     for (Index q = 0; q < num_points(); ++q)
-      if (detail::obstacle_penalty_block(o_, pts_.point(x, q), k_[q], B)) pts_.add_block(H, q, B);
+      if (detail::obstacle_penalty_block(o_, pts_.point(x, q), k_[q], B, onset_)) pts_.add_block(H, q, B);
   }
 
  private:
@@ -106,6 +113,7 @@ class EmbeddedObstacleContact {
   O o_;
   detail::EmbeddedPoints<S> pts_;
   VecX<S> k_;
+  S onset_ = S(0);
 };
 
 static_assert(assert_energy_term<EmbeddedObstacleContact<Sphere<double>>, double>());

@@ -42,28 +42,57 @@ Mat3<S> project_psd3(const Mat3<S>& A) {
   return es.eigenvectors() * es.eigenvalues().cwiseMax(S(0)).asDiagonal() * es.eigenvectors().transpose();
 }
 
-/// One point p's penalty against obstacle o with stiffness k, the class comment's formulas shared
-/// by ObstacleContact (p a vertex) and EmbeddedObstacleContact (p an embedded point): the energy
-/// k/2 min(d, 0)², and for d < 0 the derivative k d ∇d and the PSD-projected block
-/// k (∇d ∇dᵀ + d ∇²d). The last two return false (and leave their output) where d ≥ 0.
+/// The penalty's profile against the signed distance d (m) for stiffness k (N/m) and onset
+/// depth δ (m, ≥ 0): its value f, slope f' = df/dd and curvature f'' = d²f/dd², all 0 for d ≥ 0.
+///
+///     δ = 0:            f = k/2 d²,                     f' = k d,          f'' = k
+///     δ > 0, −δ < d < 0: f = −k d³/(6δ),                f' = −k d²/(2δ),   f'' = −k d/δ
+///            d ≤ −δ:     f = k/2 d² + kδ/2 d + kδ²/6,   f' = k d + kδ/2,   f'' = k
+///
+/// δ = 0 is C¹: the curvature jumps from 0 to k as a point enters, so Newton's quadratic model
+/// is wrong on both sides of every point on the surface, and a contact set that changes from
+/// iteration to iteration (cloth sliding over an edge) stalls it. δ > 0 ramps the curvature
+/// linearly over the first δ of depth (C², the pieces' values, slopes and curvatures meet at
+/// 0 and −δ); the price is δ/2 more penetration under the same load.
+template <class S>
+struct PenaltyProfile {
+  S value, slope, curvature;
+};
+template <class S>
+PenaltyProfile<S> penalty_profile(S d, S k, S onset) {
+  if (!(d < S(0))) return {S(0), S(0), S(0)};
+  if (onset == S(0)) return {k / S(2) * d * d, k * d, k};
+  if (d > -onset) return {-k * d * d * d / (S(6) * onset), -k * d * d / (S(2) * onset), -k * d / onset};
+  return {k / S(2) * d * d + k * onset / S(2) * d + k * onset * onset / S(6), k * d + k * onset / S(2), k};
+}
+
+/// One point p's penalty against obstacle o with stiffness k and onset δ (penalty_profile), the
+/// class comment's formulas shared by ObstacleContact (p a vertex) and EmbeddedObstacleContact
+/// (p an embedded point): the energy f(d), and for d < 0 the derivative f'(d) ∇d and the
+/// PSD-projected block f''(d) ∇d ∇dᵀ + f'(d) ∇²d (δ = 0: k (∇d ∇dᵀ + d ∇²d)). The last two
+/// return false (and leave their output) where d ≥ 0.
 template <class O, class S>
-S obstacle_penalty_energy(const O& o, const Vec3<S>& p, S k) {
-  const S d = o.distance(p);
-  return d < S(0) ? k / S(2) * d * d : S(0);
+S obstacle_penalty_energy(const O& o, const Vec3<S>& p, S k, S onset = S(0)) {
+  return penalty_profile(S(o.distance(p)), k, onset).value;
 }
 template <class O, class S>
-bool obstacle_penalty_force(const O& o, const Vec3<S>& p, S k, Vec3<S>& f) {
+bool obstacle_penalty_force(const O& o, const Vec3<S>& p, S k, Vec3<S>& f, S onset = S(0)) {
   const S d = o.distance(p);
   if (!(d < S(0))) return false;
-  f = (k * d) * o.distance_gradient(p);
+  f = penalty_profile(d, k, onset).slope * o.distance_gradient(p);
   return true;
 }
 template <class O, class S>
-bool obstacle_penalty_block(const O& o, const Vec3<S>& p, S k, Mat3<S>& B) {
+bool obstacle_penalty_block(const O& o, const Vec3<S>& p, S k, Mat3<S>& B, S onset = S(0)) {
   const S d = o.distance(p);
   if (!(d < S(0))) return false;
   const Vec3<S> n = o.distance_gradient(p);
-  B = k * project_psd3(Mat3<S>(n * n.transpose() + d * o.distance_hessian(p)));
+  if (onset == S(0)) {  // the δ = 0 block as it always was, to the last bit
+    B = k * project_psd3(Mat3<S>(n * n.transpose() + d * o.distance_hessian(p)));
+    return true;
+  }
+  const PenaltyProfile<S> f = penalty_profile(d, k, onset);
+  B = project_psd3(Mat3<S>(f.curvature * n * n.transpose() + f.slope * o.distance_hessian(p)));
   return true;
 }
 }  // namespace detail
@@ -217,7 +246,7 @@ class Capsule {
 
 /// Penalty contact of `vertices` (indices into x) against one obstacle O.
 ///
-/// Hessian per penetrating vertex: the 3×3 block k (∇d ∇dᵀ + d ∇²d), exact when positive
+/// Hessian per penetrating vertex (onset 0): the 3×3 block k (∇d ∇dᵀ + d ∇²d), exact when positive
 /// semi-definite, otherwise with its negative eigenvalues clamped to 0 (PSD projection). For a
 /// Plane this is exactly k n nᵀ; for a Sphere d < 0 makes the tangential part k d/‖x − c‖ (I − n nᵀ)
 /// negative, so the projection keeps k n nᵀ (the penalty does not resist sliding on the sphere).
@@ -242,6 +271,14 @@ class ObstacleContact {
 
   O& obstacle() { return o_; }  ///< to move the obstacle between frames
   const O& obstacle() const { return o_; }
+  /// The depth δ (m) over which the penalty's stiffness ramps from 0 to k (detail::penalty_profile):
+  /// 0 (the default) is the C¹ quadratic, δ > 0 makes the energy C². ArgumentError for δ not
+  /// finite and ≥ 0.
+  void set_onset(S onset) {
+    detail::require_nonnegative("ObstacleContact: onset", onset);
+    onset_ = onset;
+  }
+  S onset() const { return onset_; }
   const IndexVector& vertices() const { return v_; }
   const VecX<S>& stiffness() const { return k_; }
   Index num_vertices() const { return n_; }
@@ -259,7 +296,7 @@ class ObstacleContact {
   S energy(P, const Points<S>& x) const {
     detail::require_positions("ObstacleContact: x", x, n_);
     S e = S(0);
-    for (Index i = 0; i < v_.size(); ++i) e += detail::obstacle_penalty_energy(o_, pos(x, i), k_[i]);
+    for (Index i = 0; i < v_.size(); ++i) e += detail::obstacle_penalty_energy(o_, pos(x, i), k_[i], onset_);
     return e;
   }
 
@@ -269,7 +306,7 @@ class ObstacleContact {
     detail::require_positions("ObstacleContact: gradient", g, n_);
     Vec3<S> f;
     for (Index i = 0; i < v_.size(); ++i)
-      if (detail::obstacle_penalty_force(o_, pos(x, i), k_[i], f)) g.row(v_[i]) += f.transpose();
+      if (detail::obstacle_penalty_force(o_, pos(x, i), k_[i], f, onset_)) g.row(v_[i]) += f.transpose();
   }
 
   /// The PSD-projected blocks of the class comment, for both Definiteness values.
@@ -278,7 +315,7 @@ class ObstacleContact {
     detail::require_positions("ObstacleContact: x", x, n_);
     Mat3<S> B;
     for (Index i = 0; i < v_.size(); ++i)
-      if (detail::obstacle_penalty_block(o_, pos(x, i), k_[i], B)) H.add(v_[i], v_[i], B);
+      if (detail::obstacle_penalty_block(o_, pos(x, i), k_[i], B, onset_)) H.add(v_[i], v_[i], B);
   }
 
   /// The local–global solver's constant matrix: k_i I for every vertex that may touch, whether it
@@ -297,6 +334,7 @@ class ObstacleContact {
   IndexVector v_;
   Index n_;
   VecX<S> k_;
+  S onset_ = S(0);
 };
 
 /// `ObstacleContact c(Sphere<>(...), vertices, n, k)` with k a scalar or any vector expression.
