@@ -74,7 +74,9 @@ struct NewtonOptions {
   ///
   /// `regularized` tries the exact Hessian first too, and where it is not positive definite
   /// shifts it, H + τ·m·I on the free DOFs (m the mean |diagonal|; τ = 10⁻³, 10⁻², … up to 10²,
-  /// Levenberg–Marquardt's damping), before falling back to the projected one. The shift keeps
+  /// Levenberg–Marquardt's damping), before falling back to the projected one. After an
+  /// iteration that needed τ > 10⁻³ the next one starts at τ/10 and does not try H itself (it
+  /// stays indefinite from one iteration to the next; each failed try is a factorization). The shift keeps
   /// the negative curvature of compression as a smaller step instead of dropping it: on the DISK
   /// tablecloth (7,057 vertices, hanging in folds in wind), where the projected fallback stalled
   /// and halved steps, Newton took 253 iterations over 10 frames instead of 468, none halved
