@@ -16,6 +16,9 @@
 #include <simsr/eval/evaluate.hpp>
 #include <simsr/interp/interp.hpp>
 #include <simsr/physics/verification/cantilever.hpp>
+#if SIMSR_HAVE_CHOLMOD
+#include <simsr/physics/linear_solvers/cholmod_cholesky.hpp>
+#endif
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -81,6 +84,31 @@ void cantilever(physics::BeamDiscretization d) {
   if (!(r.tip_deflection > 0)) throw std::runtime_error("the beam did not sag");
 }
 
+#if SIMSR_HAVE_CHOLMOD
+/// CHOLMOD's supernodal LLᵀ of a 7-point Laplacian on a 24³ grid (13,824 unknowns; its top
+/// fronts are hundreds wide, where CHOLMOD 3's num_threads(4) loops run) under `policy`.
+template <class P>
+void cholmod_factor(P policy) {
+  const Index m = 24, n = m * m * m;
+  std::vector<Eigen::Triplet<double>> t;
+  const auto id = [&](Index i, Index j, Index k) { return (i * m + j) * m + k; };
+  for (Index i = 0; i < m; ++i)
+    for (Index j = 0; j < m; ++j)
+      for (Index k = 0; k < m; ++k) {
+        t.emplace_back(int(id(i, j, k)), int(id(i, j, k)), 6.1);
+        if (i + 1 < m) t.emplace_back(int(id(i, j, k)), int(id(i + 1, j, k)), -1.0), t.emplace_back(int(id(i + 1, j, k)), int(id(i, j, k)), -1.0);
+        if (j + 1 < m) t.emplace_back(int(id(i, j, k)), int(id(i, j + 1, k)), -1.0), t.emplace_back(int(id(i, j + 1, k)), int(id(i, j, k)), -1.0);
+        if (k + 1 < m) t.emplace_back(int(id(i, j, k)), int(id(i, j, k + 1)), -1.0), t.emplace_back(int(id(i, j, k + 1)), int(id(i, j, k)), -1.0);
+      }
+  physics::SparseMatrix<double> A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  physics::CholmodCholesky<> llt;
+  llt.compute(policy, A);
+  VecX<> x;
+  if (!llt.solve(policy, VecX<>::Ones(n), x).converged) throw std::runtime_error("CHOLMOD's solve did not converge");
+}
+#endif
+
 struct Workload {
   std::string name;
   std::function<void(Bunny&)> run;
@@ -123,6 +151,12 @@ std::vector<Workload> workloads() {
          o.trainer.progress = false;
          run_method(b, m, o);
        }},
+#if SIMSR_HAVE_CHOLMOD
+      // CHOLMOD 3's own OpenMP loops (num_threads(4) compiled in) on this thread under exec::seq;
+      // its control: under exec::omp they do start threads, so the workload reaches them
+      {"cholmod/supernodal-factor", [](Bunny&) { cholmod_factor(exec::seq); }},
+      {"control/cholmod-omp-starts-threads", [](Bunny&) { cholmod_factor(exec::omp); }, true},
+#endif
       {"control/omp-starts-threads",
        [](Bunny&) {
          exec::set_omp_fork(exec::OmpFork::always);

@@ -12,8 +12,10 @@
 ///
 /// Optional: needs cholmod.h and libcholmod (Debian's libsuitesparse-dev); CMake's
 /// -DSIMSR_WITH_CHOLMOD=ON gives the target simsr::cholmod, which defines SIMSR_HAVE_CHOLMOD.
-/// Threads: CHOLMOD 3 itself is sequential; its BLAS is the system's (Debian's reference BLAS is
-/// sequential; OpenBLAS starts threads of its own under either policy unless
+/// Threads: CHOLMOD 3's supernodal factorization has OpenMP loops with num_threads(4) compiled
+/// in, which ignore the thread count; under exec::seq they run on the calling thread
+/// (OpenMPSerial), under exec::omp they keep CHOLMOD's 4. Its BLAS is the system's (Debian's
+/// reference BLAS is sequential; OpenBLAS starts threads of its own under either policy unless
 /// OPENBLAS_NUM_THREADS=1), so unlike SparseCholesky, exec::seq cannot promise that no thread
 /// starts. The policy runs the residual check, as in SparseCholesky.
 
@@ -27,6 +29,7 @@
 #include <Eigen/SparseCore>
 
 #include "../../core/error.hpp"
+#include "../../core/openmp_serial.hpp"
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
 #include "linear_solver.hpp"
@@ -47,21 +50,12 @@ class CholmodCholesky {
   /// matrix is not positive definite: singular, e.g. rigid motions left free, or indefinite).
   template <exec::HostPolicy P>
   void compute(P, const SparseMatrix<S>& A, std::uint64_t pattern_version = 0) {
-    if (A.rows() != A.cols()) throw ShapeError("CholmodCholesky: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
-    // CHOLMOD reads a compressed column matrix; a symmetric row-major CSR read as column-major is
-    // its transpose, i.e. itself. CholmodSupport needs a real SparseMatrix (not a Map) whose
-    // lower triangle it reads: the copy is O(nnz), against a factorization of O(nnz(L)·front).
-    Ac_ = Eigen::Map<const Eigen::SparseMatrix<S, Eigen::ColMajor, int>>(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(),
-                                                                         A.valuePtr());
-    if (!llt_) {
-      llt_ = std::make_unique<Factorization>();
-      llt_->cholmod().print = 0;  // failures are this class's typed errors, not CHOLMOD's printout
+    if constexpr (std::is_same_v<std::remove_cvref_t<P>, exec::seq_t>) {
+      const OpenMPSerial serial;  // CHOLMOD's num_threads(4) loops, on this thread
+      factor(A, pattern_version);
+    } else {
+      factor(A, pattern_version);
     }
-    if (pattern_.changed(A, pattern_version)) llt_->analyzePattern(Ac_);
-    llt_->factorize(Ac_);
-    if (llt_->info() != Eigen::Success)
-      throw ConvergenceError("CholmodCholesky (CHOLMOD's LLT: the matrix is not positive definite)", 0, std::numeric_limits<double>::quiet_NaN());
-    A_ = &A;
   }
 
   /// x = A⁻¹ b; the relative residual is computed under `policy`.
@@ -81,6 +75,25 @@ class CholmodCholesky {
   }
 
  private:
+  /// compute() under either policy.
+  void factor(const SparseMatrix<S>& A, std::uint64_t pattern_version) {
+    if (A.rows() != A.cols()) throw ShapeError("CholmodCholesky: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
+    // CHOLMOD reads a compressed column matrix; a symmetric row-major CSR read as column-major is
+    // its transpose, i.e. itself. CholmodSupport needs a real SparseMatrix (not a Map) whose
+    // lower triangle it reads: the copy is O(nnz), against a factorization of O(nnz(L)·front).
+    Ac_ = Eigen::Map<const Eigen::SparseMatrix<S, Eigen::ColMajor, int>>(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(),
+                                                                         A.valuePtr());
+    if (!llt_) {
+      llt_ = std::make_unique<Factorization>();
+      llt_->cholmod().print = 0;  // failures are this class's typed errors, not CHOLMOD's printout
+    }
+    if (pattern_.changed(A, pattern_version)) llt_->analyzePattern(Ac_);
+    llt_->factorize(Ac_);
+    if (llt_->info() != Eigen::Success)
+      throw ConvergenceError("CholmodCholesky (CHOLMOD's LLT: the matrix is not positive definite)", 0, std::numeric_limits<double>::quiet_NaN());
+    A_ = &A;
+  }
+
   // Supernodal LLᵀ (CHOLMOD_SUPERNODAL). Held by pointer: Eigen's factorizations cannot be moved.
   using Factorization = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<S, Eigen::ColMajor, int>, Eigen::Lower>;
   std::unique_ptr<Factorization> llt_;
