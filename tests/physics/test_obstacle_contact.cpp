@@ -182,7 +182,7 @@ TEST_CASE("ObstacleContact onset: the profile is C² at 0 and −δ, and gradien
   double worst_join = 0, worst_fd = 0;
   for (int trial = 0; trial < 200; ++trial) {
     const double k = uk(rng), delta = ud(rng);
-    const auto at = [&](double d) { return detail::penalty_profile(d, k, delta); };
+    const auto at = [&](double d) { return physics::detail::penalty_profile(d, k, delta); };
     const double e = 1e-9 * delta;
     for (const double join : {0.0, -delta}) {
       const auto a = at(join - e), b = at(join + e);
@@ -197,7 +197,7 @@ TEST_CASE("ObstacleContact onset: the profile is C² at 0 and −δ, and gradien
     }
     CHECK(at(1e-3).value == 0.0);
     CHECK(at(-delta).curvature == k);
-    CHECK(detail::penalty_profile(-0.2, k, 0.0).value == doctest::Approx(k / 2 * 0.04));
+    CHECK(physics::detail::penalty_profile(-0.2, k, 0.0).value == doctest::Approx(k / 2 * 0.04));
   }
   MESSAGE("penalty onset: worst jump at the joins " << worst_join << ", worst finite-difference error " << worst_fd);
   CHECK(worst_join < 1e-7);
