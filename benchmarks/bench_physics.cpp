@@ -470,11 +470,7 @@ void BM_newton_crumpled(benchmark::State& state) {
   const TriMesh<> sheet = square_sheet(1.0, 32);
   const Index n = sheet.V.rows();
   const TriangleMembrane<> stretch(n, sheet.V, sheet.F, 50.0);
-  const Edges rim_edges = boundary_edges(sheet.F);
-  std::vector<VIndex> ids(rim_edges.data(), rim_edges.data() + rim_edges.size());
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  DirichletBoundary<> rim{Eigen::Map<IndexVector>(ids.data(), Index(ids.size())), Points<>()};
+  DirichletBoundary<> rim{boundary_vertices(sheet.F), Points<>()};
   rim.targets = sheet.V(rim.vertices, Eigen::all);
   Points<> start = sheet.V;
   std::mt19937 rng(3);

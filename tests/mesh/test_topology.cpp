@@ -231,6 +231,11 @@ TEST_CASE("boundary_edges and boundary_loops of open surfaces") {
     const auto loops = boundary_loops(g.F);
     REQUIRE(loops.size() == 1);
     CHECK(loops[0].size() == std::size_t(4 * n));
+    // boundary_vertices: the loop's vertices, each once, ascending
+    const IndexVector bv = boundary_vertices(g.F);
+    std::vector<VIndex> from_loop = loops[0];
+    std::sort(from_loop.begin(), from_loop.end());
+    CHECK(std::vector<VIndex>(bv.data(), bv.data() + bv.size()) == from_loop);
     // Counter-clockwise seen from +z (the normal side): positive shoelace area n².
     double area = 0;
     for (std::size_t i = 0; i < loops[0].size(); ++i) {
@@ -243,6 +248,7 @@ TEST_CASE("boundary_edges and boundary_loops of open surfaces") {
   const TriMesh<> s = icosphere(2);
   CHECK(boundary_edges(s.F).rows() == 0);
   CHECK(boundary_loops(s.F).empty());
+  CHECK(boundary_vertices(s.F).size() == 0);
   for (int k : {1, 2, 5}) {
     std::vector<Index> keep;
     std::set<VIndex> used;

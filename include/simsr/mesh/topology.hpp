@@ -235,6 +235,17 @@ Edges boundary_edges(const Eigen::MatrixBase<DF>& F) {
   return B;
 }
 
+/// The vertices on the boundary of a triangle mesh F (#F×3): the ends of its boundary_edges,
+/// each once, ascending (pinning a sheet's rim, holding an open cut).
+template <class DF>
+IndexVector boundary_vertices(const Eigen::MatrixBase<DF>& F) {
+  const Edges B = boundary_edges(F);
+  std::vector<VIndex> ids(B.data(), B.data() + B.size());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return Eigen::Map<const IndexVector>(ids.data(), Index(ids.size()));
+}
+
 /// Boundary loops of a triangle mesh F (#F×3): each loop lists its vertices in the direction of
 /// `boundary_edges`, starting from the loop's first edge in that order. Throws MeshError (kind
 /// "vertex") when the boundary edges do not close into loops (inconsistently oriented faces).

@@ -163,20 +163,21 @@ class QuasistaticSolver {
       LinearSolveInfo info;
       double slope = 0, shift = 0;
       const bool regularized = options_.hessian == NewtonOptions::Hessian::regularized;
-      if (!projected && regularized && last_shift_ > 1e-3 * (1 + 1e-9)) {
-        // the last iteration needed τ > 10⁻³: the exact Hessian is not tried, the search starts at τ/10
-        assemble_hessian(policy, x, Definiteness::exact, terms...);
-        shift = shifted_direction(policy, info, last_shift_ / 10);
-        if (shift > 0) slope = double(g_.dot(d_));
-        projected = !(shift > 0);
-      } else if (!projected) {
-        projected = !newton_direction(policy, x, Definiteness::exact, info, terms...);
-        if (!projected) {
-          slope = double(g_.dot(d_));
-          projected = !(slope < 0) || !d_.allFinite();
+      // after an iteration that needed τ > 10⁻³ the exact Hessian is not tried: the search starts at τ/10
+      const bool warm = regularized && last_shift_ > 1e-3 * (1 + 1e-9);
+      if (!projected) {
+        if (warm) {
+          assemble_hessian(policy, x, Definiteness::exact, terms...);
+          projected = true;
+        } else {
+          projected = !newton_direction(policy, x, Definiteness::exact, info, terms...);
+          if (!projected) {
+            slope = double(g_.dot(d_));
+            projected = !(slope < 0) || !d_.allFinite();
+          }
         }
         if (projected && regularized) {
-          shift = shifted_direction(policy, info, 1e-3);
+          shift = shifted_direction(policy, info, warm ? last_shift_ / 10 : 1e-3);
           if (shift > 0) {
             slope = double(g_.dot(d_));
             projected = false;
