@@ -17,7 +17,7 @@
 #                   checks left to ASan, no recovery); the
 #                   suites other than interp, nn, pipeline and scenario run here and under TSan only
 #                   (tests/CMakeLists.txt says why)
-#   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: every suite that runs exec::omp under TSan, with
+#   3. build-tsan/  clang, SIMSR_SANITIZE=tsan: the suites' files that run parallel code, under TSan, with
 #                   LLVM's libomp and its Archer tool (so OpenMP's synchronisation is understood)
 #   4. scripts/fuzz.sh: every libFuzzer harness (build-asan's replay binaries) for
 #                   SIMSR_FUZZ_SECONDS (default 3) seconds each
