@@ -16,6 +16,8 @@
 // Cases (wall clock, ms per 4 frames; counters: newton_per_frame, s_per_newton):
 //   BM_cloth_frames/<scene>/simplicial
 //   BM_cloth_frames/<scene>/cholmod            (-DSIMSR_WITH_CHOLMOD=ON)
+//   BM_cloth_frames/<scene>/cholmod/converged  each step's Newton solve converged, 2 steps per frame
+//                                              (the default before the inexact steps: their baseline)
 //
 // The detail-synthesis network's training (shell/detail_synthesis.hpp), the supplement's sizes
 // (9 channels, 16-d latent, 3 input frames) on SHEET's coarse 81 and fine <scene> vertices:
@@ -60,11 +62,18 @@ SheetSequence pole() {
 
 constexpr Index warmup_frames = 12, timed_frames = 4;
 
+/// `converged`: each step solved to convergence at 2 steps per frame (the default before the
+/// inexact steps: the named baseline of their ratio); otherwise ClothOptions' default.
 template <class Linear>
-void cloth_frames(benchmark::State& state, Index levels) {
+void cloth_frames(benchmark::State& state, Index levels, bool converged = false) {
   const ClothPair pair = cloth_pair(ClothDataset::sheet, {8, levels});
   const SheetSequence seq = pole();
-  ClothSimulator<physics::Capsule<>, Linear> sim(pair.fine, pair.pinned, seq.obstacle_at(0));
+  ClothOptions options;
+  if (converged) {
+    options.substeps = 2;
+    options.newton = cloth_newton_options(ClothStepping::converged);
+  }
+  ClothSimulator<physics::Capsule<>, Linear> sim(pair.fine, pair.pinned, seq.obstacle_at(0), {}, options);
   const auto move = [&](physics::Capsule<>& o, double t) { o = seq.obstacle_at(t); };
   for (Index f = 0; f < warmup_frames; ++f) sim.advance(exec::omp, move);
   const Points<> x = sim.positions(), previous = sim.previous_positions();
@@ -127,6 +136,10 @@ void register_cases() {
 #if defined(SIMSR_HAVE_CHOLMOD)
     benchmark::RegisterBenchmark((std::string("BM_cloth_frames/") + name + "/cholmod").c_str(),
                                  [l](benchmark::State& s) { cloth_frames<physics::CholmodCholesky<>>(s, l); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark((std::string("BM_cloth_frames/") + name + "/cholmod/converged").c_str(),
+                                 [l](benchmark::State& s) { cloth_frames<physics::CholmodCholesky<>>(s, l, true); })
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
 #endif

@@ -23,6 +23,7 @@
 #if defined(SIMSR_HAVE_CGAL)
 #include "remeshed_wrap.hpp"
 #endif
+#include "cloth_stepping_options.hpp"
 #include "linear_solver_choice.hpp"
 
 #include <CLI/CLI.hpp>
@@ -55,9 +56,10 @@ struct DatagenArgs {
   Index samples = 100, layers = 1, steps = 6, sphere_level = 3, max_iterations = 5000, newton_iterations = 100;
   std::optional<Index> active_expressions;
   std::string solver = "local_global", softdeca_template = "ict", linear_solver = "simplicial";
+  ClothSteppingArgs stepping;  ///< sheet, disk: --substeps, --stepping, --step-iterations
   double skin_edge = 0;
   // sheet / disk
-  Index sequences = 0, cells = 0, levels = -1, sequence_workers = 0, substeps = shell::ClothOptions{}.substeps;
+  Index sequences = 0, cells = 0, levels = -1, sequence_workers = 0;
   CLI::Option* seed_given = nullptr;  ///< sheet/disk: without --seed, the library's (the demo's) seed
 };
 
@@ -139,7 +141,7 @@ inline int datagen_cloth(const DatagenArgs& a) {
   if (a.seed_given->count() > 0) o.seed = a.seed;  // else ClothDatagenOptions' (7): the data `simsr demo --dataset sheet|disk` simulates
   o.checkpoint_every = a.checkpoint_every;
   o.sequence_workers = a.sequence_workers;
-  o.simulation.substeps = a.substeps;
+  a.stepping.apply(o.simulation);
   const auto start = std::chrono::steady_clock::now();
   o.on_frame = [start](const std::string& seq, Index f, Index frames, const shell::ClothFrameReport& rc, const shell::ClothFrameReport& rf, double sc,
                        double sf) {
@@ -219,9 +221,7 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
                   "sheet, disk: sequences simulated at once, one thread each (0: OMP_NUM_THREADS; the same data for any count)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
-  cmd->add_option("--substeps", a->substeps, "sheet, disk: backward-Euler steps per frame (the same for both resolutions)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1024));
+  add_cloth_stepping_options(cmd, a->stepping, "sheet, disk");
   cmd->add_option("--template", a->softdeca_template, "softdeca: ict (the layered head from --kit) or sphere (the stand-in ball with two expressions)")
       ->capture_default_str();
   cmd->add_option("--sphere-level", a->sphere_level, "softdeca --template sphere: icosphere level of the ball (2: 162 skin vertices, 3: 642)")

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "cloth_stepping_options.hpp"
 #include "linear_solver_choice.hpp"
 
 #ifndef SIMSR_VENDOR_DIR
@@ -40,6 +41,7 @@ struct DemoArgs {
   Index cells = 0, levels = -1;  ///< sheet/disk: 0 / −1 the scene's default
   std::string fine_target = shell::fine_target_name(shell::DetailSynthesisOptions{}.fine_target);
   std::string linear_solver = "simplicial";  ///< sheet/disk: the data's Newton linear solver
+  ClothSteppingArgs stepping;                ///< sheet/disk: --substeps, --stepping, --step-iterations
 };
 
 /// The thin-shell demo (shell/cloth_demo.hpp): progress on stderr, the tables on stdout.
@@ -51,6 +53,7 @@ int cloth_demo_cmd(DemoArgs& a) {
   if (a.seed_given->count() > 0) c.network_seed = c.training.seed = static_cast<std::uint64_t>(a.o.recipe.seed);
   if (a.batch_given->count() > 0) c.training.batch = a.o.recipe.batch_size;
   c.data.size = shell::scene_size(c.scene, a.cells, a.levels);
+  a.stepping.apply(c.data.simulation);
   c.network.fine_target = shell::parse_fine_target(a.fine_target);
   if (c.baselines == std::vector<std::string>{"none"}) c.baselines.clear();
   const auto report = with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) {
@@ -105,9 +108,7 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
                   "sheet/disk: the data's Newton linear solver, simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD; the same data to "
                   "round-off, ~3x faster at the paper's 4,225 fine vertices)")
       ->capture_default_str();
-  cmd->add_option("--substeps", cl.data.simulation.substeps, "sheet/disk: backward-Euler steps per frame (the same for both resolutions)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1024));
+  add_cloth_stepping_options(cmd, a->stepping, "sheet/disk");
   cmd->add_option("--sequence-workers", cl.data.sequence_workers,
                   "sheet/disk: sequences simulated at once, one thread each (0: OMP_NUM_THREADS; the same data for any count)")
       ->capture_default_str()

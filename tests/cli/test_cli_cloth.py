@@ -41,7 +41,10 @@ check(summary.get("coarse", {}).get("vertices") == 16 and summary.get("fine", {}
 seqs = summary.get("sequences", [])
 check(len(seqs) == 1 and seqs[0].get("name") == "sheet_000" and seqs[0].get("split") == "train", f"one training sequence: {seqs}")
 check(summary.get("seed") == 7, f"without --seed the demo's sequences (seed 7): {summary.get('seed')}")
-check(summary.get("substeps") == 2, f"without --substeps the scene's own (sheet 2): {summary.get('substeps')}")
+check(summary.get("substeps") == 8, f"without --substeps the default (8): {summary.get('substeps')}")
+newton = summary.get("newton", {})
+check(newton.get("max_iterations") == 3 and newton.get("accept_at_max_iterations") is True and newton.get("hessian") == "projected",
+      f"without --stepping inexact steps (at most 3 projected Newton iterations each): {newton}")
 check(seqs and seqs[0].get("scene", {}).get("pole") == 1 and "heading_rad" in seqs[0]["scene"], f"the sequence's parameters (sequence 0: the pole): {seqs[:1]}")
 frames = seqs[0].get("frames", 0) if seqs else 0
 check(frames > 60, f"a sequence of seconds at 30 frames per second: {frames} frames")
@@ -87,6 +90,24 @@ if all(os.path.exists(os.path.join(o, "sheet_001.npz")) for o in side.values()):
 p3 = simsr("datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "1", "--substeps", "3", "--out", os.path.join(WORK, "sheet_substeps3"))
 s3 = json.loads(p3.stdout) if p3.returncode == 0 else {}
 check(s3.get("substeps") == 3 and s3.get("sequences", [{}])[0].get("simulated") == frames, f"--substeps 3: {s3.get('substeps')}")
+# --stepping converged: Newton to convergence in each step, another run, recorded in the summary
+pconv = simsr("datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "1", "--stepping", "converged",
+              "--out", os.path.join(WORK, "sheet_converged"))
+sconv = json.loads(pconv.stdout) if pconv.returncode == 0 else {}
+check(sconv.get("newton", {}).get("hessian") == "regularized" and sconv.get("newton", {}).get("accept_at_max_iterations") is False
+      and sconv.get("sequences", [{}])[0].get("simulated") == frames, f"--stepping converged: {sconv.get('newton')}")
+if pconv.returncode == 0:
+    zconv = np.load(os.path.join(WORK, "sheet_converged", "sheet_000.npz"))
+    gap = np.linalg.norm(zconv["lowres"] - lr, axis=-1).max()  # lr: read before the file was replaced (above)
+    check(0 < gap < 0.01, f"inexact and converged steps: the same motion within a centimetre ({gap * 1e3:.2f} mm at most)")
+# --step-iterations 1: ARCSim's linearized steps, another run
+plin = simsr("datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "1", "--step-iterations", "1",
+             "--out", os.path.join(WORK, "sheet_linearized"))
+slin = json.loads(plin.stdout) if plin.returncode == 0 else {}
+check(slin.get("newton", {}).get("max_iterations") == 1 and slin.get("sequences", [{}])[0].get("simulated") == frames,
+      f"--step-iterations 1: {slin.get('newton')}")
+bad = simsr("datagen", "--scenario", "sheet", "--stepping", "exact", "--out", os.path.join(WORK, "x"), expect=1)
+check("--stepping" in bad.stderr and "exact" in bad.stderr, f"an unknown --stepping is named: {bad.stderr.strip()[-200:]}")
 bad = simsr("datagen", "--scenario", "sheet", "--substeps", "-1", "--out", os.path.join(WORK, "x"), expect=1)
 check("--substeps" in bad.stderr, f"a negative substep count is refused: {bad.stderr.strip()[-200:]}")
 bad = simsr("datagen", "--scenario", "sheet", "--sequence-workers", "-1", "--out", os.path.join(WORK, "x"), expect=1)

@@ -166,6 +166,35 @@ TEST_CASE("Newton: warm start at the solution converges at once; seq and omp sol
     CHECK(e.iterations() == 2);
     CHECK(e.residual() > 0);
   }
+  // A fixed budget instead (accept_at_max_iterations): the iterate after 1 or 2 iterations is
+  // returned, unconverged, its energy below the start's (far from the solution the gradient may
+  // grow on the way)
+  {
+    std::vector<Points<>> iterates;
+    QuasistaticSolver<SparseCholesky<>> full(mesh.num_vertices(), mesh.T, NewtonOptions{.progress = {}});
+    Points<> w = mesh.V;
+    const auto done = full.solve(exec::seq, w, wall.boundary(), elastic, heavy);
+    REQUIRE(done.converged);
+    REQUIRE(done.iterations > 2);
+    for (Index budget : {1, 2}) {
+      QuasistaticSolver<SparseCholesky<>> fixed(mesh.num_vertices(), mesh.T,
+                                               NewtonOptions{.max_iterations = budget, .accept_at_max_iterations = true, .progress = {}});
+      Points<> v = mesh.V;
+      const auto r = fixed.solve(exec::seq, v, wall.boundary(), elastic, heavy);
+      CHECK_FALSE(r.converged);
+      CHECK(r.iterations == budget);
+      CHECK(r.history.size() == std::size_t(budget));
+      CHECK(r.energy < r.history[0].energy);
+      CHECK(r.gradient_norm > done.gradient_norm);
+      CHECK((v - w).cwiseAbs().maxCoeff() > 0);  // not yet the solution
+      iterates.push_back(v);
+    }
+    // the budget of 2 continues from the budget of 1: a third solver's single step from there lands on it
+    QuasistaticSolver<SparseCholesky<>> one(mesh.num_vertices(), mesh.T, NewtonOptions{.max_iterations = 1, .accept_at_max_iterations = true, .progress = {}});
+    Points<> u = iterates[0];
+    one.solve(exec::seq, u, wall.boundary(), elastic, heavy);
+    CHECK((u - iterates[1]).cwiseAbs().maxCoeff() <= 1e-12 * iterates[1].cwiseAbs().maxCoeff());
+  }
   // Bad input: wrong position shape, Dirichlet vertex out of range, non-finite target.
   Points<> wrong(3, 3);
   CHECK_THROWS_AS(seq.solve(exec::seq, wrong, wall.boundary(), elastic), ShapeError);

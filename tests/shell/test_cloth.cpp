@@ -106,20 +106,39 @@ TEST_CASE("ClothSimulator on SHEET (reduced: 25 / 81 vertices): a sphere comes d
   ClothSimulator<physics::Capsule<>> coarse(pair.coarse, pair.pinned, seq.obstacle_at(0));
   ClothSimulator<physics::Capsule<>> fine(pair.fine, pair.pinned, seq.obstacle_at(0));
   auto move = [&](physics::Capsule<>& o, double t) { o = seq.obstacle_at(t); };
-  // a third run whose Newton solves are cut short: the failed steps are halved, and it follows
-  // the regular run closely (the momentum carried over each shorter step)
-  ClothOptions short_newton;
+  // the coarse cloth again with each step solved to convergence (the default's 8 steps per
+  // frame): the inexact steps (at most 3 Newton iterations each, the default) stay within
+  // millimetres of it, the linearized ones (1 iteration, ARCSim's) within centimetres
+  ClothOptions converged_options;
+  converged_options.newton = cloth_newton_options(ClothStepping::converged);
+  ClothSimulator<physics::Capsule<>> converged(pair.coarse, pair.pinned, seq.obstacle_at(0), {}, converged_options);
+  ClothOptions linearized_options;
+  linearized_options.newton = cloth_newton_options(ClothStepping::inexact, 1);
+  ClothSimulator<physics::Capsule<>> linearized(pair.coarse, pair.pinned, seq.obstacle_at(0), {}, linearized_options);
+  // and, at 2 steps per frame, a run whose Newton solves are cut short: the failed steps are
+  // halved, and it follows the converged run of 2 steps per frame (the momentum carried over
+  // each shorter step)
+  ClothOptions converged_2 = converged_options;
+  converged_2.substeps = 2;
+  ClothSimulator<physics::Capsule<>> converged_by_2(pair.coarse, pair.pinned, seq.obstacle_at(0), {}, converged_2);
+  ClothOptions short_newton = converged_2;
   short_newton.newton.max_iterations = 5;
   ClothSimulator<physics::Capsule<>> halving(pair.coarse, pair.pinned, seq.obstacle_at(0), {}, short_newton);
   Index halvings = 0;
-  double halving_gap = 0;
+  double halving_gap = 0, inexact_gap = 0, linearized_gap = 0;
   const Index frames = Index(std::ceil(seq.duration() / coarse.options().frame_time));
   double lowest = 0, deepest = 0, worst_gap = 0, largest_motion = 0;
   for (Index f = 0; f < frames; ++f) {
     const ClothFrameReport rc = coarse.advance(exec::omp, move), rf = fine.advance(exec::omp, move);
+    converged.advance(exec::seq, move);
+    CHECK(linearized.advance(exec::seq, move).newton_iterations == linearized_options.substeps);  // one iteration per step, none halved
+    converged_by_2.advance(exec::seq, move);
     halvings += halving.advance(exec::seq, move).halvings;
-    halving_gap = std::max(halving_gap, (halving.positions() - coarse.positions()).rowwise().norm().maxCoeff());
-    CHECK(rc.newton_iterations >= 1);
+    halving_gap = std::max(halving_gap, (halving.positions() - converged_by_2.positions()).rowwise().norm().maxCoeff());
+    inexact_gap = std::max(inexact_gap, (coarse.positions() - converged.positions()).rowwise().norm().maxCoeff());
+    linearized_gap = std::max(linearized_gap, (linearized.positions() - converged.positions()).rowwise().norm().maxCoeff());
+    CHECK(rc.newton_iterations <= 3 * coarse.options().substeps);  // the budget of 3 per step, none halved
+    CHECK(rc.halvings == 0);
     deepest = std::min({deepest, rc.deepest, rf.deepest});
     lowest = std::min(lowest, fine.positions().col(2).minCoeff());
     const Points<> up = pair.subdivision * coarse.positions();
@@ -133,7 +152,11 @@ TEST_CASE("ClothSimulator on SHEET (reduced: 25 / 81 vertices): a sphere comes d
   CHECK(worst_gap < 0.5 * largest_motion);  // the same cloth at two resolutions, unconstrained
   CHECK(halvings > 0);
   CHECK(halving_gap < 0.02);
-  MESSAGE("Newton cut at 5 iterations: " << halvings << " steps halved, at most " << halving_gap << " m from the regular run");
+  CHECK(inexact_gap < 0.01);
+  CHECK(linearized_gap < 0.05);
+  MESSAGE("Newton cut at 5 iterations (2 steps per frame): " << halvings << " steps halved, at most " << halving_gap << " m from the converged run");
+  MESSAGE("8 steps per frame, at most from the converged run: inexact (3 iterations) " << inexact_gap << " m, linearized (1) " << linearized_gap
+                                                                                       << " m, of " << largest_motion << " m motion");
   MESSAGE("SHEET 25/81: lowest " << lowest << " m, deepest " << deepest << " m, subdivided-coarse to fine gap " << worst_gap << " m of " << largest_motion << " m motion");
 }
 
@@ -153,6 +176,8 @@ TEST_CASE("ClothSimulator's linear solver is a type: CHOLMOD steps a sheet into 
   seq.start_height = 0.05;  // touching within the first frames
   auto move = [&](physics::Capsule<>& o, double t) { o = seq.obstacle_at(t); };
   ClothOptions o;
+  o.substeps = 2;
+  o.newton = cloth_newton_options(ClothStepping::converged);
   o.newton.max_iterations = 4;
   ClothSimulator<physics::Capsule<>> simplicial(pair.fine, pair.pinned, seq.obstacle_at(0), {}, o);
   ClothSimulator<physics::Capsule<>, physics::CholmodCholesky<>> cholmod(pair.fine, pair.pinned, seq.obstacle_at(0), {}, o);
@@ -204,6 +229,12 @@ TEST_CASE("ClothSimulator on DISK (reduced: 37 vertices): the cloth drapes over 
   ClothOptions o;
   o.substeps = 0;
   CHECK_THROWS_AS(ClothSimulator<physics::RoundedCylinder<>>(pair.coarse, pair.pinned, disk_table(), {}, o), ArgumentError);
+  CHECK(parse_cloth_stepping("converged") == ClothStepping::converged);
+  CHECK(parse_cloth_stepping("inexact") == ClothStepping::inexact);
+  CHECK(cloth_newton_options(ClothStepping::inexact).max_iterations == 3);
+  CHECK(cloth_newton_options(ClothStepping::converged, 7).max_iterations == 7);
+  CHECK_THROWS_AS(cloth_newton_options(ClothStepping::inexact, -1), ArgumentError);
+  CHECK_THROWS_WITH_AS(parse_cloth_stepping("exact"), doctest::Contains("'exact'"), ArgumentError);
 }
 
 }  // namespace shell_test_cloth

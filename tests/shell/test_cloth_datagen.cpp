@@ -51,7 +51,10 @@ TEST_CASE("cloth datagen (SHEET, reduced): every sequence at both resolutions, t
   CHECK(json["coarse"]["vertices"] == 16);
   CHECK(json["fine"]["vertices"] == 49);
   CHECK(json["sequences"].size() == 2);
-  CHECK(json["substeps"] == 2);  // SHEET's own (opt leaves it 0)
+  CHECK(json["substeps"] == 8);  // ClothOptions' default: inexact steps, 8 per frame
+  CHECK(json["newton"]["max_iterations"] == 3);
+  CHECK(json["newton"]["accept_at_max_iterations"] == true);
+  CHECK(json["newton"]["hessian"] == "projected");
   // each sequence's parameters, as sheet_sequences drew them (the fingerprint's values, named)
   const auto drawn = sheet_sequences(2, opt.seed);
   for (std::size_t k = 0; k < 2; ++k) {
@@ -113,7 +116,7 @@ TEST_CASE("cloth datagen (DISK, reduced): the wind's sequences, the draped start
   CHECK(stats[0].deepest > -0.01);
   // the step count and each sequence's wind in the summary
   const auto json = nlohmann::json::parse(std::ifstream(dir.path / "cloth_data.json"));
-  CHECK(json["substeps"] == 2);
+  CHECK(json["substeps"] == 8);
   CHECK(json["sequences"][1]["scene"]["wind_m_per_s"].get<double>() == doctest::Approx(8));
   CHECK(json["sequences"][0]["scene"]["heading_rad"].get<double>() == disk_sequences(2, opt.seed)[0].heading);
   // another step count is another run (a copy of the first file is not reused) with other frames
@@ -129,6 +132,13 @@ TEST_CASE("cloth datagen (DISK, reduced): the wind's sequences, the draped start
     CHECK(nlohmann::json::parse(std::ifstream(four_dir.path / "cloth_data.json"))["substeps"] == 4);
     const auto c = data::read_paired_frames(four_dir.path / "disk_000.npz");
     CHECK((c.hr(c.num_frames() - 1) - a.hr(a.num_frames() - 1)).cwiseAbs().maxCoeff() > 0);
+    // steps solved to convergence are another run too
+    std::filesystem::copy_file(dir.path / "disk_000.npz", four_dir.path / "disk_000.npz", std::filesystem::copy_options::overwrite_existing);
+    ClothDatagenOptions converged = four;
+    converged.simulation.substeps = opt.simulation.substeps;
+    converged.simulation.newton = cloth_newton_options(ClothStepping::converged);
+    CHECK_FALSE(generate_cloth_data(exec::omp, ClothDataset::disk, four_dir.path, converged)[0].reused);
+    CHECK(nlohmann::json::parse(std::ifstream(four_dir.path / "cloth_data.json"))["newton"]["hessian"] == "regularized");
     ClothDatagenOptions none = four;
     none.simulation.substeps = 0;
     CHECK(test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::seq, ClothDataset::disk, four_dir.path, none); }).find("substeps") !=

@@ -63,6 +63,12 @@ struct NewtonOptions {
   /// round-off of the positions, even where no force scale exists (an unloaded body at rest).
   double step_tolerance = 1e-13;
   Index max_iterations = 100;
+  /// After max_iterations, return the iterate (report.converged false) instead of throwing
+  /// ConvergenceError: an inexact Newton with a fixed budget. max_iterations = 1 is one Newton
+  /// step with line search per solve; for a backward-Euler step that is the linearized implicit
+  /// Euler of Baraff & Witkin 1998 (what ARCSim, the thin-shell paper's cloth simulator, takes),
+  /// one factorization per step. A line search that finds no decrease still throws.
+  bool accept_at_max_iterations = false;
   double armijo = 1e-4;           ///< sufficient decrease: E(x+αd) ≤ E(x) + armijo·α·gᵀd
   Index max_backtracks = 40;      ///< each halves α
   /// Which Hessian the Newton systems use. `adaptive` tries the exact Hessian first and falls back
@@ -155,7 +161,10 @@ class QuasistaticSolver {
         report.converged = true;
         return report;
       }
-      if (it >= options_.max_iterations) throw ConvergenceError("quasistatic Newton", it, gnorm);
+      if (it >= options_.max_iterations) {
+        if (options_.accept_at_max_iterations) return report;
+        throw ConvergenceError("quasistatic Newton", it, gnorm);
+      }
 
       // Newton direction: H d = −g (fixed DOFs: identity rows, zero right-hand side).
       rhs_ = -g_;

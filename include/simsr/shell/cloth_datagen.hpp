@@ -117,7 +117,9 @@ inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, cons
   f.add(m.areal_density).add(m.stretch).add(m.bending).add(s.frame_time).add(s.substeps).add(s.damping).add(s.gravity).add(s.contact_stiffness);
   f.add(s.newton.relative_tolerance).add(s.newton.absolute_tolerance).add(s.newton.max_iterations).add(std::int64_t(s.newton.hessian)).add(s.max_halvings);
   f.add(o.settle_frames).add(o.seed).add(o.extra_seconds).add(sequence).add(frames).add(parameters);
-  if (s.contact_onset != 0) f.add(s.contact_onset);  // added after the data of earlier runs: 0 hashes as before, so that data stays valid
+  // added after the data of earlier runs: their defaults hash as before, so that data stays valid
+  if (s.contact_onset != 0) f.add(s.contact_onset);
+  if (s.newton.accept_at_max_iterations) f.add(std::int64_t(1));
   return f.hex();
 }
 
@@ -432,6 +434,14 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   j["seed"] = opt.seed;
   j["frame_time_s"] = dt;
   j["substeps"] = opt.simulation.substeps;
+  {
+    const physics::NewtonOptions& n = opt.simulation.newton;
+    static constexpr const char* hessians[] = {"projected", "adaptive", "regularized"};
+    j["newton"] = {{"max_iterations", n.max_iterations},
+                   {"accept_at_max_iterations", n.accept_at_max_iterations},
+                   {"relative_tolerance", n.relative_tolerance},
+                   {"hessian", hessians[int(n.hessian)]}};
+  }
   nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
   Index train_frames = 0, test_frames = 0;
   for (std::size_t k = 0; k < stats.size(); ++k) {

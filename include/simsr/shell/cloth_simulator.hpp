@@ -2,8 +2,9 @@
 /// \file
 /// A cloth simulator on a triangle surface (the data of Chen et al. 2023, §3 of the supplement,
 /// issue #14): the coarse and the fine cloth are simulated separately with the same parameters
-/// and no constraint between them. Each frame is `substeps` backward-Euler steps, each a Newton
-/// solve (physics::QuasistaticSolver, projected Hessians where needed) of
+/// and no constraint between them. Each frame is `substeps` backward-Euler steps, each at most a
+/// few Newton iterations with line search (the default) or a Newton solve to convergence
+/// (physics::QuasistaticSolver; ClothStepping) of
 ///
 ///     ARAP membrane (TriangleMembrane) + bending (SurfaceBending) + gravity (lumped areal masses)
 ///     + inertia (ImplicitInertia: α = 1, γ = 1, damping β) + wind (VertexForces from the last
@@ -51,22 +52,62 @@ struct ClothMaterial {
   double bending = 2e-5;       ///< SurfaceBending k (N·m)
 };
 
+/// How each backward-Euler step is solved.
+///
+/// `inexact` (the default): at most 3 Newton iterations from the prediction (the budget of
+/// cloth_newton_options), on the projected (PSD) Hessian, each with a line search on the step's
+/// energy; fewer where the gradient falls to 10⁻⁶ of its scale, and the iterate taken when the
+/// budget is spent (physics::NewtonOptions::accept_at_max_iterations).
+/// One iteration is Baraff & Witkin 1998's linearized implicit Euler, ARCSim's scheme (the
+/// paper's data). `converged`: Newton to a relative gradient of 10⁻⁶ (at most 30 iterations),
+/// the Hessian `regularized` (exact, shifted where a folding cloth makes it indefinite).
+///
+/// Why 3 iterations at 8 steps per frame: measured on DISK's fine cloth (7,057 vertices) in
+/// 5.7 m/s wind, 3 frames from a checkpoint, against Newton converged at 8 steps per frame: 3
+/// iterations 0.13 / 0.19 / 0.24 mm RMS apart after 1 / 2 / 3 frames at 7–8 s per fine frame;
+/// 1 iteration 0.8 / 2.2 / 3.5 mm at 4.5–5.8 s; converged at 2 steps per frame (the earlier
+/// default) 1.3 / 2.5 / 4.2 mm at 31–83 s; converged at 8 steps 29–35 s (README, "Thin shells").
+enum class ClothStepping { inexact, converged };
+
+/// Newton's options for one step of `stepping` (see ClothStepping); `iterations` the budget
+/// (inexact) or the cap (converged), 0 for the stepping's default (3 / 30).
+inline physics::NewtonOptions cloth_newton_options(ClothStepping stepping, Index iterations = 0) {
+  if (iterations < 0) throw ArgumentError("cloth steps: Newton iterations must be >= 0 (0: the default), got " + std::to_string(iterations));
+  if (stepping == ClothStepping::converged)
+    return {.relative_tolerance = 1e-6,
+            .max_iterations = iterations > 0 ? iterations : 30,
+            .hessian = physics::NewtonOptions::Hessian::regularized,
+            .progress = {}};
+  return {.relative_tolerance = 1e-6,
+          .max_iterations = iterations > 0 ? iterations : 3,
+          .accept_at_max_iterations = true,
+          .hessian = physics::NewtonOptions::Hessian::projected,
+          .progress = {}};
+}
+
+/// "inexact" or "converged" (`simsr datagen|demo --stepping`); ArgumentError naming the others.
+inline ClothStepping parse_cloth_stepping(const std::string& name) {
+  if (name == "inexact") return ClothStepping::inexact;
+  if (name == "converged") return ClothStepping::converged;
+  throw ArgumentError("cloth steps: unknown '" + name + "' (inexact: at most a few Newton iterations per backward-Euler step; converged: Newton to 1e-6)");
+}
+
 /// Time stepping, gravity and contact.
 struct ClothOptions {
   double frame_time = 1.0 / 30;  ///< s per frame
-  Index substeps = 2;            ///< backward-Euler steps per frame
+  Index substeps = 8;            ///< backward-Euler steps per frame
   double damping = 0.02;         ///< ImplicitInertia β (s): velocity-proportional damping
   Vec3<> gravity{0, 0, -9.81};   ///< m/s²
   double contact_stiffness = 2e6;  ///< κ (N/m³): vertex i's penalty stiffness is κ A_i, a triangle point's κ A_t / 4
   /// The depth (m) over which the contact stiffness ramps up from 0 (physics::ObstacleContact::set_onset):
   /// 0 is the C¹ quadratic penalty, > 0 a C² one.
   double contact_onset = 0;
-  /// Newton's options. The Hessian `regularized` (shifted where it is indefinite, not projected):
-  /// a hanging cloth buckles, and with the projected fallback Newton stalled and halved steps
-  /// (physics::NewtonOptions::Hessian).
-  physics::NewtonOptions newton{.relative_tolerance = 1e-6, .max_iterations = 30, .hessian = physics::NewtonOptions::Hessian::regularized, .progress = {}};
-  /// A step whose Newton solve fails is taken as two half steps, recursively, at most this deep
-  /// (1/16 of a step at 4); beyond it the ConvergenceError is thrown.
+  /// Newton's options for each step: ClothStepping's inexact steps by default
+  /// (cloth_newton_options(ClothStepping::converged) for Newton to convergence).
+  physics::NewtonOptions newton = cloth_newton_options(ClothStepping::inexact);
+  /// A step whose Newton solve fails (not converged where that is asked, or a line search that
+  /// finds no decrease) is taken as two half steps, recursively, at most this deep (1/16 of a
+  /// step at 4); beyond it the ConvergenceError is thrown.
   Index max_halvings = 4;
 };
 
