@@ -67,6 +67,8 @@ struct ClothMaterial {
 /// iterations 0.13 / 0.19 / 0.24 mm RMS apart after 1 / 2 / 3 frames at 7–8 s per fine frame;
 /// 1 iteration 0.8 / 2.2 / 3.5 mm at 4.5–5.8 s; converged at 2 steps per frame (the earlier
 /// default) 1.3 / 2.5 / 4.2 mm at 31–83 s; converged at 8 steps 29–35 s (README, "Thin shells").
+/// Not cheaper everywhere: on bench_shell's SHEET pole, where converged Newton needs 8
+/// iterations per step, the budget's 24 per frame cost 1.5× the earlier default's 16.
 enum class ClothStepping { inexact, converged };
 
 /// Newton's options for one step of `stepping` (see ClothStepping); `iterations` the budget
