@@ -151,6 +151,7 @@ inline int datagen_cloth(const DatagenArgs& a) {
                  static_cast<long long>(f + 1), static_cast<long long>(frames), sc, static_cast<long long>(rc.newton_iterations), sf,
                  static_cast<long long>(rf.newton_iterations), 1e3 * std::min(rc.deepest, rf.deepest), elapsed);
   };
+  o.on_settle_frame = o.on_frame;  // the shared start, settled first: "settle frame 10/45: ..."
   with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) { shell::generate_cloth_data<L>(exec::omp, d, a.out, o); });
   std::ifstream summary(std::filesystem::path(a.out) / "cloth_data.json");
   std::cout << nlohmann::ordered_json::parse(summary).dump() << '\n';

@@ -49,6 +49,7 @@ check(seqs and seqs[0].get("scene", {}).get("pole") == 1 and "heading_rad" in se
 frames = seqs[0].get("frames", 0) if seqs else 0
 check(frames > 60, f"a sequence of seconds at 30 frames per second: {frames} frames")
 check(p.stderr.count("sheet_000 frame ") >= frames // 10, "a progress line per 10 frames on stderr")
+check(p.stderr.count("settle frame ") >= 4, "progress lines while the shared start settles (45 frames)")
 for name in ("coarse_rest.obj", "fine_rest.obj", "cloth_data.json", "sheet_000.npz"):
     check(os.path.exists(os.path.join(data, name)), f"datagen wrote {name}")
 if not os.path.exists(os.path.join(data, "sheet_000.npz")):

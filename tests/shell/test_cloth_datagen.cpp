@@ -169,9 +169,25 @@ TEST_CASE("cloth datagen: sequences side by side are bitwise the sequences one a
   opt.sequence_workers = 1;
   const auto a = generate_cloth_data(exec::omp, ClothDataset::sheet, one.path, opt);
   opt.sequence_workers = 3;
-  Index calls = 0;
+  Index calls = 0, settle_calls = 0;
   opt.on_frame = [&](const std::string&, Index, Index, const ClothFrameReport&, const ClothFrameReport&, double, double) { ++calls; };
+  // the shared start's settling reports its frames too, through its own callback
+  opt.on_settle_frame = [&](const std::string& name, Index f, Index F, const ClothFrameReport& c, const ClothFrameReport& fi, double sc, double sf) {
+    CHECK(name == "settle");
+    CHECK(f == settle_calls);
+    CHECK(F == opt.settle_frames);
+    CHECK(c.newton_iterations >= 1);
+    CHECK(fi.newton_iterations >= 1);
+    CHECK(sc >= 0);
+    CHECK(sf >= 0);
+    ++settle_calls;
+  };
   const auto b = generate_cloth_data(exec::omp, ClothDataset::sheet, three.path, opt);
+  CHECK(settle_calls == opt.settle_frames);
+  // a settled start read from its file calls nothing (the finished sequences are reused)
+  generate_cloth_data(exec::omp, ClothDataset::sheet, three.path, opt);
+  CHECK(settle_calls == opt.settle_frames);
+  opt.on_settle_frame = nullptr;
   REQUIRE(a.size() == 3);
   REQUIRE(b.size() == 3);
   Index frames = 0;
@@ -185,7 +201,7 @@ TEST_CASE("cloth datagen: sequences side by side are bitwise the sequences one a
     CHECK(p.lowres == q.lowres);
     CHECK(p.highres == q.highres);
   }
-  CHECK(calls == frames);  // every frame reported, the counter never raced (calls are serialized)
+  CHECK(calls == frames);  // every frame reported (not again when reused), the counter never raced (calls are serialized)
 
   // the first sequence fails at its 3rd frame: its error ends the run after the second sequence,
   // which another worker had, is finished and written

@@ -76,6 +76,10 @@ struct ClothDatagenOptions {
   /// the other workers' sequences are done, the run.
   std::function<void(const std::string&, Index, Index, const ClothFrameReport&, const ClothFrameReport&, double, double)> on_frame;
   using FrameCallback = decltype(on_frame);
+  /// Called after every frame of settling the sequences' shared start (on_frame's arguments, the
+  /// name "settle"; minutes at the paper's sizes); nothing when the settled start is read from
+  /// its file.
+  FrameCallback on_settle_frame;
 };
 
 /// One sequence's figures.
@@ -205,8 +209,14 @@ ClothPairState settled_cloth_start(P policy, const ClothDatagenRun& run, ClothSi
     if (io::fingerprint_of(z) == run.settle_print) return ClothPairState::read(z, run.coarse_vertices(), run.fine_vertices(), file.string());
   }
   for (Index f = 0; f < run.opt.settle_frames; ++f) {
-    advance_frame(policy, coarse, still, "settle", f, "coarse");
-    advance_frame(policy, fine, still, "settle", f, "fine");
+    const auto t0 = std::chrono::steady_clock::now();
+    const ClothFrameReport rc = advance_frame(policy, coarse, still, "settle", f, "coarse");
+    const auto t1 = std::chrono::steady_clock::now();
+    const ClothFrameReport rf = advance_frame(policy, fine, still, "settle", f, "fine");
+    const auto t2 = std::chrono::steady_clock::now();
+    if (run.opt.on_settle_frame)
+      run.opt.on_settle_frame("settle", f, run.opt.settle_frames, rc, rf, std::chrono::duration<double>(t1 - t0).count(),
+                              std::chrono::duration<double>(t2 - t1).count());
   }
   const ClothPairState s = ClothPairState::of(coarse, fine);
   io::NpzArrays z;

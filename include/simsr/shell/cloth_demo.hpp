@@ -122,16 +122,20 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
   std::filesystem::create_directories(results);
 
   ClothDatagenOptions gen = o.data;
-  const auto user_frame = gen.on_frame;
-  gen.on_frame = [&](const std::string& s, Index f, Index F, const ClothFrameReport& c, const ClothFrameReport& fi, double sc, double sf) {
-    if (user_frame) user_frame(s, f, F, c, fi, sc, sf);
-    if ((f + 1) % 20 == 0 || f + 1 == F) {
-      char buf[240];
-      std::snprintf(buf, sizeof buf, "data: %s frame %lld/%lld (this frame: coarse %.3f s, fine %.3f s, %lld Newton iterations, %lld steps halved)",
-                    s.c_str(), (long long)(f + 1), (long long)F, sc, sf, (long long)fi.newton_iterations, (long long)fi.halvings);
-      tell(buf);
-    }
+  // a progress line every 20th frame of each sequence and of the settling before them
+  auto progress = [&](const ClothDatagenOptions::FrameCallback& user) {
+    return [&, user](const std::string& s, Index f, Index F, const ClothFrameReport& c, const ClothFrameReport& fi, double sc, double sf) {
+      if (user) user(s, f, F, c, fi, sc, sf);
+      if ((f + 1) % 20 == 0 || f + 1 == F) {
+        char buf[240];
+        std::snprintf(buf, sizeof buf, "data: %s frame %lld/%lld (this frame: coarse %.3f s, fine %.3f s, %lld Newton iterations, %lld steps halved)",
+                      s.c_str(), (long long)(f + 1), (long long)F, sc, sf, (long long)fi.newton_iterations, (long long)fi.halvings);
+        tell(buf);
+      }
+    };
   };
+  gen.on_frame = progress(gen.on_frame);
+  gen.on_settle_frame = progress(gen.on_settle_frame);
   tell("data: " + data_dir.string());
   generate_cloth_data<Linear>(policy, o.scene, data_dir, gen);
   const ClothData data = read_cloth_data(data_dir);
