@@ -230,6 +230,9 @@ TEST_CASE("Newton progress: every iteration is reported, with the Hessian it use
 }
 
 TEST_CASE("Hessian::regularized: where the exact Hessian is indefinite it is shifted, not projected; where it is definite, Newton as adaptive") {
+  CHECK(std::string(hessian_name(NewtonOptions::Hessian::projected)) == "projected");
+  CHECK(std::string(hessian_name(NewtonOptions::Hessian::adaptive)) == "adaptive");
+  CHECK(std::string(hessian_name(NewtonOptions::Hessian::regularized)) == "regularized");
   // a cloth membrane crumpled inside its pinned boundary: compressed triangles make the exact
   // Hessian indefinite at the start; the minimum (energy 0) is the flat rest sheet
   const TriMesh<> sheet = square_sheet(1.0, 8);

@@ -93,6 +93,16 @@ struct NewtonOptions {
   std::function<void(const NewtonIteration&)> progress;
 };
 
+/// "projected", "adaptive" or "regularized" (reports and dataset summaries).
+inline const char* hessian_name(NewtonOptions::Hessian h) {
+  switch (h) {
+    case NewtonOptions::Hessian::projected: return "projected";
+    case NewtonOptions::Hessian::adaptive: return "adaptive";
+    case NewtonOptions::Hessian::regularized: return "regularized";
+  }
+  return "unknown";
+}
+
 /// What a solve did.
 struct NewtonReport {
   bool converged = false;

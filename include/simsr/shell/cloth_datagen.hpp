@@ -147,6 +147,24 @@ ClothFrameReport advance_frame(P policy, Sim& sim, const Move& move, const std::
   }
 }
 
+/// One frame of both resolutions (coarse first), each timed: what on_frame reports.
+struct PairFrame {
+  ClothFrameReport coarse, fine;
+  double coarse_seconds = 0, fine_seconds = 0;
+};
+template <class P, class Sim, class Move>
+PairFrame advance_pair(P policy, Sim& coarse, Sim& fine, const Move& move, const std::string& seq, Index frame) {
+  PairFrame r;
+  const auto t0 = std::chrono::steady_clock::now();
+  r.coarse = advance_frame(policy, coarse, move, seq, frame, "coarse");
+  const auto t1 = std::chrono::steady_clock::now();
+  r.fine = advance_frame(policy, fine, move, seq, frame, "fine");
+  const auto t2 = std::chrono::steady_clock::now();
+  r.coarse_seconds = std::chrono::duration<double>(t1 - t0).count();
+  r.fine_seconds = std::chrono::duration<double>(t2 - t1).count();
+  return r;
+}
+
 /// What generate_cloth_data hands each scene's simulation: the meshes, options, paths, and per
 /// sequence its frame count, fingerprint and checkpoint (read and checked before anything runs).
 struct ClothDatagenRun {
@@ -209,14 +227,8 @@ ClothPairState settled_cloth_start(P policy, const ClothDatagenRun& run, ClothSi
     if (io::fingerprint_of(z) == run.settle_print) return ClothPairState::read(z, run.coarse_vertices(), run.fine_vertices(), file.string());
   }
   for (Index f = 0; f < run.opt.settle_frames; ++f) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const ClothFrameReport rc = advance_frame(policy, coarse, still, "settle", f, "coarse");
-    const auto t1 = std::chrono::steady_clock::now();
-    const ClothFrameReport rf = advance_frame(policy, fine, still, "settle", f, "fine");
-    const auto t2 = std::chrono::steady_clock::now();
-    if (run.opt.on_settle_frame)
-      run.opt.on_settle_frame("settle", f, run.opt.settle_frames, rc, rf, std::chrono::duration<double>(t1 - t0).count(),
-                              std::chrono::duration<double>(t2 - t1).count());
+    const PairFrame p = advance_pair(policy, coarse, fine, still, "settle", f);
+    if (run.opt.on_settle_frame) run.opt.on_settle_frame("settle", f, run.opt.settle_frames, p.coarse, p.fine, p.coarse_seconds, p.fine_seconds);
   }
   const ClothPairState s = ClothPairState::of(coarse, fine);
   io::NpzArrays z;
@@ -261,12 +273,9 @@ ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run,
   for (Index f = start; f < F; ++f) {
     coarse.set_air(air_for(k, coarse.time()));
     fine.set_air(air_for(k, fine.time()));
-    const auto t0 = std::chrono::steady_clock::now();
-    const ClothFrameReport rc = advance_frame(policy, coarse, move, st.name, f, "coarse");
-    const auto t1 = std::chrono::steady_clock::now();
-    const ClothFrameReport rf = advance_frame(policy, fine, move, st.name, f, "fine");
-    const auto t2 = std::chrono::steady_clock::now();
-    const double sc = std::chrono::duration<double>(t1 - t0).count(), sf = std::chrono::duration<double>(t2 - t1).count();
+    const PairFrame p = advance_pair(policy, coarse, fine, move, st.name, f);
+    const ClothFrameReport &rc = p.coarse, &rf = p.fine;
+    const double sc = p.coarse_seconds, sf = p.fine_seconds;
     out.lr(f) = coarse.positions();
     out.hr(f) = fine.positions();
     st.coarse_seconds += sc;
@@ -444,14 +453,11 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   j["seed"] = opt.seed;
   j["frame_time_s"] = dt;
   j["substeps"] = opt.simulation.substeps;
-  {
-    const physics::NewtonOptions& n = opt.simulation.newton;
-    static constexpr const char* hessians[] = {"projected", "adaptive", "regularized"};
-    j["newton"] = {{"max_iterations", n.max_iterations},
-                   {"accept_at_max_iterations", n.accept_at_max_iterations},
-                   {"relative_tolerance", n.relative_tolerance},
-                   {"hessian", hessians[int(n.hessian)]}};
-  }
+  const physics::NewtonOptions& newton = opt.simulation.newton;
+  j["newton"] = {{"max_iterations", newton.max_iterations},
+                 {"accept_at_max_iterations", newton.accept_at_max_iterations},
+                 {"relative_tolerance", newton.relative_tolerance},
+                 {"hessian", physics::hessian_name(newton.hessian)}};
   nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
   Index train_frames = 0, test_frames = 0;
   for (std::size_t k = 0; k < stats.size(); ++k) {
