@@ -23,6 +23,7 @@
 #if defined(SIMSR_HAVE_CGAL)
 #include "remeshed_wrap.hpp"
 #endif
+#include "cloth_fine_options.hpp"
 #include "cloth_stepping_options.hpp"
 #include "linear_solver_choice.hpp"
 
@@ -59,7 +60,8 @@ struct DatagenArgs {
   ClothSteppingArgs stepping;  ///< sheet, disk: --substeps, --stepping, --step-iterations
   double skin_edge = 0;
   // sheet / disk
-  Index sequences = 0, cells = 0, levels = -1, sequence_workers = 0;
+  Index sequences = 0, cells = 0, levels = -1, fine_cells = 0, sequence_workers = 0;
+  std::string fine_frames_from;  ///< sheet/disk: a dataset whose fine frames this one takes
   CLI::Option* seed_given = nullptr;  ///< sheet/disk: without --seed, the library's (the demo's) seed
 };
 
@@ -136,7 +138,8 @@ inline scenario::FaceModelOptions face_model_options(const DatagenArgs& a) {
 inline int datagen_cloth(const DatagenArgs& a) {
   const shell::ClothDataset d = shell::cloth_dataset(a.scenario);
   shell::ClothDatagenOptions o;
-  o.size = shell::scene_size(d, a.cells, a.levels);
+  o.size = shell::scene_size(d, a.cells, a.levels, a.fine_cells);
+  o.fine_frames_from = a.fine_frames_from;
   o.sequences = a.sequences;
   if (a.seed_given->count() > 0) o.seed = a.seed;  // else ClothDatagenOptions' (7): the data `simsr demo --dataset sheet|disk` simulates
   o.checkpoint_every = a.checkpoint_every;
@@ -195,6 +198,7 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--cells", a->cells, "sheet: coarse cells per side (default 8: 81 vertices); disk: coarse rings (default 6: 127 vertices)")
       ->check(CLI::Range(2, 1000));
   cmd->add_option("--levels", a->levels, "sheet/disk: Loop subdivision levels from the coarse to the fine cloth (default 3)")->check(CLI::Range(0, 6));
+  add_fine_cloth_options(cmd, a->fine_cells, a->fine_frames_from);
   cmd->add_option("--samples", a->samples, "softdeca: parameter samples to simulate")->capture_default_str()->check(CLI::Range(1, 10000000));
   cmd->add_option("--layers", a->layers, "softdeca: prism layers per shell of the template (its resolution)")->capture_default_str()->check(CLI::Range(1, 16));
   cmd->add_option("--steps", a->steps, "softdeca: implicit steps from rest to the expression")->capture_default_str()->check(CLI::Range(1, 10000));

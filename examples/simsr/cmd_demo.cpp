@@ -19,6 +19,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "cloth_fine_options.hpp"
 #include "cloth_stepping_options.hpp"
 #include "linear_solver_choice.hpp"
 
@@ -38,7 +39,8 @@ struct DemoArgs {
   CLI::Option* epochs_given = nullptr;
   CLI::Option* seed_given = nullptr;
   CLI::Option* batch_given = nullptr;
-  Index cells = 0, levels = -1;  ///< sheet/disk: 0 / −1 the scene's default
+  Index cells = 0, levels = -1, fine_cells = 0;  ///< sheet/disk: 0 / −1 / 0 the scene's default
+  std::string fine_frames_from;                  ///< sheet/disk: a dataset whose fine frames this one takes
   std::string fine_target = shell::fine_target_name(shell::DetailSynthesisOptions{}.fine_target);
   std::string linear_solver = "simplicial";  ///< sheet/disk: the data's Newton linear solver
   ClothSteppingArgs stepping;                ///< sheet/disk: --substeps, --stepping, --step-iterations
@@ -52,7 +54,8 @@ int cloth_demo_cmd(DemoArgs& a) {
   if (a.epochs_given->count() > 0) c.training.epochs = a.o.recipe.epochs;
   if (a.seed_given->count() > 0) c.network_seed = c.training.seed = static_cast<std::uint64_t>(a.o.recipe.seed);
   if (a.batch_given->count() > 0) c.training.batch = a.o.recipe.batch_size;
-  c.data.size = shell::scene_size(c.scene, a.cells, a.levels);
+  c.data.size = shell::scene_size(c.scene, a.cells, a.levels, a.fine_cells);
+  c.data.fine_frames_from = a.fine_frames_from;
   a.stepping.apply(c.data.simulation);
   c.network.fine_target = shell::parse_fine_target(a.fine_target);
   if (c.baselines == std::vector<std::string>{"none"}) c.baselines.clear();
@@ -100,6 +103,7 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
       ->check(CLI::Range(2, 64));
   cmd->add_option("--levels", a->levels, "sheet/disk: Loop levels from the coarse to the fine cloth (3: the paper's ×64 faces)")
       ->check(CLI::Range(0, 6));
+  add_fine_cloth_options(cmd, a->fine_cells, a->fine_frames_from);
   cmd->add_option("--fine-target", a->fine_target,
                   "sheet/disk: what the network's fine side holds: residual (to the subdivided coarse mesh's features) or features (the supplement)")
       ->capture_default_str()

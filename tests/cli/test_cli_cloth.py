@@ -2,7 +2,8 @@
 """The thin-shell pipeline from the command line (issue #14): `simsr datagen --scenario sheet` at a
 reduced size (3 cells, one Loop level: 16 / 49 vertices, one sequence), its files, its summary
 and progress lines, a finished run reused, the same frames with `--linear-solver cholmod` and with
-two sequences side by side (`--sequence-workers 2`), and bad
+two sequences side by side (`--sequence-workers 2`), a coarser sheet beside the same fine one
+taking its fine frames from another dataset (`--fine-cells`, `--fine-frames-from`), and bad
 options named; `simsr demo --dataset sheet` at
 the same size (5 sequences, the 5th held out; 3 epochs): its report, per-frame errors and views
 (rendered by scripts/render_comparison.py --view oblique), the core paper's local-linear map and
@@ -87,6 +88,27 @@ if all(os.path.exists(os.path.join(o, "sheet_001.npz")) for o in side.values()):
     for name in ("sheet_000.npz", "sheet_001.npz"):
         a, b = np.load(os.path.join(side["1"], name)), np.load(os.path.join(side["2"], name))
         check((a["lowres"] == b["lowres"]).all() and (a["highres"] == b["highres"]).all(), f"--sequence-workers 2: {name} bitwise as with 1")
+# --fine-cells / --fine-frames-from (the scale study's pairing): a 2-cell coarse sheet beside the
+# same 49-vertex fine sheet, its fine frames taken from the one-worker dataset: bitwise those frames,
+# nothing of the fine cloth simulated; another seed's fine cloth refused, naming the file
+coarser = os.path.join(WORK, "sheet_coarser")
+pf = simsr("datagen", "--scenario", "sheet", "--cells", "2", "--fine-cells", "3", "--levels", "1", "--sequences", "1",
+           "--fine-frames-from", side["1"], "--out", coarser)
+sf = json.loads(pf.stdout) if pf.returncode == 0 else {}
+check(sf.get("coarse", {}).get("vertices") == 9 and sf.get("fine", {}).get("vertices") == 49 and sf.get("fine", {}).get("cells") == 3,
+      f"--cells 2 --fine-cells 3: 9 / 49 vertices: {sf.get('coarse')} {sf.get('fine')}")
+check(sf.get("sequences", [{}])[0].get("fine_reused") is True and "fine 0.000 s (0 Newton)" in pf.stderr,
+      f"--fine-frames-from: the fine frames taken, not simulated: {pf.stderr.strip()[-200:]}")
+if pf.returncode == 0 and os.path.exists(os.path.join(side["1"], "sheet_000.npz")):
+    zf, zs = np.load(os.path.join(coarser, "sheet_000.npz")), np.load(os.path.join(side["1"], "sheet_000.npz"))
+    check(zf["lowres"].shape[1] == 9 and (zf["highres"] == zs["highres"]).all(), "--fine-frames-from: the source's fine frames, bitwise")
+bad = simsr("datagen", "--scenario", "sheet", "--cells", "2", "--fine-cells", "3", "--levels", "1", "--sequences", "1", "--seed", "8",
+            "--fine-frames-from", side["1"], "--out", os.path.join(WORK, "x"), expect=1)
+check("sheet_000.npz" in bad.stderr and "another simulation's" in bad.stderr, f"another seed's fine frames refused: {bad.stderr.strip()[-300:]}")
+bad = simsr("datagen", "--scenario", "disk", "--fine-cells", "4", "--out", os.path.join(WORK, "x"), expect=1)
+check("first ring" in bad.stderr, f"--fine-cells for DISK refused: {bad.stderr.strip()[-200:]}")
+bad = simsr("demo", "--dataset", "disk", "--fine-cells", "4", "--out", os.path.join(WORK, "x"), expect=1)
+check("first ring" in bad.stderr, f"demo --fine-cells for DISK refused: {bad.stderr.strip()[-200:]}")
 # --substeps: another step is another run (simulated again), and its count is in the summary
 p3 = simsr("datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "1", "--substeps", "3", "--out", os.path.join(WORK, "sheet_substeps3"))
 s3 = json.loads(p3.stdout) if p3.returncode == 0 else {}

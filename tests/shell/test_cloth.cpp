@@ -10,6 +10,10 @@
 #include <simsr/physics/linear_solvers/cholmod_cholesky.hpp>
 #endif
 
+#include <simsr/mesh/closest_point.hpp>
+#include <simsr/mesh/loop_subdivision.hpp>
+
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -82,6 +86,7 @@ TEST_CASE("cloth_pair: SHEET 81 / 4,225 and DISK 127 / 7,057 vertices, the fine 
   CHECK((Points<>(sheet.subdivision * sheet.coarse.V) - sheet.fine.V).cwiseAbs().maxCoeff() == 0);
   for (Index k = 0; k < 4; ++k)  // the corners are kept: pinned at the same spot in both
     CHECK((sheet.fine.V.row(sheet.pinned[k]) - sheet.coarse.V.row(sheet.pinned[k])).norm() == 0);
+  CHECK((sheet.fine_pinned.array() == sheet.pinned.array()).all());
   CHECK(std::abs(sheet.coarse.V.col(0).mean()) < 1e-15);
   const ClothPair disk = cloth_pair(ClothDataset::disk, default_scene_size(ClothDataset::disk));
   CHECK(disk.coarse.V.rows() == 127);
@@ -93,6 +98,78 @@ TEST_CASE("cloth_pair: SHEET 81 / 4,225 and DISK 127 / 7,057 vertices, the fine 
   CHECK_THROWS_WITH_AS(cloth_dataset("skirt"), doctest::Contains("got 'skirt'"), ArgumentError);
   CHECK_THROWS_AS(cloth_pair(ClothDataset::sheet, {1, 2}), ArgumentError);
   CHECK_THROWS_AS(cloth_pair(ClothDataset::disk, {6, -1}), ArgumentError);
+}
+
+/// Brute force over every triangle of `surface` (rest positions) for the closest point to each
+/// fine rest vertex, then the deformed surface `moved` read there: what ClothPair::subdivision
+/// must do for a fine sheet of its own, written without the kd-tree.
+Points<> resampled_by_brute_force(const TriMesh<>& surface, const Points<>& moved, const Points<>& fine_rest) {
+  Points<> out(fine_rest.rows(), 3);
+  for (Index i = 0; i < fine_rest.rows(); ++i) {
+    const Vec3<> q = fine_rest.row(i).transpose();
+    double best = 1e300;
+    for (Index t = 0; t < surface.F.rows(); ++t) {
+      const Vec3<> a = surface.V.row(surface.F(t, 0)).transpose(), b = surface.V.row(surface.F(t, 1)).transpose(), c = surface.V.row(surface.F(t, 2)).transpose();
+      const Vec3<> w = closest_point_on_triangle(q, a, b, c);
+      const double d = (w[0] * a + w[1] * b + w[2] * c - q).norm();
+      if (d < best - 1e-14) {
+        best = d;
+        out.row(i) = w[0] * moved.row(surface.F(t, 0)) + w[1] * moved.row(surface.F(t, 1)) + w[2] * moved.row(surface.F(t, 2));
+      }
+    }
+  }
+  return out;
+}
+
+TEST_CASE("cloth_pair, a fine sheet of its own (the scale study's ×16 / ×256 beside the default fine cloth): the same fine cloth and pins, the baseline map resampled") {
+  const ClothPair standard = cloth_pair(ClothDataset::sheet, default_scene_size(ClothDataset::sheet));
+  CHECK(scene_size(ClothDataset::sheet, 16, -1, 8).fine_cells == 8);
+  CHECK(scene_size(ClothDataset::sheet, 16, -1).fine_source_cells() == 16);
+  // the paper's three: 512 / 128 / 32 coarse faces against the one 8,192-face fine sheet
+  for (const Index cells : {16, 8, 4, 2}) {
+    CAPTURE(cells);
+    const ClothPair p = cloth_pair(ClothDataset::sheet, {cells, 3, 8});
+    CHECK(p.coarse.F.rows() == 2 * cells * cells);
+    CHECK(p.fine.V == standard.fine.V);  // bitwise: the fine simulation is the default's
+    CHECK(p.fine.F == standard.fine.F);
+    CHECK((p.fine_pinned.array() == standard.pinned.array()).all());
+    REQUIRE(p.pinned.size() == 4);
+    for (Index a = 0; a < 4; ++a) CHECK((p.fine.V.row(p.fine_pinned[a]) - p.coarse.V.row(p.pinned[a])).norm() == 0);
+    REQUIRE(p.subdivision.rows() == 4225);
+    REQUIRE(p.subdivision.cols() == p.coarse.V.rows());
+    const Eigen::SparseMatrix<double> S = p.subdivision;
+    CHECK((Eigen::VectorXd(S * Eigen::VectorXd::Ones(S.cols())).array() - 1).abs().maxCoeff() < 1e-12);  // rows sum to 1
+    for (Index k = 0; k < S.outerSize(); ++k)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(S, k); it; ++it) CHECK(it.value() >= 0);
+    // at rest both are the flat 1 m square: the map gives the fine rest sheet itself
+    CHECK((Points<>(S * p.coarse.V) - p.fine.V).cwiseAbs().maxCoeff() < 1e-12);
+  }
+  CHECK(cloth_pair(ClothDataset::sheet, {8, 3, 8}).subdivision.isApprox(standard.subdivision));  // the same cells: Loop's own map
+  // a bent, turned coarse cloth: the map against Loop then a brute-force closest point
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const auto& [coarse_cells, fine_cells, levels] : std::vector<std::array<Index, 3>>{{4, 2, 2}, {2, 4, 1}, {3, 2, 2}, {5, 3, 1}}) {
+    CAPTURE(coarse_cells);
+    CAPTURE(fine_cells);
+    const ClothPair p = cloth_pair(ClothDataset::sheet, {coarse_cells, levels, fine_cells});
+    Points<> moved = p.coarse.V;
+    const double a = u(rng), b = u(rng);
+    for (Index i = 0; i < moved.rows(); ++i) moved(i, 2) = 0.2 * std::sin(3 * moved(i, 0) + a) * std::cos(2 * moved(i, 1) + b) + 0.05 * u(rng);
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(u(rng) * 3, Vec3<>(u(rng), u(rng), 1).normalized()).toRotationMatrix();
+    moved = (moved * R.transpose()).rowwise() + Vec3<>(u(rng), u(rng), u(rng)).transpose();
+    Index levels_up = 0;
+    while ((coarse_cells << levels_up) < (fine_cells << levels)) ++levels_up;
+    const LoopSubdivision sub = loop_subdivision(p.coarse.V, p.coarse.F, levels_up);
+    TriMesh<> surface;
+    surface.V = sub.S * p.coarse.V;
+    surface.F = sub.F;
+    const Points<> expected = resampled_by_brute_force(surface, Points<>(sub.S * moved), p.fine.V);
+    CHECK((Points<>(p.subdivision * moved) - expected).cwiseAbs().maxCoeff() < 1e-12);
+  }
+  CHECK_THROWS_WITH_AS(cloth_pair(ClothDataset::disk, {6, 3, 4}), doctest::Contains("first ring"), ArgumentError);
+  CHECK(cloth_pair(ClothDataset::disk, {3, 1, 3}).fine.V == cloth_pair(ClothDataset::disk, {3, 1}).fine.V);  // its own ring count: allowed
+  CHECK_THROWS_AS(cloth_pair(ClothDataset::sheet, {4, 1, -1}), ArgumentError);
+  CHECK_THROWS_AS(cloth_pair(ClothDataset::sheet, {4, 1, 1}), ArgumentError);
 }
 
 TEST_CASE("ClothSimulator on SHEET (reduced: 25 / 81 vertices): a sphere comes down and leaves; pins held, no vertex deep in it, the two resolutions agree") {

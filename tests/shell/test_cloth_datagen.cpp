@@ -2,6 +2,7 @@
 // resuming bitwise, another run's checkpoint refused, a finished file reused.
 #include <doctest/doctest.h>
 
+#include <simsr/shell/cloth_data.hpp>
 #include <simsr/shell/cloth_datagen.hpp>
 
 #include <fstream>
@@ -220,6 +221,89 @@ TEST_CASE("cloth datagen: sequences side by side are bitwise the sequences one a
   opt.sequence_workers = -1;
   CHECK_THROWS_AS(generate_cloth_data(exec::omp, ClothDataset::sheet, refused.path / "d", opt), ArgumentError);
   CHECK_FALSE(std::filesystem::exists(refused.path / "d"));
+}
+
+TEST_CASE("cloth datagen, a coarse sheet of other cells beside the same fine sheet: the fine frames taken from that dataset are bitwise the fine cloth simulated again; another simulation's refused") {
+  test::ScratchDir standard("simsr_test_cloth_fine_standard"), taken("simsr_test_cloth_fine_taken"), again("simsr_test_cloth_fine_again"),
+      refused("simsr_test_cloth_fine_refused");
+  ClothDatagenOptions opt = small_sheet();
+  opt.sequences = 2;
+  const auto a = generate_cloth_data(exec::omp, ClothDataset::sheet, standard.path, opt);  // 3 cells, Loop once: 16 / 49
+  ClothDatagenOptions coarser = opt;
+  coarser.size = {2, 1, 3};  // a 2-cell coarse sheet (9 vertices), the same 49-vertex fine one
+  coarser.fine_frames_from = standard.path;
+  Index fine_newton = 0;
+  coarser.on_frame = [&](const std::string&, Index, Index, const ClothFrameReport&, const ClothFrameReport& f, double, double) { fine_newton += f.newton_iterations; };
+  const auto b = generate_cloth_data(exec::omp, ClothDataset::sheet, taken.path, coarser);
+  CHECK(fine_newton == 0);  // the fine cloth never stepped
+  coarser.fine_frames_from.clear();
+  const auto c = generate_cloth_data(exec::omp, ClothDataset::sheet, again.path, coarser);  // both simulated
+  CHECK(fine_newton > 0);
+  REQUIRE(b.size() == 2);
+  REQUIRE(c.size() == 2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    CHECK(b[k].fine_reused);
+    CHECK_FALSE(c[k].fine_reused);
+    CHECK(b[k].fine_iterations == 0);
+    CHECK(c[k].fine_iterations == a[k].fine_iterations);
+    const auto p = data::read_paired_frames(standard.path / (a[k].name + ".npz"), 16, 49);
+    const auto q = data::read_paired_frames(taken.path / (b[k].name + ".npz"), 9, 49);
+    const auto r = data::read_paired_frames(again.path / (c[k].name + ".npz"), 9, 49);
+    CHECK(q.highres == p.highres);  // taken
+    CHECK(r.highres == p.highres);  // simulated again: the same simulation, bitwise
+    CHECK(r.lowres == q.lowres);
+    CHECK(b[k].subdivided_rmse == c[k].subdivided_rmse);
+    CHECK(b[k].subdivided_rmse > 0);
+  }
+  const auto json = nlohmann::json::parse(std::ifstream(taken.path / "cloth_data.json"));
+  CHECK(json["coarse_cells"] == 2);
+  CHECK(json["fine"]["cells"] == 3);
+  CHECK(json["coarse"]["vertices"] == 9);
+  CHECK(json["fine_frames_from"] == standard.path.string());
+  CHECK(json["sequences"][0]["fine_reused"] == true);
+  CHECK_FALSE(nlohmann::json::parse(std::ifstream(again.path / "cloth_data.json")).contains("fine_frames_from"));
+  // read back: the pair rebuilt with its fine cloth of its own
+  const ClothData d = read_cloth_data(taken.path);
+  CHECK(d.size.fine_cells == 3);
+  CHECK(d.num_coarse() == 9);
+  CHECK(d.num_fine() == 49);
+
+  // refused before anything is simulated, each naming the file: another seed's fine cloth, a
+  // sequence the source lacks, a file without the fine fingerprint, the output folder itself
+  ClothDatagenOptions other = coarser;
+  other.fine_frames_from = standard.path;
+  other.seed = opt.seed + 1;
+  const std::string file0 = (standard.path / "sheet_000.npz").string();
+  std::string e = test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::omp, ClothDataset::sheet, refused.path / "seed", other); });
+  CHECK(e.find(file0) != std::string::npos);
+  CHECK(e.find("another simulation's") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(refused.path / "seed"));
+  other.seed = opt.seed;
+  other.sequences = 3;
+  e = test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::omp, ClothDataset::sheet, refused.path / "count", other); });
+  CHECK(e.find("sheet_002.npz: no such file") != std::string::npos);
+  other.sequences = 2;
+  other.fine_frames_from = taken.path;  // its fine frames are the same simulation: taken again is fine ...
+  CHECK(generate_cloth_data(exec::omp, ClothDataset::sheet, refused.path / "chain", other)[1].fine_reused);
+  {  // ... but not from a file written before fine fingerprints
+    std::filesystem::create_directories(refused.path / "old");
+    io::NpzArrays z = io::read_npz(standard.path / "sheet_000.npz"), old;
+    for (const auto& [name, array] : z)
+      if (name != "fine_fingerprint") old[name] = array;
+    io::write_npz(refused.path / "old" / "sheet_000.npz", old);
+    std::filesystem::copy_file(standard.path / "sheet_001.npz", refused.path / "old" / "sheet_001.npz");
+    other.fine_frames_from = refused.path / "old";
+    CHECK(test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::omp, ClothDataset::sheet, refused.path / "from_old", other); })
+              .find("no fine-cloth fingerprint") != std::string::npos);
+  }
+  other.fine_frames_from = taken.path;
+  CHECK(test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::omp, ClothDataset::sheet, taken.path, other); }).find("output folder") !=
+        std::string::npos);
+  // a fine cloth of its own for DISK is refused (its vase is the first ring)
+  ClothDatagenOptions disk;
+  disk.size = {3, 1, 4};
+  CHECK(test::typed_error_of<ArgumentError>([&] { generate_cloth_data(exec::omp, ClothDataset::disk, refused.path / "disk", disk); }).find("first ring") !=
+        std::string::npos);
 }
 
 }  // namespace shell_test_cloth_datagen

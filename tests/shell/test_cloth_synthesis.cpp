@@ -77,6 +77,25 @@ TEST_CASE("read_cloth_data: the pair, the split and every frame; the obstacle at
   CHECK(test::typed_error_of<ParseError>([&] { read_cloth_data(empty.path); }).find("cloth_data.json") != std::string::npos);
 }
 
+/// The scale study's pairing at a reduced size: a 2-cell coarse sheet (9 vertices) beside
+/// dataset()'s fine sheet (3 cells, Loop once: 49), its fine frames taken from dataset().
+const std::filesystem::path& coarser_dataset() {
+  static const test::ScratchDir dir("simsr_test_cloth_synthesis_coarser");
+  static const bool made = [] {
+    ClothDatagenOptions o;
+    o.size = {2, 1, 3};
+    o.sequences = 5;
+    o.extra_seconds = 0;
+    o.settle_frames = 5;
+    o.simulation.frame_time = 0.1;
+    o.fine_frames_from = dataset();
+    generate_cloth_data(exec::omp, ClothDataset::sheet, dir.path, o);
+    return true;
+  }();
+  (void)made;
+  return dir.path;
+}
+
 /// RMS distance to the fine simulation of sequence t's subdivided coarse frames' features decoded
 /// with the pins where the coarse frames have them, computed here from the parts.
 double decoded_subdivided_rmse(const ClothSynthesis& run, const ClothData& d, const ClothSequenceFrames& t) {
@@ -93,31 +112,42 @@ double decoded_subdivided_rmse(const ClothSynthesis& run, const ClothData& d, co
 
 TEST_CASE("ClothSynthesis, residual fine target: a network whose residual is zero gives back the subdivided mesh's features decoded") {
   const ClothData d = read_cloth_data(dataset());
-  const auto& t = d.sequences[4];
-  for (const FineTarget target : {FineTarget::residual, FineTarget::features}) {
-    CAPTURE(fine_target_name(target));
-    DetailSynthesisOptions o = small_net();
-    o.fine_target = target;
-    ClothSynthesis run(exec::seq, d, o, 5);
-    CHECK(run.residual() == (target == FineTarget::residual));
-    // the decoder's last convolution made constant: its output is the normalized zero residual
-    auto& net = run.network();
-    auto& store = net.store();
-    for (const char* w : {"fine_dec.conv2.point.weight", "fine_dec.conv2.neighbor.weight"})
-      for (float& v : store.values(store.at(w))) v = 0;
-    const auto bias = store.values(store.at("fine_dec.conv2.point.bias"));
-    for (Index c = 0; c < 9; ++c) bias[std::size_t(c)] = float(-net.fine_scaling().mean[c] / net.fine_scaling().scale[c]);
-    std::vector<Points<>> raw;
-    run.synthesize(exec::seq, 4, nullptr, nullptr, &raw);
-    const double expected = decoded_subdivided_rmse(run, d, t);
-    double sum = 0;
-    for (Index f = 0; f < t.num_frames(); ++f) sum += (raw[std::size_t(f)] - t.fine[std::size_t(f)]).squaredNorm();
-    const double synthesized = std::sqrt(sum / double(t.num_frames() * d.num_fine()));
-    if (target == FineTarget::residual) {
-      CHECK(synthesized == doctest::Approx(expected).epsilon(1e-5));  // the residual passes through float
-    } else {
-      // the same zero output as features is a flat rotation-free sheet, far from the subdivided mesh
-      CHECK(std::abs(synthesized - expected) > 0.1 * expected);
+  // the same on the scale study's pairing: a coarser sheet of its own, the baseline map resampled
+  const ClothData coarser = read_cloth_data(coarser_dataset());
+  REQUIRE(coarser.num_coarse() == 9);
+  REQUIRE(coarser.num_fine() == 49);
+  CHECK(coarser.sequences[4].fine == d.sequences[4].fine);
+  CHECK((coarser.pair.fine_pinned.array() == d.pair.pinned.array()).all());
+  for (const ClothData* data : {&d, &coarser}) {
+    for (const FineTarget target : {FineTarget::residual, FineTarget::features}) {
+      if (data == &coarser && target == FineTarget::features) continue;
+      const ClothData& e = *data;
+      const auto& t = e.sequences[4];
+      CAPTURE(e.num_coarse());
+      CAPTURE(fine_target_name(target));
+      DetailSynthesisOptions o = small_net();
+      o.fine_target = target;
+      ClothSynthesis run(exec::seq, e, o, 5);
+      CHECK(run.residual() == (target == FineTarget::residual));
+      // the decoder's last convolution made constant: its output is the normalized zero residual
+      auto& net = run.network();
+      auto& store = net.store();
+      for (const char* w : {"fine_dec.conv2.point.weight", "fine_dec.conv2.neighbor.weight"})
+        for (float& v : store.values(store.at(w))) v = 0;
+      const auto bias = store.values(store.at("fine_dec.conv2.point.bias"));
+      for (Index c = 0; c < 9; ++c) bias[std::size_t(c)] = float(-net.fine_scaling().mean[c] / net.fine_scaling().scale[c]);
+      std::vector<Points<>> raw;
+      run.synthesize(exec::seq, 4, nullptr, nullptr, &raw);
+      const double expected = decoded_subdivided_rmse(run, e, t);
+      double sum = 0;
+      for (Index f = 0; f < t.num_frames(); ++f) sum += (raw[std::size_t(f)] - t.fine[std::size_t(f)]).squaredNorm();
+      const double synthesized = std::sqrt(sum / double(t.num_frames() * e.num_fine()));
+      if (target == FineTarget::residual) {
+        CHECK(synthesized == doctest::Approx(expected).epsilon(1e-5));  // the residual passes through float
+      } else {
+        // the same zero output as features is a flat rotation-free sheet, far from the subdivided mesh
+        CHECK(std::abs(synthesized - expected) > 0.1 * expected);
+      }
     }
   }
   // a model of one fine target is refused by a network of the other

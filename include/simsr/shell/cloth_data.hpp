@@ -2,8 +2,9 @@
 /// \file
 /// A cloth dataset that generate_cloth_data (cloth_datagen.hpp) wrote, read back for training and
 /// evaluation: the coarse/fine pair rebuilt from DIR/cloth_data.json (scene, coarse size, Loop
-/// levels), every sequence's frames, its split, and the scene's obstacle at the end of any frame
-/// (the sequences are rebuilt from the seed, so nothing of the scene is stored twice).
+/// levels, the fine cloth's cells), every sequence's frames, its split, and the scene's obstacle at
+/// the end of any frame (the sequences are rebuilt from the seed, so nothing of the scene is
+/// stored twice).
 ///
 ///     const shell::ClothData data = shell::read_cloth_data("sheet_data");
 ///     data.with_obstacle(k, f, [&](const auto& obstacle) { refine.refine(exec::seq, obstacle, x); });
@@ -68,6 +69,8 @@ inline ClothData read_cloth_data(const std::filesystem::path& dir, const std::st
     d.scene = cloth_dataset(j.at("scene").get<std::string>());
     d.size.coarse_cells = j.at("coarse_cells").get<Index>();
     d.size.levels = j.at("fine").at("loop_levels").get<Index>();
+    // a fine cloth of its own (ClothSceneSize::fine_cells); data written before the field: Loop(coarse)
+    d.size.fine_cells = j.at("fine").value("cells", Index(0));
     d.seed = j.at("seed").get<std::uint64_t>();
     d.frame_time = j.at("frame_time_s").get<double>();
   } catch (const nlohmann::json::exception& e) {

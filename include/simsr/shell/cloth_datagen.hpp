@@ -4,7 +4,8 @@
 /// sequence simulated at the coarse and at the fine resolution, separately, with the same
 /// parameters and no constraint between them, into
 ///
-///     DIR/coarse_rest.obj, DIR/fine_rest.obj   the two cloths at rest (fine = Loop(coarse))
+///     DIR/coarse_rest.obj, DIR/fine_rest.obj   the two cloths at rest (fine = Loop(coarse), or
+///                                              a SHEET Loop-subdivided of its own: fine_cells)
 ///     DIR/<scene>_NNN.npz                      a sequence's frames (data::PairedFrames: lowres the
 ///                                              coarse cloth, highres the fine one, F × 3N / 3M)
 ///     DIR/cloth_data.json                      sizes, the split, per-sequence figures
@@ -18,6 +19,13 @@
 /// frames so far and both cloths' last two states, written atomically), so a killed run resumes
 /// where it stopped and ends bitwise where the uninterrupted run ends. A file of another run
 /// (another scene, size, seed or parameters) is refused by fingerprint, never continued.
+///
+/// The fine cloth's frames of another dataset with the same fine cloth, scene and options (the
+/// supplement's scale study: one fine simulation, coarse inputs of three sizes) are taken instead
+/// of simulated again with `fine_frames_from` = that dataset's folder: every sequence file carries
+/// the fingerprint of its fine cloth's simulation alone ("fine_fingerprint"), which must be this
+/// run's, or the run is refused before anything is simulated. The data is bitwise what simulating
+/// the fine cloth again would give (tested).
 ///
 /// Under exec::omp the sequences are simulated side by side, one per thread (each sequence's
 /// own steps then on that thread alone): a Newton step of the fine cloth is a sparse Cholesky
@@ -80,6 +88,9 @@ struct ClothDatagenOptions {
   /// name "settle"; minutes at the paper's sizes); nothing when the settled start is read from
   /// its file.
   FrameCallback on_settle_frame;
+  /// A dataset folder whose sequences' fine frames this run takes instead of simulating them
+  /// (see the file comment); empty: simulate both cloths.
+  std::filesystem::path fine_frames_from;
 };
 
 /// One sequence's figures.
@@ -87,6 +98,7 @@ struct ClothSequenceStats {
   std::string name;
   bool test = false;    ///< held out
   bool reused = false;  ///< a finished file of this run was found
+  bool fine_reused = false;  ///< the fine frames were read from ClothDatagenOptions::fine_frames_from
   Index frames = 0, simulated = 0;
   Index coarse_iterations = 0, fine_iterations = 0;  ///< Newton iterations (frames simulated in this run)
   Index halvings = 0;                                ///< steps halved after a failed solve (both resolutions)
@@ -109,13 +121,8 @@ inline bool cloth_sequence_is_test(Index k) { return k % 5 == 4; }
 
 namespace detail {
 
-/// The fingerprint of a sequence's (or the settled start's: sequence −1) file: the meshes, the
-/// material and options, and the sequence's own parameters (a sequence's wind speed depends on
-/// how many sequences were drawn, so its index alone would not do).
-inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, const ClothDatagenOptions& o, Index sequence, Index frames,
-                                     const std::vector<double>& parameters) {
-  Fingerprint f;
-  f.add(std::int64_t(d)).add(pair.coarse.V).add(pair.coarse.F).add(pair.fine.V).add(pair.fine.F).add(pair.pinned);
+/// The material, the simulation's options and a sequence's own figures into a fingerprint.
+inline void add_cloth_run(Fingerprint& f, const ClothDatagenOptions& o, Index sequence, Index frames, const std::vector<double>& parameters) {
   const ClothMaterial& m = o.material;
   const ClothOptions& s = o.simulation;
   f.add(m.areal_density).add(m.stretch).add(m.bending).add(s.frame_time).add(s.substeps).add(s.damping).add(s.gravity).add(s.contact_stiffness);
@@ -124,6 +131,31 @@ inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, cons
   // added after the data of earlier runs: their defaults hash as before, so that data stays valid
   if (s.contact_onset != 0) f.add(s.contact_onset);
   if (s.newton.accept_at_max_iterations) f.add(std::int64_t(1));
+}
+
+/// The fingerprint of a sequence's (or the settled start's: sequence −1) file: the meshes, the
+/// material and options, and the sequence's own parameters (a sequence's wind speed depends on
+/// how many sequences were drawn, so its index alone would not do).
+inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, const ClothDatagenOptions& o, Index sequence, Index frames,
+                                     const std::vector<double>& parameters) {
+  Fingerprint f;
+  f.add(std::int64_t(d)).add(pair.coarse.V).add(pair.coarse.F).add(pair.fine.V).add(pair.fine.F).add(pair.pinned);
+  add_cloth_run(f, o, sequence, frames, parameters);
+  // added after the data of earlier runs: their defaults hash as before, so that data stays valid
+  if (pair.fine_pinned.size() != pair.pinned.size() || !(pair.fine_pinned.array() == pair.pinned.array()).all()) f.add(pair.fine_pinned);
+  return f.hex();
+}
+
+/// The fingerprint of the fine cloth's simulation alone in a sequence: what its frames depend on
+/// (the fine mesh and pins, the material and options, the sequence, and what the shared start
+/// settled with), not the coarse cloth. `settle_parameters` the settling's sequence parameters.
+inline std::string cloth_fine_fingerprint(ClothDataset d, const ClothPair& pair, const ClothDatagenOptions& o, Index sequence, Index frames,
+                                          const std::vector<double>& parameters, const std::vector<double>& settle_parameters) {
+  static constexpr char tag[] = "fine cloth";  // never a whole file's fingerprint
+  Fingerprint f;
+  f.add_bytes(tag, sizeof tag - 1).add(std::int64_t(d)).add(pair.fine.V).add(pair.fine.F).add(pair.fine_pinned);
+  add_cloth_run(f, o, sequence, frames, parameters);
+  f.add(settle_parameters);
   return f.hex();
 }
 
@@ -147,18 +179,19 @@ ClothFrameReport advance_frame(P policy, Sim& sim, const Move& move, const std::
   }
 }
 
-/// One frame of both resolutions (coarse first), each timed: what on_frame reports.
+/// One frame of both resolutions (coarse first), each timed: what on_frame reports. The fine
+/// cloth stays where it is (a report of zeros) when its frames come from elsewhere (`fine_too`).
 struct PairFrame {
   ClothFrameReport coarse, fine;
   double coarse_seconds = 0, fine_seconds = 0;
 };
 template <class P, class Sim, class Move>
-PairFrame advance_pair(P policy, Sim& coarse, Sim& fine, const Move& move, const std::string& seq, Index frame) {
+PairFrame advance_pair(P policy, Sim& coarse, Sim& fine, const Move& move, const std::string& seq, Index frame, bool fine_too = true) {
   PairFrame r;
   const auto t0 = std::chrono::steady_clock::now();
   r.coarse = advance_frame(policy, coarse, move, seq, frame, "coarse");
   const auto t1 = std::chrono::steady_clock::now();
-  r.fine = advance_frame(policy, fine, move, seq, frame, "fine");
+  if (fine_too) r.fine = advance_frame(policy, fine, move, seq, frame, "fine");
   const auto t2 = std::chrono::steady_clock::now();
   r.coarse_seconds = std::chrono::duration<double>(t1 - t0).count();
   r.fine_seconds = std::chrono::duration<double>(t2 - t1).count();
@@ -175,6 +208,7 @@ struct ClothDatagenRun {
   const std::filesystem::path& state;  ///< DIR/.state
   const std::vector<Index>& frames;
   const std::vector<std::string>& prints;
+  const std::vector<std::string>& fine_prints;  ///< cloth_fine_fingerprint of each sequence
   const std::vector<std::optional<io::NpzArrays>>& checkpoints;
   const std::string& settle_print;
   Index workers;  ///< sequences at once (sequence_worker_count)
@@ -263,6 +297,15 @@ ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run,
       return st;
     }
   }
+  // the fine frames of ClothDatagenOptions::fine_frames_from (its fingerprints checked before the run)
+  std::optional<data::PairedFrames<>> fine_source;
+  if (!opt.fine_frames_from.empty()) {
+    const auto file = opt.fine_frames_from / (st.name + ".npz");
+    fine_source = data::read_paired_frames(file);
+    if (fine_source->num_frames() != F || fine_source->num_hr() != M)
+      throw ShapeError(file.string() + ": fine frames (frames, vertices) for " + st.name, {F, M}, {fine_source->num_frames(), fine_source->num_hr()});
+    st.fine_reused = true;
+  }
   data::PairedFrames<> out = data::PairedFrames<>::one_sequence(F, N, M, st.name);
   Index start = 0;
   start_state.set(coarse, fine, 0);
@@ -273,11 +316,12 @@ ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run,
   for (Index f = start; f < F; ++f) {
     coarse.set_air(air_for(k, coarse.time()));
     fine.set_air(air_for(k, fine.time()));
-    const PairFrame p = advance_pair(policy, coarse, fine, move, st.name, f);
+    const PairFrame p = advance_pair(policy, coarse, fine, move, st.name, f, !fine_source);
     const ClothFrameReport &rc = p.coarse, &rf = p.fine;
     const double sc = p.coarse_seconds, sf = p.fine_seconds;
     out.lr(f) = coarse.positions();
-    out.hr(f) = fine.positions();
+    if (fine_source) out.hr(f) = fine_source->hr(f);
+    else out.hr(f) = fine.positions();
     st.coarse_seconds += sc;
     st.fine_seconds += sf;
     st.coarse_iterations += rc.newton_iterations;
@@ -296,9 +340,29 @@ ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run,
   st.subdivided_rmse = subdivided_rmse(out, run.pair.subdivision);
   auto arrays = data::paired_frame_arrays(out);
   io::set_fingerprint(arrays, print);
+  arrays["fine_fingerprint"] = io::make_npy(std::vector<std::string>{run.fine_prints[std::size_t(k)]});
   io::write_npz(final_file, arrays);
   std::filesystem::remove(partial);
   return st;
+}
+
+/// Refuses a fine_frames_from folder that is the output folder, lacks a sequence, or holds a
+/// sequence whose fine cloth is not this run's (ArgumentError naming the file), before anything runs.
+inline void check_fine_frames_source(const std::filesystem::path& from, const std::filesystem::path& dir, ClothDataset d,
+                                     const std::vector<std::string>& fine_prints) {
+  if (std::filesystem::weakly_canonical(from) == std::filesystem::weakly_canonical(dir))
+    throw ArgumentError("generate_cloth_data: fine_frames_from is the output folder (" + dir.string() + "): name the other dataset's folder");
+  for (std::size_t k = 0; k < fine_prints.size(); ++k) {
+    const auto file = from / (cloth_sequence_name(d, Index(k)) + ".npz");
+    if (!std::filesystem::exists(file))
+      throw ArgumentError(file.string() + ": no such file, so its fine frames can't be reused (fine_frames_from must be a finished dataset of this scene with at least this run's sequences)");
+    io::NpzReader z(file);  // reads the one member
+    const bool has = z.contains("fine_fingerprint");
+    if (!has || z.read("fine_fingerprint").to_strings() != std::vector<std::string>{fine_prints[k]})
+      throw ArgumentError(file.string() + (has ? ": its fine cloth is another simulation's (another fine mesh, seed, sequence count or simulation option)"
+                                               : ": carries no fine-cloth fingerprint (written before they were)") +
+                          ", so its fine frames can't stand in for this run's");
+  }
 }
 
 /// How many sequences run at once (ClothDatagenOptions::sequence_workers).
@@ -323,11 +387,11 @@ void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstac
                           std::vector<ClothSequenceStats>& stats) {
   using O = std::decay_t<decltype(make_obstacle(Index(0)))>;
   using Sim = ClothSimulator<O, Linear>;
-  auto simulator = [&](const TriMesh<>& cloth) { return Sim(cloth, run.pair.pinned, make_obstacle(-1), run.opt.material, run.opt.simulation); };
+  auto simulator = [&](const TriMesh<>& cloth, const IndexVector& pins) { return Sim(cloth, pins, make_obstacle(-1), run.opt.material, run.opt.simulation); };
   auto sequence = [&](auto pol, Index k, Sim& c, Sim& f, const ClothPairState& start, const ClothDatagenOptions::FrameCallback& on_frame) {
     return simulate_cloth_sequence(pol, run, k, c, f, start, std::function<void(O&, double)>(move_for(k)), air_for, on_frame);
   };
-  Sim coarse = simulator(run.pair.coarse), fine = simulator(run.pair.fine);
+  Sim coarse = simulator(run.pair.coarse, run.pair.pinned), fine = simulator(run.pair.fine, run.pair.fine_pinned);
   const std::function<void(O&, double)> still = [&](O& o, double) { o = make_obstacle(-1); };
   const ClothPairState start = settled_cloth_start(policy, run, coarse, fine, still);
   const Index count = Index(run.frames.size()), workers = std::min(count, run.workers);
@@ -353,7 +417,7 @@ void simulate_cloth_scene(P policy, const ClothDatagenRun& run, const MakeObstac
   auto work = [&] {
     try {
       const EigenSingleThreaded eigen_serial;  // this thread's Eigen products stay on it
-      Sim c = simulator(run.pair.coarse), f = simulator(run.pair.fine);
+      Sim c = simulator(run.pair.coarse, run.pair.pinned), f = simulator(run.pair.fine, run.pair.fine_pinned);
       for (Index k; !failed.load() && (k = next.fetch_add(1)) < count;) done[std::size_t(k)] = sequence(exec::seq, k, c, f, start, locked);
     } catch (...) {
       const std::lock_guard<std::mutex> hold(lock);
@@ -405,10 +469,12 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     return v;
   };
   const auto state = dir / ".state";
-  std::vector<std::string> prints;
+  const std::vector<double> settle_values = d == ClothDataset::sheet ? values_of(0) : std::vector<double>{};
+  std::vector<std::string> prints, fine_prints;
   std::vector<std::optional<io::NpzArrays>> checkpoints;
   for (Index k = 0; k < count; ++k) {
     prints.push_back(detail::cloth_fingerprint(d, pair, opt, k, frames[std::size_t(k)], values_of(k)));
+    fine_prints.push_back(detail::cloth_fine_fingerprint(d, pair, opt, k, frames[std::size_t(k)], values_of(k), settle_values));
     const auto partial = state / (cloth_sequence_name(d, k) + ".npz");
     checkpoints.emplace_back();
     if (!std::filesystem::exists(partial)) continue;
@@ -416,6 +482,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     if (io::fingerprint_of(*checkpoints.back()) != prints.back())
       throw ArgumentError(partial.string() + " is a checkpoint of another run (another scene, size, seed or parameters): remove it or use another directory");
   }
+  if (!opt.fine_frames_from.empty()) detail::check_fine_frames_source(opt.fine_frames_from, dir, d, fine_prints);
   std::filesystem::create_directories(state);
   {
     io::MeshData<double> c, f;
@@ -428,10 +495,9 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   }
 
   // SHEET settles with the first sequence's obstacle at its start (above the sheet)
-  const std::string settle_print =
-      detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames, d == ClothDataset::sheet ? values_of(0) : std::vector<double>{});
+  const std::string settle_print = detail::cloth_fingerprint(d, pair, opt, -1, opt.settle_frames, settle_values);
 
-  const detail::ClothDatagenRun run{d, pair, opt, dir, state, frames, prints, checkpoints, settle_print, workers};
+  const detail::ClothDatagenRun run{d, pair, opt, dir, state, frames, prints, fine_prints, checkpoints, settle_print, workers};
   std::vector<ClothSequenceStats> stats;
   if (d == ClothDataset::sheet) {
     detail::simulate_cloth_scene<Linear>(
@@ -449,7 +515,8 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
   j["scene"] = to_string(d);
   j["coarse"] = {{"vertices", N}, {"triangles", pair.coarse.F.rows()}};
   j["coarse_cells"] = size.coarse_cells;
-  j["fine"] = {{"vertices", M}, {"triangles", pair.fine.F.rows()}, {"loop_levels", size.levels}};
+  j["fine"] = {{"vertices", M}, {"triangles", pair.fine.F.rows()}, {"loop_levels", size.levels}, {"cells", size.fine_source_cells()}};
+  if (!opt.fine_frames_from.empty()) j["fine_frames_from"] = opt.fine_frames_from.string();
   j["seed"] = opt.seed;
   j["frame_time_s"] = dt;
   j["substeps"] = opt.simulation.substeps;
@@ -465,6 +532,7 @@ std::vector<ClothSequenceStats> generate_cloth_data(P policy, ClothDataset d, co
     (s.test ? test_frames : train_frames) += s.frames;
     nlohmann::ordered_json e{{"name", s.name}, {"split", s.test ? "test" : "train"}, {"frames", s.frames}, {"reused", s.reused},
                              {"simulated", s.simulated}, {"subdivided_rmse_m", s.subdivided_rmse}};
+    if (s.fine_reused) e["fine_reused"] = true;
     nlohmann::ordered_json& scene = e["scene"] = nlohmann::ordered_json::object();
     for (const auto& p : parameters_of(Index(k))) scene[p.name] = p.value;
     if (s.simulated > 0) {

@@ -3,6 +3,9 @@
 /// The SHEET and DISK scenes of Chen et al. 2023 (supplement §3, issue #14), each at a coarse and
 /// a fine resolution: the fine rest mesh is the coarse one Loop-subdivided (mesh/loop_subdivision),
 /// so the coarse vertices are the fine mesh's first ones and the pins are the same vertex ids.
+/// SHEET also takes a fine cloth of its own (`ClothSceneSize::fine_cells`): an N-cell sheet
+/// Loop-subdivided, beside a coarse sheet of another cell count, as the supplement's scale study
+/// pairs one 8,192-face fine mesh with coarse inputs of 512, 128 and 32 faces (Table 3).
 ///
 ///   SHEET  a 1 m square sheet, 8×8 cells (81 vertices; ×3 Loop levels: 4,225, the paper's
 ///          counts), pinned at its four corners, sagging under gravity; each sequence a pole or a
@@ -31,6 +34,7 @@
 #include "../mesh/generators.hpp"
 #include "../mesh/loop_subdivision.hpp"
 #include "../mesh/tri_mesh.hpp"
+#include "../neighbors/surface_distance.hpp"
 #include "../physics/forces/obstacle_contact.hpp"
 #include "../physics/forces/obstacle_shapes.hpp"
 #include "wind.hpp"
@@ -49,54 +53,120 @@ inline ClothDataset cloth_dataset(const std::string& name) {
   throw ArgumentError("cloth dataset must be 'sheet' or 'disk', got '" + name + "'");
 }
 
-/// Both resolutions of a scene's cloth at rest and the pinned vertex ids (the same in both).
+/// Both resolutions of a scene's cloth at rest and their pinned vertex ids: pin a of the coarse
+/// cloth, pinned[a], and of the fine one, fine_pinned[a], are held at the same spot (the same
+/// ids when the fine cloth is the coarse one Loop-subdivided).
 struct ClothPair {
   TriMesh<> coarse, fine;
-  IndexVector pinned;
-  Eigen::SparseMatrix<double> subdivision;  ///< fine-from-coarse Loop map (#fine × #coarse)
+  IndexVector pinned;       ///< coarse vertex ids
+  IndexVector fine_pinned;  ///< fine vertex ids, in the order of `pinned`
+  /// The fine-from-coarse map (#fine × #coarse) of the subdivided-coarse baseline: Loop's map
+  /// when fine = Loop(coarse); for a fine sheet of its own, the coarse sheet Loop-subdivided to
+  /// at least the fine one's resolution and read at each fine vertex's closest rest point
+  /// (barycentric), so that both are one sparse matrix, rows summing to 1.
+  Eigen::SparseMatrix<double> subdivision;
 };
 
 /// The coarse cloth at rest, its pins and the Loop levels to the fine one.
 struct ClothSceneSize {
   Index coarse_cells = 8;  ///< SHEET: cells per side (8: 81 vertices); DISK: rings (6: 127 vertices)
   Index levels = 3;        ///< Loop levels to the fine mesh (3: SHEET 4,225 vertices, DISK 7,057)
+  /// SHEET: the cells per side of the sheet Loop-subdivided `levels` times into the fine cloth;
+  /// 0: coarse_cells (fine = Loop(coarse)). The scale study (supplement Table 3) keeps the fine
+  /// cloth, 8 cells × 3 levels, and varies the coarse one: 16 (×16 faces), 8 (×64), 4 (×256).
+  Index fine_cells = 0;
+  /// The cells the fine cloth is subdivided from.
+  Index fine_source_cells() const { return fine_cells > 0 ? fine_cells : coarse_cells; }
 };
 
 /// The default size of a dataset (the paper's SHEET counts; DISK's nearest ring count).
 inline ClothSceneSize default_scene_size(ClothDataset d) { return d == ClothDataset::sheet ? ClothSceneSize{8, 3} : ClothSceneSize{6, 3}; }
 
-/// The scene's default size with a user's overrides: `cells` when > 0, `levels` when >= 0 (the
-/// command line's --cells / --levels, where 0 / −1 mean "the default").
-inline ClothSceneSize scene_size(ClothDataset d, Index cells, Index levels) {
+/// The scene's default size with a user's overrides: `cells` when > 0, `levels` when >= 0,
+/// `fine_cells` when > 0 (the command line's --cells / --levels / --fine-cells, where 0 / −1 / 0
+/// mean "the default").
+inline ClothSceneSize scene_size(ClothDataset d, Index cells, Index levels, Index fine_cells = 0) {
   ClothSceneSize s = default_scene_size(d);
   if (cells > 0) s.coarse_cells = cells;
   if (levels >= 0) s.levels = levels;
+  if (fine_cells > 0) s.fine_cells = fine_cells;
   return s;
 }
 
+namespace detail {
+
+/// The 1 m SHEET of `cells` cells per side, centred on the origin in z = 0, and its four corners.
+inline TriMesh<> centred_sheet(Index cells, IndexVector& corners) {
+  TriMesh<> m = square_sheet(1.0, cells);
+  m.V.rowwise() -= Vec3<>(0.5, 0.5, 0).transpose();
+  const Index n = cells + 1;
+  corners.resize(4);
+  corners << 0, VIndex(n - 1), VIndex(n * (n - 1)), VIndex(n * n - 1);
+  return m;
+}
+
+/// The subdivided-coarse map onto a fine cloth of its own (ClothPair::subdivision): the coarse
+/// cloth Loop-subdivided until its cells are no larger than the fine one's (`fine_cells`·2^levels
+/// per side), then each fine rest vertex read at its closest point of that surface.
+inline Eigen::SparseMatrix<double> resampled_subdivision(const TriMesh<>& coarse, Index coarse_cells, const TriMesh<>& fine, Index fine_resolution) {
+  Index levels = 0;
+  while ((coarse_cells << levels) < fine_resolution) ++levels;
+  const LoopSubdivision sub = loop_subdivision(coarse.V, coarse.F, levels);
+  TriMesh<> surface;
+  surface.V = sub.S * coarse.V;
+  surface.F = sub.F;
+  const neighbors::SurfaceDistance<> closest(surface);
+  std::vector<Eigen::Triplet<double>> w;
+  w.reserve(std::size_t(3 * fine.V.rows()));
+  for (Index i = 0; i < fine.V.rows(); ++i) {
+    const auto hit = closest.closest(fine.V.row(i).transpose());
+    for (int c = 0; c < 3; ++c)
+      if (hit.barycentric[c] != 0) w.emplace_back(i, surface.F(hit.triangle, c), hit.barycentric[c]);
+  }
+  Eigen::SparseMatrix<double> sample(fine.V.rows(), surface.V.rows());
+  sample.setFromTriplets(w.begin(), w.end());
+  return Eigen::SparseMatrix<double>(sample * sub.S);
+}
+
+}  // namespace detail
+
 /// The scene's two meshes (see the file comment). ArgumentError for fewer than 2 cells (SHEET),
-/// 2 rings (DISK) or a negative level count.
+/// 2 rings (DISK), a negative level count, or a fine cell count for DISK (its pinned vase is the
+/// first ring, whose radius is the ring count's: two ring counts would hold different cloths).
 inline ClothPair cloth_pair(ClothDataset d, ClothSceneSize size) {
   if (size.levels < 0) throw ArgumentError("cloth_pair: levels must be >= 0, got " + std::to_string(size.levels));
+  if (size.fine_cells < 0) throw ArgumentError("cloth_pair: fine_cells must be >= 0 (0: the coarse cells), got " + std::to_string(size.fine_cells));
   ClothPair p;
+  const Index fine_cells = size.fine_source_cells();
   if (d == ClothDataset::sheet) {
     if (size.coarse_cells < 2) throw ArgumentError("cloth_pair: a sheet needs >= 2 cells per side, got " + std::to_string(size.coarse_cells));
-    p.coarse = square_sheet(1.0, size.coarse_cells);
-    p.coarse.V.rowwise() -= Vec3<>(0.5, 0.5, 0).transpose();  // centred on the origin, in z = 0
-    const Index n = size.coarse_cells + 1;
-    p.pinned.resize(4);
-    p.pinned << 0, VIndex(n - 1), VIndex(n * (n - 1)), VIndex(n * n - 1);
+    if (fine_cells < 2) throw ArgumentError("cloth_pair: the fine sheet needs >= 2 cells per side, got " + std::to_string(fine_cells));
+    p.coarse = detail::centred_sheet(size.coarse_cells, p.pinned);
   } else {
     if (size.coarse_cells < 2) throw ArgumentError("cloth_pair: a disk needs >= 2 rings, got " + std::to_string(size.coarse_cells));
+    if (fine_cells != size.coarse_cells)
+      throw ArgumentError("cloth_pair: DISK's fine cloth is its coarse one subdivided (fine_cells " + std::to_string(size.fine_cells) +
+                          " against " + std::to_string(size.coarse_cells) + " rings): the pinned vase is the first ring, whose radius the ring count sets");
     p.coarse = disk_surface(0.75, size.coarse_cells);
     p.coarse.V.col(2).setConstant(0.03);  // just above the table top (z = 0.0)
     p.pinned.resize(7);                   // the centre and the first ring
     for (Index i = 0; i < 7; ++i) p.pinned[i] = VIndex(i);
   }
-  const LoopSubdivision sub = loop_subdivision(p.coarse.V, p.coarse.F, size.levels);
-  p.fine.V = sub.S * p.coarse.V;
+  if (fine_cells == size.coarse_cells) {
+    const LoopSubdivision sub = loop_subdivision(p.coarse.V, p.coarse.F, size.levels);
+    p.fine.V = sub.S * p.coarse.V;
+    p.fine.F = sub.F;
+    p.fine_pinned = p.pinned;
+    p.subdivision = sub.S;
+    return p;
+  }
+  IndexVector fine_corners;
+  const TriMesh<> fine_source = detail::centred_sheet(fine_cells, fine_corners);
+  const LoopSubdivision sub = loop_subdivision(fine_source.V, fine_source.F, size.levels);
+  p.fine.V = sub.S * fine_source.V;
   p.fine.F = sub.F;
-  p.subdivision = sub.S;
+  p.fine_pinned = fine_corners;  // Loop keeps the source's vertices first, its corners in place
+  p.subdivision = detail::resampled_subdivision(p.coarse, size.coarse_cells, p.fine, fine_cells << size.levels);
   return p;
 }
 

@@ -119,9 +119,12 @@ class ClothSynthesis {
         net_(vertex_adjacency(data.pair.coarse.F, data.num_coarse()), vertex_adjacency(data.pair.fine.F, data.num_fine()), options, seed),
         refine_(data.pair.fine) {
     on_encode = std::move(progress);
-    // the pinned vertices (the fine mesh's first vertices are the coarse ones: Loop keeps them)
-    // anchor the Poisson solve; where a scene pins none, the subdivided coarse centroid places it
-    if (data.pair.pinned.size() > 0) fine_acap_.set_anchors(data.pair.pinned);
+    // the fine cloth's pinned vertices, held where the coarse cloth's are, anchor the Poisson
+    // solve; where a scene pins none, the subdivided coarse centroid places it
+    if (data.pair.fine_pinned.size() != data.pair.pinned.size())
+      throw ArgumentError("ClothSynthesis: the pair pins " + std::to_string(data.pair.pinned.size()) + " coarse and " +
+                          std::to_string(data.pair.fine_pinned.size()) + " fine vertices: pin a of one must be pin a of the other");
+    if (data.pair.fine_pinned.size() > 0) fine_acap_.set_anchors(data.pair.fine_pinned);
     // TS-ACAP of every frame (the fine side of the training sequences only, as the residual to
     // the subdivided coarse frames' features where the network holds residuals); the scaling from
     // the training sequences; normalized float copies
