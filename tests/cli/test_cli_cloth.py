@@ -160,6 +160,7 @@ check(d.stderr.count("baselines: network epoch ") == 2, "the upsampling network'
 seq0 = (report.get("sequences") or [{}])[0]
 check("local_linear_m" in seq0 and "upsampling_network_m" in seq0, f"their per-sequence figures: {seq0}")
 check(report.get("coarse_vertices") == 16 and report.get("fine_vertices") == 49, "the pair's sizes")
+check(report.get("face_scale_factor") == 4 and "(x4 faces)" in d.stdout, f"the scale factor (Loop once: x4 faces): {report.get('face_scale_factor')}")
 check(len(report.get("training", [])) == 3, "the training history")
 sec = report.get("seconds_per_frame", {})
 check(all(sec.get(k, 0) > 0 for k in ("coarse_simulation", "fine_simulation", "ts_acap_extraction", "synthesis")), f"Table 1's stages timed: {sec}")
