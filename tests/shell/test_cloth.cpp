@@ -148,7 +148,8 @@ TEST_CASE("cloth_pair, a fine sheet of its own (the scale study's ×16 / ×256 b
   // a bent, turned coarse cloth: the map against Loop then a brute-force closest point
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (const auto& [coarse_cells, fine_cells, levels] : std::vector<std::array<Index, 3>>{{4, 2, 2}, {2, 4, 1}, {3, 2, 2}, {5, 3, 1}}) {
+  for (const auto& cells : std::vector<std::array<Index, 3>>{{4, 2, 2}, {2, 4, 1}, {3, 2, 2}, {5, 3, 1}}) {
+    const Index coarse_cells = cells[0], fine_cells = cells[1], levels = cells[2];  // (no structured binding: clang's CAPTURE can't name one)
     CAPTURE(coarse_cells);
     CAPTURE(fine_cells);
     const ClothPair p = cloth_pair(ClothDataset::sheet, {coarse_cells, levels, fine_cells});
