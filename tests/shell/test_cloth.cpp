@@ -133,6 +133,7 @@ TEST_CASE("cloth_pair, a fine sheet of its own (the scale study's ×16 / ×256 b
     CHECK(p.fine.V == standard.fine.V);  // bitwise: the fine simulation is the default's
     CHECK(p.fine.F == standard.fine.F);
     CHECK((p.fine_pinned.array() == standard.pinned.array()).all());
+    CHECK(p.fine_pins_are_coarse_pins() == (cells == 8));
     REQUIRE(p.pinned.size() == 4);
     for (Index a = 0; a < 4; ++a) CHECK((p.fine.V.row(p.fine_pinned[a]) - p.coarse.V.row(p.pinned[a])).norm() == 0);
     REQUIRE(p.subdivision.rows() == 4225);
@@ -158,15 +159,17 @@ TEST_CASE("cloth_pair, a fine sheet of its own (the scale study's ×16 / ×256 b
     for (Index i = 0; i < moved.rows(); ++i) moved(i, 2) = 0.2 * std::sin(3 * moved(i, 0) + a) * std::cos(2 * moved(i, 1) + b) + 0.05 * u(rng);
     const Eigen::Matrix3d R = Eigen::AngleAxisd(u(rng) * 3, Vec3<>(u(rng), u(rng), 1).normalized()).toRotationMatrix();
     moved = (moved * R.transpose()).rowwise() + Vec3<>(u(rng), u(rng), u(rng)).transpose();
-    Index levels_up = 0;
-    while ((coarse_cells << levels_up) < (fine_cells << levels)) ++levels_up;
-    const LoopSubdivision sub = loop_subdivision(p.coarse.V, p.coarse.F, levels_up);
+    const LoopSubdivision sub = loop_subdivision(p.coarse.V, p.coarse.F, shell::detail::loop_levels_to_reach(coarse_cells, fine_cells << levels));
     TriMesh<> surface;
     surface.V = sub.S * p.coarse.V;
     surface.F = sub.F;
     const Points<> expected = resampled_by_brute_force(surface, Points<>(sub.S * moved), p.fine.V);
     CHECK((Points<>(p.subdivision * moved) - expected).cwiseAbs().maxCoeff() < 1e-12);
   }
+  CHECK(shell::detail::loop_levels_to_reach(16, 64) == 2);  // the study's ×16 and ×256 inputs
+  CHECK(shell::detail::loop_levels_to_reach(4, 64) == 4);
+  CHECK(shell::detail::loop_levels_to_reach(3, 64) == 5);  // not a power of two: at least as fine
+  CHECK(shell::detail::loop_levels_to_reach(8, 8) == 0);
   CHECK_THROWS_WITH_AS(cloth_pair(ClothDataset::disk, {6, 3, 4}), doctest::Contains("first ring"), ArgumentError);
   CHECK(cloth_pair(ClothDataset::disk, {3, 1, 3}).fine.V == cloth_pair(ClothDataset::disk, {3, 1}).fine.V);  // its own ring count: allowed
   CHECK_THROWS_AS(cloth_pair(ClothDataset::sheet, {4, 1, -1}), ArgumentError);

@@ -16,15 +16,25 @@
 
 namespace simsr::io {
 
-/// The fingerprint a run file carries ("" for none).
-inline std::string fingerprint_of(const NpzArrays& z) {
-  if (!z.contains("fingerprint")) return "";
-  const auto s = z.at("fingerprint").to_strings();
+/// The fingerprint a run file carries ("" for none). A file may carry more than one, each under
+/// its own array name (a cloth sequence: "fine_fingerprint", its fine cloth's simulation alone).
+inline std::string fingerprint_of(const NpzArrays& z, const std::string& name = "fingerprint") {
+  if (!z.contains(name)) return "";
+  const auto s = z.at(name).to_strings();
   return s.empty() ? "" : s[0];
 }
 
-/// `print` as the file's fingerprint array.
-inline void set_fingerprint(NpzArrays& z, const std::string& print) { z["fingerprint"] = make_npy(std::vector<std::string>{print}); }
+/// The same, read from an open archive without reading its other members.
+inline std::string fingerprint_of(NpzReader& z, const std::string& name = "fingerprint") {
+  if (!z.contains(name)) return "";
+  const auto s = z.read(name).to_strings();
+  return s.empty() ? "" : s[0];
+}
+
+/// `print` as the file's fingerprint array (`name`: see fingerprint_of).
+inline void set_fingerprint(NpzArrays& z, const std::string& print, const std::string& name = "fingerprint") {
+  z[name] = make_npy(std::vector<std::string>{print});
+}
 
 /// A rows×3 array `name` of a run file; ArgumentError naming the file when it is missing,
 /// ShapeError when it has another shape.

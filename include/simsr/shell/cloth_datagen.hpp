@@ -142,7 +142,7 @@ inline std::string cloth_fingerprint(ClothDataset d, const ClothPair& pair, cons
   f.add(std::int64_t(d)).add(pair.coarse.V).add(pair.coarse.F).add(pair.fine.V).add(pair.fine.F).add(pair.pinned);
   add_cloth_run(f, o, sequence, frames, parameters);
   // added after the data of earlier runs: their defaults hash as before, so that data stays valid
-  if (pair.fine_pinned.size() != pair.pinned.size() || !(pair.fine_pinned.array() == pair.pinned.array()).all()) f.add(pair.fine_pinned);
+  if (!pair.fine_pins_are_coarse_pins()) f.add(pair.fine_pinned);
   return f.hex();
 }
 
@@ -340,7 +340,7 @@ ClothSequenceStats simulate_cloth_sequence(P policy, const ClothDatagenRun& run,
   st.subdivided_rmse = subdivided_rmse(out, run.pair.subdivision);
   auto arrays = data::paired_frame_arrays(out);
   io::set_fingerprint(arrays, print);
-  arrays["fine_fingerprint"] = io::make_npy(std::vector<std::string>{run.fine_prints[std::size_t(k)]});
+  io::set_fingerprint(arrays, run.fine_prints[std::size_t(k)], "fine_fingerprint");
   io::write_npz(final_file, arrays);
   std::filesystem::remove(partial);
   return st;
@@ -357,9 +357,9 @@ inline void check_fine_frames_source(const std::filesystem::path& from, const st
     if (!std::filesystem::exists(file))
       throw ArgumentError(file.string() + ": no such file, so its fine frames can't be reused (fine_frames_from must be a finished dataset of this scene with at least this run's sequences)");
     io::NpzReader z(file);  // reads the one member
-    const bool has = z.contains("fine_fingerprint");
-    if (!has || z.read("fine_fingerprint").to_strings() != std::vector<std::string>{fine_prints[k]})
-      throw ArgumentError(file.string() + (has ? ": its fine cloth is another simulation's (another fine mesh, seed, sequence count or simulation option)"
+    const std::string print = io::fingerprint_of(z, "fine_fingerprint");
+    if (print != fine_prints[k])
+      throw ArgumentError(file.string() + (!print.empty() ? ": its fine cloth is another simulation's (another fine mesh, seed, sequence count or simulation option)"
                                                : ": carries no fine-cloth fingerprint (written before they were)") +
                           ", so its fine frames can't stand in for this run's");
   }

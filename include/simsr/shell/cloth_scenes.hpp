@@ -65,6 +65,8 @@ struct ClothPair {
   /// at least the fine one's resolution and read at each fine vertex's closest rest point
   /// (barycentric), so that both are one sparse matrix, rows summing to 1.
   Eigen::SparseMatrix<double> subdivision;
+  /// Whether both cloths pin the same vertex ids (always so when fine = Loop(coarse)).
+  bool fine_pins_are_coarse_pins() const { return fine_pinned.size() == pinned.size() && (fine_pinned.array() == pinned.array()).all(); }
 };
 
 /// The coarse cloth at rest, its pins and the Loop levels to the fine one.
@@ -105,13 +107,18 @@ inline TriMesh<> centred_sheet(Index cells, IndexVector& corners) {
   return m;
 }
 
+/// The Loop levels that bring a sheet of `coarse_cells` cells per side to at least `resolution`.
+inline Index loop_levels_to_reach(Index coarse_cells, Index resolution) {
+  Index levels = 0;
+  while ((coarse_cells << levels) < resolution) ++levels;
+  return levels;
+}
+
 /// The subdivided-coarse map onto a fine cloth of its own (ClothPair::subdivision): the coarse
 /// cloth Loop-subdivided until its cells are no larger than the fine one's (`fine_cells`·2^levels
 /// per side), then each fine rest vertex read at its closest point of that surface.
 inline Eigen::SparseMatrix<double> resampled_subdivision(const TriMesh<>& coarse, Index coarse_cells, const TriMesh<>& fine, Index fine_resolution) {
-  Index levels = 0;
-  while ((coarse_cells << levels) < fine_resolution) ++levels;
-  const LoopSubdivision sub = loop_subdivision(coarse.V, coarse.F, levels);
+  const LoopSubdivision sub = loop_subdivision(coarse.V, coarse.F, loop_levels_to_reach(coarse_cells, fine_resolution));
   TriMesh<> surface;
   surface.V = sub.S * coarse.V;
   surface.F = sub.F;
