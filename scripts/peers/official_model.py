@@ -258,8 +258,11 @@ if torch is not None:
             else:
                 idx = feature_knn(h.transpose(1, 2), self.k)
             self.last_graph = idx.detach()
-            e = self.edge_conv(edge_features(h, idx)).max(dim=-1)[0]  # (B, out, N)
-            g_max = e.max(dim=2, keepdim=True)[0].expand(-1, -1, N)
+            e, edge_arg = self.edge_conv(edge_features(h, idx)).max(dim=-1)  # (B, out, N)
+            g_max, global_arg = e.max(dim=2, keepdim=True)
+            g_max = g_max.expand(-1, -1, N)
+            # which edge / point each max took: the interop test routes ours the same at near-ties
+            self.last_edge_argmax, self.last_global_argmax = edge_arg.detach(), global_arg.detach()
             g_mean = e.mean(dim=2, keepdim=True).expand(-1, -1, N)
             cat = torch.cat((h.transpose(1, 2), e, g_max, g_mean), dim=1)
             return self.fc_out(cat).transpose(1, 2)
@@ -531,6 +534,9 @@ def export(out_dir, data_dir, seed=0, n_frames=2, checkpoint=None, dtype="float3
         blocks = model.net_feat_emb.blocks
         io[prefix + "/z_lr"] = model.z.detach().numpy()
         io[prefix + "/feature_graph"] = blocks[1].last_graph[:, :, :].numpy().astype(np.int64)
+        for b, block in enumerate(blocks):
+            io["%s/edge_argmax/%d" % (prefix, b)] = block.last_edge_argmax.numpy().astype(np.int64)      # (B, out, N)
+            io["%s/global_argmax/%d" % (prefix, b)] = block.last_global_argmax.numpy().astype(np.int64)  # (B, out, 1)
         io[prefix + "/up_weights"] = model.net_upscale.last_weights.numpy()
         io[prefix + "/z_hr"] = model.z_hr.detach().numpy()
         io[prefix + "/hdx_pred"] = pred.detach().numpy()

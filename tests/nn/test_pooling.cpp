@@ -55,6 +55,52 @@ TEST_CASE("nn::GroupPool: max routes the gradient to the first maximum") {
   CHECK(d == expected);
 }
 
+TEST_CASE("nn::GroupPool: set_argmax routes the next backward through the given rows, broadcast or not") {
+  std::mt19937_64 rng(53);
+  std::uniform_int_distribution<int> size(1, 6);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Index groups = size(rng), G = size(rng), C = size(rng);
+    for (bool broadcast : {true, false}) {
+      INFO("groups " << groups << " size " << G << " C " << C << " broadcast " << broadcast);
+      nn::GroupPool<double> pool(nn::PoolKind::max, G, broadcast);
+      const Matrix<double> x = random_matrix(rng, groups * G, C);
+      Matrix<double> y, d;
+      pool.forward(exec::seq, nn::Mode::train, x, y);
+      nn::GroupPool<double>::ArgmaxIndices rows(groups, C);
+      std::uniform_int_distribution<Index> row(0, G - 1);
+      for (Index i = 0; i < rows.size(); ++i) rows.data()[i] = row(rng);
+      pool.set_argmax(rows);
+      CHECK(pool.argmax() == rows);
+      const Matrix<double> g = random_matrix(rng, y.rows(), C);
+      pool.backward(exec::seq, x, y, g, &d);
+      // brute force: each group's gradient (summed over its rows when broadcast) lands on the chosen row only
+      Matrix<double> expected = Matrix<double>::Zero(groups * G, C);
+      for (Index q = 0; q < groups; ++q)
+        for (Index c = 0; c < C; ++c)
+          expected(q * G + rows(q, c), c) = broadcast ? g.middleRows(q * G, G).col(c).sum() : g(q, c);
+      CHECK((d - expected).cwiseAbs().maxCoeff() <= 1e-14);
+      // the next forward finds its own maxima again
+      pool.forward(exec::seq, nn::Mode::train, x, y);
+      for (Index q = 0; q < groups; ++q)
+        for (Index c = 0; c < C; ++c) CHECK(x(q * G + pool.argmax()(q, c), c) == x.middleRows(q * G, G).col(c).maxCoeff());
+    }
+  }
+  nn::GroupPool<double> pool(nn::PoolKind::max, 3, false), mean(nn::PoolKind::mean, 3, false);
+  Matrix<double> y;
+  nn::GroupPool<double>::ArgmaxIndices none(1, 2);
+  none.setZero();
+  CHECK_THROWS_AS(pool.set_argmax(none), ShapeError);  // before a forward
+  pool.forward(exec::seq, nn::Mode::train, Matrix<double>::Zero(3, 2), y);
+  mean.forward(exec::seq, nn::Mode::train, Matrix<double>::Zero(3, 2), y);
+  CHECK_THROWS_AS(mean.set_argmax(none), ArgumentError);
+  CHECK_THROWS_AS(pool.set_argmax(nn::GroupPool<double>::ArgmaxIndices::Zero(2, 2)), ShapeError);
+  none(0, 1) = 3;
+  CHECK_THROWS_WITH_AS(pool.set_argmax(none), doctest::Contains("group 0, channel 1: row 3 outside [0, 3)"), ArgumentError);
+  none(0, 1) = 2;
+  pool.set_argmax(none);
+  CHECK(pool.argmax()(0, 1) == 2);
+}
+
 TEST_CASE("nn::GroupPool: gradients match finite differences (distinct values for max)") {
   std::mt19937_64 rng(52);
   std::uniform_int_distribution<int> size(1, 6);

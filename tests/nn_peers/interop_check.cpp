@@ -6,9 +6,9 @@
 ///
 /// loads the converted model, rebuilds the official network, and compares with PyTorch's
 /// recorded tensors: the inputs (normalization of the bunny frames), the eval forward (code z,
-/// the dynamic feature graph, upsampling weights, z^H, the prediction) both through forward() and
-/// through the precomputed-weights inference path, then one training step (loss terms, every
-/// parameter gradient, the parameters after one Adam step). Prints one JSON object: per tensor
+/// the dynamic feature graph, every max pooling's choices, upsampling weights, z^H, the
+/// prediction) both through forward() and through the precomputed-weights inference path, then
+/// one training step (loss terms, every parameter gradient, the parameters after one Adam step). Prints one JSON object: per tensor
 /// the max |ours − torch| and that divided by max |torch|; exit 0 when every relative error is
 /// at most --tol (default 1e-5), 1 otherwise, 2 on bad usage.
 
@@ -21,6 +21,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -112,6 +113,62 @@ GraphAgreement graph_agreement(const Matrix<S>& h, const nn::GraphIndices& ours,
   return a;
 }
 
+/// How our max poolings' choices agree with PyTorch's. `ours` is a GroupPool's argmax (groups × C,
+/// groups = items × n, the row within the group); `ref` PyTorch's indices of the same maxima laid
+/// out (item, C, n). A choice may differ only at a near-tie: the values at the two rows within
+/// tol·M (M the group's largest |value| in that channel). Float32 rounding on another CPU breaks
+/// such ties the other way, and the max then routes its gradient elsewhere: a global max sends a
+/// whole item's gradient (the sum over its N points) to another point, enough to move the
+/// BatchNorm-projected gradients upstream by 6e-2 of their size (CI, stop 41). `theirs` receives
+/// PyTorch's choices in our layout, for GroupPool::set_argmax. An EdgeConv's choices are edges
+/// of a row of its graph, and the two graphs may list a row's neighbours in another order (a
+/// near-tie in distance): with `graphs` (ours, N×k or (B·N)×k, and PyTorch's, (B, N, k)) PyTorch's
+/// choice is read as the neighbour it names, found in our row.
+struct MaxAgreement {
+  Index equal = 0, tied = 0, differ = 0;
+};
+
+template <class S>
+MaxAgreement max_agreement(const Matrix<S>& values, Index group_size, const typename nn::GroupPool<S>::ArgmaxIndices& ours,
+                           const std::vector<std::int64_t>& ref, Index n, double tol, typename nn::GroupPool<S>::ArgmaxIndices& theirs,
+                           std::optional<std::pair<const nn::GraphIndices*, const std::vector<std::int64_t>*>> graphs = std::nullopt) {
+  MaxAgreement a;
+  const Index groups = ours.rows(), C = ours.cols();
+  theirs.resize(groups, C);
+  if (Index(ref.size()) != groups * C || values.rows() != groups * group_size || values.cols() != C) {
+    a.differ = groups * C;
+    return a;
+  }
+  for (Index g = 0; g < groups; ++g)
+    for (Index c = 0; c < C; ++c) {
+      const Index item = g / n, m = g % n;
+      std::int64_t t = ref[std::size_t((item * C + c) * n + m)];
+      if (graphs && t >= 0 && t < group_size) {  // PyTorch's edge t of row g: the neighbour it names, in our row
+        const auto& [mine, their_graph] = *graphs;
+        const std::int64_t neighbour = (*their_graph)[std::size_t(g * group_size + t)];
+        const Index row = g % mine->rows();
+        t = -1;
+        for (Index j = 0; j < group_size; ++j)
+          if ((*mine)(row, j) == neighbour) t = j;
+      }
+      theirs(g, c) = Index(std::max<std::int64_t>(t, 0));
+      if (t == ours(g, c)) {
+        ++a.equal;
+        continue;
+      }
+      if (t < 0 || t >= group_size) {
+        ++a.differ;
+        continue;
+      }
+      const Index r0 = g * group_size;
+      double M = 0;
+      for (Index j = 0; j < group_size; ++j) M = std::max(M, std::abs(double(values(r0 + j, c))));
+      const double gap = std::abs(double(values(r0 + ours(g, c), c)) - double(values(r0 + Index(t), c)));
+      ++(gap <= tol * M ? a.tied : a.differ);
+    }
+  return a;
+}
+
 nn::GraphIndices as_graph(const std::vector<std::int64_t>& v, Index k) {
   nn::GraphIndices g(Index(v.size()) / k, k);
   for (Index i = 0; i < g.size(); ++i) g.data()[i] = VIndex(v[std::size_t(i)]);
@@ -169,8 +226,36 @@ int check(const std::string& model, const std::string& state, const std::string&
     if (a.tied) edge1.set_graph(as_graph(ref, k1), N);
     return a.tied > 0;
   };
+  // Each block's edge max and global max against PyTorch's choices; where they differ only at
+  // near-ties, PyTorch's are taken (GroupPool::set_argmax) so the backward routes as its did.
+  auto check_maxima = [&](const std::string& what) {
+    auto& emb = net.feature_embedding();
+    const auto their_graph = fx.at(what + "/feature_graph").template to_vector<std::int64_t>();
+    for (Index b = 0; b < emb.blocks(); ++b) {
+      auto& block = emb.block(b);
+      const std::string id = "/" + std::to_string(b);
+      struct Pool {
+        std::string name;
+        nn::GroupPool<S>& pool;
+        const Matrix<S>& values;
+        Index group_size, n;
+      };
+      for (const Pool& p : {Pool{"edge_argmax", block.edge_conv().max_pool(), block.edge_conv().edge_values(), block.edge_conv().k(), N},
+                            Pool{"global_argmax", block.global_max(), block.edge_output(), N, 1}}) {
+        typename nn::GroupPool<S>::ArgmaxIndices theirs;
+        const bool by_neighbour = p.name == "edge_argmax" && b == 1;  // block 1's graph is PyTorch's row order, not ours
+        const MaxAgreement a = max_agreement(p.values, p.group_size, p.pool.argmax(),
+                                             fx.at(what + "/" + p.name + id).template to_vector<std::int64_t>(), p.n, tol, theirs,
+                                             by_neighbour ? std::optional{std::pair{&block.edge_conv().graph(), &their_graph}} : std::nullopt);
+        rep.j[what + "/" + p.name][std::to_string(b)] = {{"equal", a.equal}, {"tied", a.tied}, {"differ", a.differ}};
+        if (a.differ) rep.fail(what + "/" + p.name + id);
+        if (a.tied) p.pool.set_argmax(theirs);
+      }
+    }
+  };
   net.forward(exec::seq, nn::Mode::eval, ldx, pred);
   if (check_graph("eval")) net.forward(exec::seq, nn::Mode::eval, ldx, pred);
+  check_maxima("eval");
   rep.compare("eval/z_lr", net.code(), as_matrix<S>(fx.at("eval/z_lr"), net.latent_dim()));
   rep.compare("eval/up_weights", net.upsampling().weights(), as_matrix<S>(fx.at("eval/up_weights"), net.config().up_k).topRows(M));
   rep.compare("eval/z_hr", net.hr_code(), as_matrix<S>(fx.at("eval/z_hr"), net.latent_dim()));
@@ -201,6 +286,7 @@ int check(const std::string& model, const std::string& state, const std::string&
   };
   train_forward();
   if (check_graph("train")) train_forward();
+  check_maxima("train");
   net.store().zero_grad();
   const auto t = loss.evaluate(exec::omp, pred, hdx, net.code(), 0, &d_pred, &d_z);
   net.backward(exec::omp, d_pred, &d_z);

@@ -87,6 +87,10 @@ class EdgeConv {
     return mlp_.linear(1);
   }
   Mlp<S>& edge_function() { return mlp_; }
+  /// The max over each point's k edges; its argmax() says which edge each channel took.
+  GroupPool<S>& max_pool() { return pool_; }
+  /// The edge function's output of the last forward, (B·N·k)×out: what max_pool() pooled.
+  const Matrix<S>& edge_values() const { return e4_; }
 
   /// In eval mode (BatchNorm on running statistics) the edge rows are gathered chunk by chunk
   /// into per-worker scratch and run through the edge MLP there (Mlp::eval_block, the chunks of

@@ -43,6 +43,10 @@ class EmbeddingBlock {
   Index out_features(Index = -1) const { return out_; }
   EdgeConv<S, Search>& edge_conv() { return edge_; }
   Mlp<S>& fc_out() { return fc_out_; }
+  /// The global max over each item's points (of edge_output()); its argmax() says which point.
+  GroupPool<S>& global_max() { return gmax_; }
+  /// The edge convolution's output of the last forward, (B·N)×out.
+  const Matrix<S>& edge_output() const { return e_; }
 
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode mode, const ConstView<S>& h, Matrix<S>& out) {

@@ -33,8 +33,26 @@ class GroupPool {
   Index group_size() const { return g_; }
   bool broadcast() const { return broadcast_; }
   Index out_features(Index in_cols) const { return in_cols; }
+  using ArgmaxIndices = Eigen::Matrix<Index, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
   /// Row within its group of each group's maximum, groups × C (max pooling, last forward).
-  const Eigen::Matrix<Index, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& argmax() const { return argmax_; }
+  const ArgmaxIndices& argmax() const { return argmax_; }
+  /// Routes the next backward's gradient through `rows` (groups × C, each within its group)
+  /// instead of the first maxima the forward found: at tied maxima the gradient is a choice of
+  /// subgradient, and this makes another implementation's choice (PyTorch's, in the interop test,
+  /// where float32 rounding breaks near-ties the other way). The next forward finds its own again.
+  /// ArgumentError for mean pooling, before a forward, for another shape or a row outside its group.
+  void set_argmax(const ArgmaxIndices& rows) {
+    if (kind_ != PoolKind::max) throw ArgumentError("nn::GroupPool::set_argmax: mean pooling has no maxima");
+    if (rows.rows() != argmax_.rows() || rows.cols() != argmax_.cols())
+      throw ShapeError("nn::GroupPool::set_argmax: the last forward's groups × channels", {argmax_.rows(), argmax_.cols()}, {rows.rows(), rows.cols()});
+    for (Index g = 0; g < rows.rows(); ++g)
+      for (Index c = 0; c < rows.cols(); ++c)
+        if (rows(g, c) < 0 || rows(g, c) >= g_)
+          throw ArgumentError("nn::GroupPool::set_argmax: group " + std::to_string(g) + ", channel " + std::to_string(c) + ": row " +
+                              std::to_string(rows(g, c)) + " outside [0, " + std::to_string(g_) + ")");
+    argmax_ = rows;
+  }
 
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
@@ -135,7 +153,7 @@ class GroupPool {
   PoolKind kind_;
   Index g_;
   bool broadcast_;
-  Eigen::Matrix<Index, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> argmax_;
+  ArgmaxIndices argmax_;
   Vector<S> pooled_;
   std::vector<Vector<double>> sums_;  ///< per worker: the channel sums of a mean group (forward)
   std::vector<Vector<S>> grads_;      ///< per worker: a broadcast group's gradient (backward)
