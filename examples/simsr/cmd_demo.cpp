@@ -42,6 +42,7 @@ struct DemoArgs {
   Index cells = 0, levels = -1, fine_cells = 0;  ///< sheet/disk: 0 / −1 / 0 the scene's default
   std::string fine_frames_from;                  ///< sheet/disk: a dataset whose fine frames this one takes
   std::string fine_target = shell::fine_target_name(shell::DetailSynthesisOptions{}.fine_target);
+  std::string residual_lift = shell::residual_lift_name(shell::DetailSynthesisOptions{}.residual_lift);
   std::string linear_solver = "simplicial";  ///< sheet/disk: the data's Newton linear solver
   ClothSteppingArgs stepping;                ///< sheet/disk: --substeps, --stepping, --step-iterations
 };
@@ -58,6 +59,7 @@ int cloth_demo_cmd(DemoArgs& a) {
   c.data.fine_frames_from = a.fine_frames_from;
   a.stepping.apply(c.data.simulation);
   c.network.fine_target = shell::parse_fine_target(a.fine_target);
+  c.network.residual_lift = shell::parse_residual_lift(a.residual_lift);
   if (c.baselines == std::vector<std::string>{"none"}) c.baselines.clear();
   const auto report = with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) {
     return shell::run_cloth_demo<L>(exec::omp, c, [](const std::string& line) { std::fprintf(stderr, "demo: %s\n", line.c_str()); });
@@ -108,6 +110,11 @@ void add_demo_options(CLI::App* cmd, DemoArgs& args) {
                   "sheet/disk: what the network's fine side holds: residual (to the subdivided coarse mesh's features) or features (the supplement)")
       ->capture_default_str()
       ->check(CLI::IsMember({"residual", "features"}));
+  cmd->add_option("--residual-lift", a->residual_lift,
+                  "sheet/disk: a residual target's fine rotation vectors: nearest (each the form nearest the subdivided mesh's) or own (the fine "
+                  "sequence's own integer steps; the two can differ by 2 pi)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"nearest", "own"}));
   cmd->add_option("--linear-solver", a->linear_solver,
                   "sheet/disk: the data's Newton linear solver, simplicial (Eigen's LDLT) or cholmod (supernodal; needs CHOLMOD; the same data to "
                   "round-off, ~3x faster at the paper's 4,225 fine vertices)")

@@ -7,7 +7,7 @@ taking its fine frames from another dataset (`--fine-cells`, `--fine-frames-from
 options named; `simsr demo --dataset sheet` at
 the same size (5 sequences, the 5th held out; 3 epochs): its report, per-frame errors and views
 (rendered by scripts/render_comparison.py --view oblique), the core paper's local-linear map and
-network beside, a rerun that trains nothing, and the other --fine-target refused as another run's
+network beside, a rerun that trains nothing, and the other --fine-target or --residual-lift refused as another run's
 checkpoint.
 
     /usr/bin/python3 tests/cli/test_cli_cloth.py SIMSR_EXE WORK_DIR
@@ -155,6 +155,9 @@ if os.path.exists(os.path.join(demo, "report.json")):
 rm = report.get("rmse_m", {})
 check(all(k in rm and rm[k] > 0 for k in ("subdivided", "synthesized", "synthesized_refined", "decoded_truth", "decoded_subdivided")), f"five RMSEs: {rm}")
 check(report.get("fine_target") == "residual", f"the default fine target: {report.get('fine_target')}")
+rj = report.get("feature_jumps", {}).get("residual_beyond_pi", {})
+check(report.get("residual_lift") == "nearest" and rj.get("trained", -1) <= rj.get("own", -1) and rj.get("vertex_frames", 0) > 0,
+      f"the default residual lift and its counts: {report.get('residual_lift')} {rj}")
 check(all(k in rm and rm[k] > 0 for k in ("local_linear", "upsampling_network")), f"the core paper's methods beside: {rm}")
 check(d.stderr.count("baselines: network epoch ") == 2, "the upsampling network's epochs (--baseline-epochs 2) as progress lines")
 seq0 = (report.get("sequences") or [{}])[0]
@@ -200,8 +203,12 @@ if os.path.exists(os.path.join(demo, "report.json")):
 # the other fine target is another run: its checkpoint is refused, not resumed into
 d3 = simsr(*dargs, "--fine-target", "features", expect=1)
 check("another run" in d3.stderr, f"a checkpoint of the other fine target refused: {d3.stderr.strip()[-300:]}")
+d4 = simsr(*dargs, "--residual-lift", "own", expect=1)
+check("another run" in d4.stderr, f"a checkpoint of the other residual lift refused: {d4.stderr.strip()[-300:]}")
 bad = simsr(*dargs, "--baselines", "kriging", expect=1)
 check("kriging" in bad.stderr, f"an unknown baseline is named: {bad.stderr.strip()[-200:]}")
 bad = simsr(*dargs, "--fine-target", "both", expect=1)
 check("fine-target" in bad.stderr, f"an unknown fine target is named: {bad.stderr.strip()[-200:]}")
+bad = simsr(*dargs, "--residual-lift", "closest", expect=1)
+check("residual-lift" in bad.stderr, f"an unknown residual lift is named: {bad.stderr.strip()[-200:]}")
 finish()

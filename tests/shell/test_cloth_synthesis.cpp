@@ -157,10 +157,50 @@ TEST_CASE("ClothSynthesis, residual fine target: a network whose residual is zer
   ClothSynthesis run(exec::seq, d, o, 5);
   run.network().save(dir.path / "model.npz");
   CHECK(DetailSynthesisNet<float>::saved_options(dir.path / "model.npz").fine_target == FineTarget::residual);
+  CHECK(DetailSynthesisNet<float>::saved_options(dir.path / "model.npz").residual_lift == ResidualLift::nearest);
   o.fine_target = FineTarget::features;
   DetailSynthesisNet<float> other(vertex_adjacency(d.pair.coarse.F, 16), vertex_adjacency(d.pair.fine.F, 49), o, 1);
   CHECK(test::typed_error_of<ArgumentError>([&] { other.load(dir.path / "model.npz"); }).find("'residual'") != std::string::npos);
   CHECK(test::typed_error_of<ArgumentError>([] { parse_fine_target("residuals"); }).find("residuals") != std::string::npos);
+  CHECK(test::typed_error_of<ArgumentError>([] { parse_residual_lift("closest"); }).find("closest") != std::string::npos);
+}
+
+TEST_CASE("ClothSynthesis, residual lift: the trained residual's rotations are the forms nearest the subdivided mesh's; 'own' keeps the fine ones") {
+  const ClothData d = read_cloth_data(dataset());
+  const auto& s = d.sequences[0];
+  REQUIRE(!s.test);
+  DetailSynthesisOptions o = small_net();
+  ClothSynthesis nearest(exec::seq, d, o, 5);
+  o.residual_lift = ResidualLift::own;
+  ClothSynthesis own(exec::seq, d, o, 5);
+  // both count the same residuals beyond π as lifted alone; nearest trains on no more of them
+  CHECK(nearest.feature_jumps().residual_own == own.feature_jumps().residual_own);
+  CHECK(own.feature_jumps().residual_trained == own.feature_jumps().residual_own);
+  CHECK(nearest.feature_jumps().residual_trained <= nearest.feature_jumps().residual_own);
+  Index train_frames = 0;
+  for (const auto& q : d.sequences) train_frames += q.test ? 0 : q.num_frames();
+  CHECK(nearest.feature_jumps().residual_vertex_frames == train_frames * 49);
+  // the two runs are different trainings: one's checkpoint is refused by the other
+  const ClothTrainingOptions t{.epochs = 1, .batch = 8, .seed = 1, .checkpoint = {}};
+  CHECK(nearest.fingerprint(t) != own.fingerprint(t));
+  // the lift itself, on a frame whose fine features are turned by 2π at every third vertex (the
+  // same rotations in other forms, as another run of the integer steps could have left them):
+  // it gives back the forms nearest the subdivided frame's whichever forms the fine side came in
+  TsAcapState<double> fs, bs;
+  const TsAcapFeatures<double> fine = nearest.fine_acap().encode(exec::seq, s.fine[0], fs);
+  const TsAcapFeatures<double> base = nearest.fine_acap().encode(exec::seq, nearest.subdivided({s.coarse[0]})[0], bs);
+  TsAcapFeatures<double> turned = fine;
+  for (Index i = 0; i < turned.rows(); i += 3) {
+    const Vec3<> rho = turned.row(i).head<3>().transpose();
+    const Vec3<> u = rho.norm() > 0 ? Vec3<>(rho.normalized()) : Vec3<>(0, 0, 1);
+    turned.row(i).head<3>() = (rho + 2 * std::numbers::pi * u).transpose();
+  }
+  TsAcapFeatures<double> a = fine, b = turned;
+  lift_rotations_toward(a, base);
+  CHECK(lift_rotations_toward(b, base) >= (turned.rows() + 2) / 3);
+  CHECK((a - b).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK(FeatureJumps::beyond_pi(b, base) <= FeatureJumps::beyond_pi(turned, base));
+  CHECK(FeatureJumps::beyond_pi(b, base) == 0);  // a sheet's two simulations turn alike here
 }
 
 TEST_CASE("ClothSynthesis: training lowers the loss; a killed run resumes bitwise; another run is refused; the evaluation's figures") {

@@ -4,6 +4,7 @@
 #include <simsr/shell/ts_acap.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <random>
@@ -238,6 +239,62 @@ TEST_CASE("TsAcap: bad input is a typed error") {
   state.angle = VecX<>::Zero(3);
   state.principal_angle = VecX<>::Zero(3);
   CHECK(!test::typed_error_of<ShapeError>([&] { acap.encode(exec::seq, two.V, state); }).empty());
+}
+
+}  // namespace shell_test_ts_acap
+
+namespace shell_test_ts_acap {
+
+TEST_CASE("lift_rotations_toward: the same rotations, each the form nearest the reference's (brute force over the forms)") {
+  std::mt19937_64 rng(77);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> angle(-4 * pi, 4 * pi), noise(0, 0.6);
+  std::uniform_int_distribution<int> cycles(-3, 3);
+  auto rotation = [](const Vec3<>& rho) {
+    const double t = rho.norm();
+    return t > 0 ? Mat3<>(Eigen::AngleAxisd(t, rho / t).toRotationMatrix()) : Mat3<>(Mat3<>::Identity());
+  };
+  const Index n = 400;
+  TsAcapFeatures<double> f(n, 9), ref(n, 9);
+  for (Index i = 0; i < n; ++i) {
+    const Vec3<> u = Vec3<>(g(rng), g(rng), g(rng)).normalized();
+    const double t = i % 40 == 0 ? 0.0 : angle(rng);  // a few identities
+    f.row(i).head<3>() = (u * t).transpose();
+    for (int c = 3; c < 9; ++c) f(i, c) = g(rng);
+    // the reference: the same rotation's form k cycles away, turned a little (a nearby rotation),
+    // or, every fifth vertex, anything at all
+    const Vec3<> w = Vec3<>(g(rng), g(rng), g(rng)).normalized();
+    const Vec3<> near = (u * (t + 2 * pi * cycles(rng))) + noise(rng) * w;
+    ref.row(i).head<3>() = (i % 5 == 0 ? Vec3<>(angle(rng) * w) : near).transpose();
+    for (int c = 3; c < 9; ++c) ref(i, c) = g(rng);
+  }
+  TsAcapFeatures<double> lifted = f;
+  const Index moved = lift_rotations_toward(lifted, ref);
+  CHECK(moved > n / 2);
+  CHECK(lifted.rightCols<6>() == f.rightCols<6>());
+  Index checked = 0;
+  for (Index i = 0; i < n; ++i) {
+    INFO("vertex " << i);
+    const Vec3<> rho = f.row(i).head<3>().transpose(), out = lifted.row(i).head<3>().transpose(), r = ref.row(i).head<3>().transpose();
+    CHECK((rotation(out) - rotation(rho)).cwiseAbs().maxCoeff() < 1e-12);
+    // every form of the rotation: u(t + 2πk) (a negative factor is the opposite axis); for the
+    // identity any u, and the nearest form lies along r
+    const double t = rho.norm();
+    const Vec3<> u = t > 0 ? Vec3<>(rho / t) : r.normalized();
+    double best = 1e300;
+    for (int k = -8; k <= 8; ++k) best = std::min(best, (u * (t + 2 * pi * k) - r).norm());
+    CHECK((out - r).norm() <= best + 1e-12);
+    ++checked;
+  }
+  CHECK(checked == n);
+  // nothing to move the second time
+  TsAcapFeatures<double> again = lifted;
+  CHECK(lift_rotations_toward(again, ref) == 0);
+  CHECK(again == lifted);
+  CHECK_THROWS_AS(lift_rotations_toward(lifted, TsAcapFeatures<double>(n - 1, 9)), ShapeError);
+  TsAcapFeatures<double> bad = ref;
+  bad(3, 1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(lift_rotations_toward(lifted, bad), ArgumentError);
 }
 
 }  // namespace shell_test_ts_acap

@@ -229,6 +229,7 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
                   {"decoded_truth", e.decoded_truth_rmse}, {"decoded_subdivided", e.decoded_subdivided_rmse}};
   for (const auto& b : baselines) r["rmse_m"][b.method] = b.rmse;
   r["fine_target"] = fine_target_name(o.network.fine_target);
+  if (o.network.fine_target == FineTarget::residual) r["residual_lift"] = residual_lift_name(o.network.residual_lift);
   nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
   for (const auto& s : e.sequences)
     seqs.push_back({{"name", s.name}, {"frames", s.frames}, {"subdivided_m", s.subdivided_rmse}, {"synthesized_m", s.synthesized_rmse},
@@ -247,6 +248,8 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
                                   {"edge_frames", c.edge_frames}, {"largest_angle_rad", c.largest_angle}};
   };
   r["feature_jumps"] = {{"coarse", counts(j.coarse)}, {"fine", counts(j.fine)}};
+  if (o.network.fine_target == FineTarget::residual)
+    r["feature_jumps"]["residual_beyond_pi"] = {{"own", j.residual_own}, {"trained", j.residual_trained}, {"vertex_frames", j.residual_vertex_frames}};
   nlohmann::ordered_json tt{{"ts_acap_extraction", e.timings.ts_acap}, {"synthesis", e.timings.synthesis}, {"collision_refinement", e.timings.refinement}};
   if (weight > 0) tt["coarse_simulation"] = coarse_s / weight;
   if (fine_weight > 0) tt["fine_simulation"] = fine_s / fine_weight;
@@ -281,6 +284,13 @@ inline std::string cloth_report_text(const nlohmann::ordered_json& r) {
                 (long long)j.at("fine").at("temporal").get<Index>(), (long long)j.at("fine").at("spatial").get<Index>(),
                 j.at("fine").at("largest_angle_rad").get<double>());
   s += buf;
+  if (j.contains("residual_beyond_pi")) {
+    const auto& q = j.at("residual_beyond_pi");
+    std::snprintf(buf, sizeof buf, "residual rotations > pi from the subdivided mesh's: %lld as lifted alone, %lld trained on (%s), of %lld vertex-frames\n",
+                  (long long)q.at("own").get<Index>(), (long long)q.at("trained").get<Index>(), r.value("residual_lift", std::string("own")).c_str(),
+                  (long long)q.at("vertex_frames").get<Index>());
+    s += buf;
+  }
   s += "\nseconds per frame (Table 1's stages)\n";
   for (const auto& [k, v] : r.at("seconds_per_frame").items()) {
     std::snprintf(buf, sizeof buf, "  %-22s %.5f\n", k.c_str(), v.get<double>());

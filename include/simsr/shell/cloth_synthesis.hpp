@@ -98,6 +98,15 @@ struct FeatureJumps {
     }
   };
   Counts coarse, fine;
+  /// A residual target's training vertex-frames whose fine rotation vector lies more than π from
+  /// the subdivided coarse frame's: as the fine sequence's own integer steps left it, and as the
+  /// network is given it (after lift_rotations_toward with ResidualLift::nearest; else the same).
+  Index residual_own = 0, residual_trained = 0, residual_vertex_frames = 0;
+
+  /// Vertices whose rotation vectors in a and b lie more than π apart.
+  static Index beyond_pi(const TsAcapFeatures<double>& a, const TsAcapFeatures<double>& b) {
+    return ((a.leftCols<3>() - b.leftCols<3>()).rowwise().norm().array() > std::numbers::pi).count();
+  }
 };
 
 namespace detail {
@@ -139,7 +148,14 @@ class ClothSynthesis {
         feature_jumps_.fine.add(fine.back(), fine_acap_.edges());
         if (residual()) {
           const std::vector<TsAcapFeatures<double>> base = fine_acap_.encode_sequence(policy, subdivided(s.coarse));
-          for (std::size_t f = 0; f < base.size(); ++f) fine.back()[f] -= base[f];
+          for (std::size_t f = 0; f < base.size(); ++f) {
+            TsAcapFeatures<double>& target = fine.back()[f];
+            feature_jumps_.residual_own += FeatureJumps::beyond_pi(target, base[f]);
+            if (net_.options().residual_lift == ResidualLift::nearest) lift_rotations_toward(target, base[f]);
+            feature_jumps_.residual_trained += FeatureJumps::beyond_pi(target, base[f]);
+            feature_jumps_.residual_vertex_frames += target.rows();
+            target -= base[f];
+          }
         }
       }
       if (on_encode) on_encode(s.name, Index(coarse.size()), Index(data.sequences.size()));
@@ -180,6 +196,7 @@ class ClothSynthesis {
     for (const auto& s : data_->sequences) f.add(s.num_frames()).add(std::int64_t(s.test)).add(s.coarse.front()).add(s.fine.back());
     f.add(o.batch).add(o.seed).add(net_.options().lr).add(net_.options().lr_decay).add(net_.options().lr_step);
     f.add(net_.options().noise_variance).add(std::int64_t(net_.options().fine_target));
+    if (residual()) f.add(std::int64_t(net_.options().residual_lift));
     return f.hex();
   }
 

@@ -100,6 +100,23 @@ inline FineTarget parse_fine_target(const std::string& name) {
   throw ArgumentError("fine target '" + name + "': expected 'features' or 'residual'");
 }
 
+/// Which axis–angle forms a residual target's fine rotation vectors take before the subdivided
+/// coarse frame's are subtracted. The two sides are lifted by their own integer problems (Eq. 2–4)
+/// and can differ by 2π where those chose differently (on DISK's fine cloth 1.6 % of edge-frames
+/// jump by more than π); every form decodes alike, so the choice changes only what is learnt.
+enum class ResidualLift {
+  nearest,  ///< each vertex's form nearest the subdivided frame's (lift_rotations_toward): the residual is the rotation between them
+  own,      ///< the fine sequence's own forms, as the features target holds them
+};
+
+inline const char* residual_lift_name(ResidualLift l) { return l == ResidualLift::nearest ? "nearest" : "own"; }
+/// ArgumentError for a name other than "nearest" or "own".
+inline ResidualLift parse_residual_lift(const std::string& name) {
+  if (name == "nearest") return ResidualLift::nearest;
+  if (name == "own") return ResidualLift::own;
+  throw ArgumentError("residual lift '" + name + "': expected 'nearest' or 'own'");
+}
+
 struct DetailSynthesisOptions {
   MeshCodecOptions codec;  ///< encoders and decoder: 9 channels, 16-d latent
   DeformTransformerOptions transformer;
@@ -108,6 +125,7 @@ struct DetailSynthesisOptions {
   double lr_decay = 0.1;
   Index lr_step = 20;
   FineTarget fine_target = FineTarget::residual;  ///< see FineTarget; the README gives both's figures
+  ResidualLift residual_lift = ResidualLift::nearest;  ///< a residual target's rotation forms (see ResidualLift)
 };
 
 /// One training batch: `windows` (sequence, first frame) pairs into the sequences' features.
@@ -294,6 +312,7 @@ class DetailSynthesisNet {
                      {"feed_forward", opt_.transformer.feed_forward}, {"heads", opt_.transformer.heads},
                      {"blocks", opt_.transformer.blocks}, {"frames", opt_.transformer.frames},
                      {"fine_target", fine_target_name(opt_.fine_target)}};
+    if (opt_.fine_target == FineTarget::residual) j["residual_lift"] = residual_lift_name(opt_.residual_lift);  // how it was trained
     z["config"] = io::make_npy(std::vector<std::string>{j.dump()});
     for (const auto& [name, s] : {std::pair{"coarse", &scale_c_}, std::pair{"fine", &scale_f_}}) {
       z[std::string("scaling/") + name + "_mean"] = io::make_npy<double>({ts_acap_feature_dim}, s->mean.data());
@@ -343,6 +362,11 @@ class DetailSynthesisNet {
     o.transformer.blocks = j.at("blocks").get<Index>();
     o.transformer.frames = j.at("frames").get<Index>();
     o.fine_target = target_of(j, file);
+    try {  // files written before the option lifted residuals as their own integer steps did
+      o.residual_lift = parse_residual_lift(j.value("residual_lift", std::string("own")));
+    } catch (const std::exception& e) {
+      throw ParseError(file.string(), 0, std::string("the model's residual_lift: ") + e.what());
+    }
     return o;
   }
 

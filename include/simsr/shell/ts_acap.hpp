@@ -26,6 +26,8 @@
 /// to a vertex-alternating in-plane perturbation.
 
 #include <Eigen/SparseCholesky>
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "../core/error.hpp"
@@ -65,6 +67,44 @@ struct TsAcapFrameReport {
   Index flipped_axes = 0;    ///< vertices with o = −1
   Index wrapped_angles = 0;  ///< vertices with r ≠ 0
 };
+
+/// Moves each vertex's rotation vector (columns 0–2 of `f`) to the axis–angle form of the same
+/// rotation nearest `reference`'s at that vertex. The forms of a rotation by t about u are
+/// u(t + 2πk), k ∈ ℤ (a negative factor is the opposite axis, Eq. 2's sign), and every one gives
+/// the same T_i; the nearest to ρ_ref is k = round((u·ρ_ref − t) / 2π), a closed form per vertex
+/// (the identity, t = 0, takes u along ρ_ref). Why: two meshes whose rotations were lifted by
+/// their own integer problems (Eq. 2–4) can differ by 2π at a vertex where the two chose
+/// differently, though their rotations are close; a residual between them (the fine features
+/// minus the subdivided coarse mesh's) then jumps by 2π there, which a network must learn as a
+/// spike. Lifted this way the residual holds only the rotation between them. The stretch columns
+/// are untouched. Returns how many vertices moved; ShapeError for another vertex count,
+/// ArgumentError for a non-finite entry.
+template <class S>
+Index lift_rotations_toward(TsAcapFeatures<S>& f, const TsAcapFeatures<S>& reference) {
+  if (f.rows() != reference.rows()) throw ShapeError("lift_rotations_toward: reference features", {f.rows(), ts_acap_feature_dim}, {reference.rows(), reference.cols()});
+  if (!f.allFinite() || !reference.allFinite()) throw ArgumentError("lift_rotations_toward: features contain NaN or Inf");
+  constexpr double two_pi = 2 * std::numbers::pi;
+  Index moved = 0;
+  for (Index i = 0; i < f.rows(); ++i) {
+    const Vec3<double> rho = f.row(i).template head<3>().transpose().template cast<double>();
+    const Vec3<double> ref = reference.row(i).template head<3>().transpose().template cast<double>();
+    double t = rho.norm();
+    Vec3<double> u;
+    if (t > 0) {
+      u = rho / t;
+    } else if (ref.norm() > 0) {
+      u = ref.normalized();
+    } else {
+      continue;  // both the identity's zero form
+    }
+    const double k = std::round((u.dot(ref) - t) / two_pi);
+    if (k == 0) continue;
+    t += two_pi * k;
+    f.row(i).template head<3>() = (u * t).transpose().template cast<S>();
+    ++moved;
+  }
+  return moved;
+}
 
 template <class S = Scalar>
 class TsAcap {
