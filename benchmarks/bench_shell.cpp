@@ -27,6 +27,21 @@
 //   BM_tanh/<scene>/libm                      input (64 frames × fine vertices × 9); beside it the
 //                                             per-element std::tanh loop nn::Tanh ran before
 //
+// Collision refinement (shell/collision_refinement.hpp) on DISK's fine cloth (7,057 vertices, the
+// default 6 rings Loop ×3), wrinkled 5 mm and pressed 3 cm into a sphere (~390 vertices inside;
+// the DISK run's held-out frames averaged ~470): Table 1's "refinement" stage, which the DISK run
+// measured at 0.123 s per frame (simplicial, every solve analysed anew) against the supplement's
+// 0.008.
+//   BM_collision_refinement/disk_7057/<solver>         one frame refined (ms; counter solves)
+//   BM_refinement_factorization/disk_7057/<solver>/analyse_each
+//                                                      one solve's matrix factored from nothing:
+//                                                      ordering, symbolic and numeric (what every
+//                                                      solve did before the pattern was kept)
+//   BM_refinement_factorization/disk_7057/<solver>/factor_only
+//                                                      the numeric factorization on the kept
+//                                                      analysis (every solve now)
+// <solver>: simplicial (Eigen's LDLᵀ, the default) or cholmod (-DSIMSR_WITH_CHOLMOD=ON).
+//
 // Run: OMP_NUM_THREADS=2 build/benchmarks/bench_shell [--benchmark_filter=4225]
 // CHOLMOD's supernodal kernels are BLAS: with Debian's reference BLAS they are ~3× slower than
 // with OpenBLAS (scripts/deps.sh test installs libopenblas0-pthread).
@@ -37,9 +52,11 @@
 #endif
 #include <simsr/shell/cloth_scenes.hpp>
 #include <simsr/shell/cloth_simulator.hpp>
+#include <simsr/shell/collision_refinement.hpp>
 #include <simsr/shell/detail_synthesis.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 namespace {
@@ -126,7 +143,72 @@ void tanh_forward(benchmark::State& state, Index levels, bool libm) {
   state.SetItemsProcessed(state.iterations() * x.size());
 }
 
+/// DISK's fine rest cloth (the default 6 rings, Loop ×3) wrinkled along x, and a sphere it is
+/// pressed 3 cm into.
+Points<> disk_pressed(const ClothPair& pair, physics::Sphere<>& sphere) {
+  Points<> x = pair.fine.V;
+  const double top = x.col(2).mean();
+  for (Index i = 0; i < x.rows(); ++i) x(i, 2) = top + 0.005 * std::sin(60 * x(i, 0));
+  sphere = physics::Sphere<>(Vec3<>(x.col(0).mean(), x.col(1).mean(), top - 0.5), 0.53);
+  return x;
+}
+
+template <class Linear>
+void collision_refinement(benchmark::State& state) {
+  const ClothPair pair = cloth_pair(ClothDataset::disk, {6, 3});
+  physics::Sphere<> sphere(Vec3<>::Zero(), 1);
+  const Points<> x0 = disk_pressed(pair, sphere);
+  CollisionRefinement<Linear> refine(pair.fine);
+  Points<> x = x0;
+  CollisionRefinementReport r = refine.refine(exec::omp, sphere, x);  // warm: the analysis made
+  for (auto _ : state) {
+    x = x0;
+    r = refine.refine(exec::omp, sphere, x);
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["solves"] = double(r.solves);
+  state.counters["inside"] = double(r.inside_before);
+  state.counters["vertices"] = double(x0.rows());
+}
+
+/// One solve's matrix (the system with the inside vertices' weights on its diagonal) factored by
+/// `Linear`: analysed anew each time (a new pattern version) or on the kept analysis.
+template <class Linear>
+void refinement_factorization(benchmark::State& state, bool analyse_each) {
+  const ClothPair pair = cloth_pair(ClothDataset::disk, {6, 3});
+  physics::Sphere<> sphere(Vec3<>::Zero(), 1);
+  const Points<> x0 = disk_pressed(pair, sphere);
+  const CollisionRefinement<Linear> refine(pair.fine);
+  physics::SparseMatrix<double> A = refine.system_matrix();
+  for (Index i = 0; i < x0.rows(); ++i)
+    if (sphere.distance(Vec3<>(x0.row(i).transpose())) < 0) A.coeffRef(i, i) *= 1e4 + 1;
+  Linear solver;
+  std::uint64_t version = 1;
+  solver.compute(exec::omp, A, version);
+  for (auto _ : state) {
+    if (analyse_each) ++version;
+    solver.compute(exec::omp, A, version);
+  }
+  state.counters["nonzeros"] = double(A.nonZeros());
+}
+
+template <class Linear>
+void register_refinement(const std::string& solver) {
+  benchmark::RegisterBenchmark(("BM_collision_refinement/disk_7057/" + solver).c_str(), collision_refinement<Linear>)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
+  for (const bool each : {true, false})
+    benchmark::RegisterBenchmark(("BM_refinement_factorization/disk_7057/" + solver + (each ? "/analyse_each" : "/factor_only")).c_str(),
+                                 [each](benchmark::State& s) { refinement_factorization<Linear>(s, each); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+}
+
 void register_cases() {
+  register_refinement<physics::SparseCholesky<>>("simplicial");
+#if defined(SIMSR_HAVE_CHOLMOD)
+  register_refinement<physics::CholmodCholesky<>>("cholmod");
+#endif
   for (const auto& [name, levels] : {std::pair<const char*, Index>{"sheet_81", 0}, {"sheet_1089", 2}, {"sheet_4225", 3}}) {
     const Index l = levels;
     benchmark::RegisterBenchmark((std::string("BM_cloth_frames/") + name + "/simplicial").c_str(),

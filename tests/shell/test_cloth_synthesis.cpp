@@ -98,7 +98,7 @@ const std::filesystem::path& coarser_dataset() {
 
 /// RMS distance to the fine simulation of sequence t's subdivided coarse frames' features decoded
 /// with the pins where the coarse frames have them, computed here from the parts.
-double decoded_subdivided_rmse(const ClothSynthesis& run, const ClothData& d, const ClothSequenceFrames& t) {
+double decoded_subdivided_rmse(const ClothSynthesis<>& run, const ClothData& d, const ClothSequenceFrames& t) {
   double sum = 0;
   TsAcapState<double> state;
   for (Index f = 0; f < t.num_frames(); ++f) {

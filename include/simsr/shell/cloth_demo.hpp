@@ -142,8 +142,8 @@ nlohmann::ordered_json run_cloth_demo(P policy, const ClothDemoOptions& o, const
 
   tell("features: TS-ACAP of every frame (coarse " + std::to_string(data.num_coarse()) + ", fine " + std::to_string(data.num_fine()) +
        " vertices)");
-  ClothSynthesis run(policy, data, o.network, o.network_seed,
-                     [&](const std::string& s, Index done, Index total) { tell("features: " + s + " (" + std::to_string(done) + "/" + std::to_string(total) + ")"); });
+  ClothSynthesis<Linear> run(policy, data, o.network, o.network_seed,
+                             [&](const std::string& s, Index done, Index total) { tell("features: " + s + " (" + std::to_string(done) + "/" + std::to_string(total) + ")"); });
   run.on_epoch = [&](const ClothEpochReport& r) {
     char buf[200];
     std::snprintf(buf, sizeof buf, "train: epoch %lld/%lld lr %.1e loss synthesis %.4f reconstruction %.4f latent %.4f (%.1f s)", (long long)r.epoch,

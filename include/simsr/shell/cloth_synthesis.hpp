@@ -114,6 +114,8 @@ inline double rms_distance(const Points<>& a, const Points<>& b) { return std::s
 }  // namespace detail
 
 /// The dataset's features, the network and its training and evaluation (see the file comment).
+/// `Linear` solves the collision refinement's systems (CollisionRefinement<Linear>).
+template <class Linear = physics::SparseCholesky<>>
 class ClothSynthesis {
  public:
   std::function<void(const ClothEpochReport&)> on_epoch;          ///< progress of train()
@@ -397,7 +399,7 @@ class ClothSynthesis {
   const ClothData* data_;
   TsAcap<double> coarse_acap_, fine_acap_;
   DetailSynthesisNet<float> net_;
-  CollisionRefinement refine_;
+  CollisionRefinement<Linear> refine_;
   std::vector<SequenceFeatures<float>> features_;
   FeatureJumps feature_jumps_;
 };

@@ -19,6 +19,11 @@
 ///
 ///     shell::CollisionRefinement refine(fine_rest);
 ///     const auto report = refine.refine(exec::seq, obstacle, x);   // x: in/out, #V×3
+///
+/// Every solve's matrix is the same sparse pattern (only some diagonal entries grow), so its
+/// linear solver (a physics::LinearSolver: SparseCholesky, Eigen's simplicial LDLᵀ, by default;
+/// physics::CholmodCholesky built with CHOLMOD) analyses it once and refactors per solve. The
+/// factorization is nearly all of a refinement: benchmarks/bench_shell.cpp measures the two.
 
 #include <algorithm>
 #include <cmath>
@@ -26,7 +31,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/SparseCholesky>
 
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
@@ -35,6 +39,9 @@
 #include "../mesh/tri_mesh.hpp"
 #include "../mesh/vertex_areas.hpp"
 #include "../physics/forces/obstacle_contact.hpp"
+#include "../physics/hessian.hpp"
+#include "../physics/linear_solvers/linear_solver.hpp"
+#include "../physics/linear_solvers/sparse_cholesky.hpp"
 
 namespace simsr::shell {
 
@@ -53,8 +60,12 @@ struct CollisionRefinementReport {
   double deepest_before = 0, deepest_after = 0;  ///< the most negative distance (m; 0: none inside)
 };
 
-/// The refinement of the file comment, for one rest mesh (its Laplacian built once).
+/// The refinement of the file comment, for one rest mesh (its Laplacian built once), solved by
+/// `Linear`. A Linear that is not a physics::LinearSolver stops the build with one sentence.
+template <class Linear = physics::SparseCholesky<>>
 class CollisionRefinement {
+  static_assert(physics::assert_linear_solver<Linear>());
+
  public:
   /// MeshError for a bad triangle; ArgumentError for a bad option.
   explicit CollisionRefinement(const TriMesh<>& rest, CollisionRefinementOptions options = {}) : options_(options) {
@@ -71,17 +82,26 @@ class CollisionRefinement {
     for (Index i = 0; i < areas.size(); ++i)
       if (!(areas[i] > 0)) throw MeshError("vertex", i, "CollisionRefinement: zero Voronoi area (every triangle at it degenerate or none)");
     const VecX<> inv_area = areas.cwiseInverse(), position = areas / std::pow(options_.falloff, 4);
-    A_ = Eigen::SparseMatrix<double>(L.transpose() * inv_area.asDiagonal() * L);
-    for (Index i = 0; i < A_.rows(); ++i) A_.coeffRef(i, i) += position[i];
+    Eigen::SparseMatrix<double> A(L.transpose() * inv_area.asDiagonal() * L);
+    for (Index i = 0; i < A.rows(); ++i) A.coeffRef(i, i) += position[i];
+    A_ = physics::SparseMatrix<double>(A);
     A_.makeCompressed();
+    K_ = A_;
+    diagonal_.resize(A_.rows());  // where each row's diagonal entry sits in the values
+    for (Index i = 0; i < A_.rows(); ++i)
+      for (Index k = A_.outerIndexPtr()[i]; k < A_.outerIndexPtr()[i + 1]; ++k)
+        if (A_.innerIndexPtr()[k] == i) diagonal_[i] = k;
   }
 
   Index num_vertices() const { return A_.rows(); }
+  /// LᵀM⁻¹L + M/ℓ⁴: the matrix of every solve before the targets' weights join its diagonal.
+  const physics::SparseMatrix<double>& system_matrix() const { return A_; }
 
   /// Refines x (#V×3, in/out) against `obstacle` (see the file comment). ShapeError for another
-  /// vertex count; ArgumentError for a non-finite position.
+  /// vertex count; ArgumentError for a non-finite position. One call at a time per object (the
+  /// factorization is kept between calls).
   template <exec::HostPolicy P, physics::Obstacle O>
-  CollisionRefinementReport refine(P, const O& obstacle, Points<>& x) {
+  CollisionRefinementReport refine(P policy, const O& obstacle, Points<>& x) {
     if (x.rows() != num_vertices() || x.cols() != 3)
       throw ShapeError("CollisionRefinement::refine: positions", {num_vertices(), 3}, {x.rows(), x.cols()});
     if (!x.allFinite()) throw ArgumentError("CollisionRefinement::refine: a position is not finite");
@@ -108,19 +128,21 @@ class CollisionRefinement {
     }
     if (report.inside_before == 0) return report;
     const Points<> kept = A_ * x;  // the Laplacian and distance terms' right-hand side at x₀
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+    VecX<> b(n), xc(n);
     for (Index it = 0; it < options_.max_iterations; ++it) {
-      Eigen::SparseMatrix<double> A = A_;
-      Points<> b = kept;
+      // K = A_ with the constrained vertices' weights on the diagonal: A_'s pattern, analysed by
+      // the solver at the first solve and kept (pattern version 1 for good)
+      std::copy(A_.valuePtr(), A_.valuePtr() + A_.nonZeros(), K_.valuePtr());
       for (Index i = 0; i < n; ++i)
-        if (constrained[std::size_t(i)]) {
-          const double w = options_.weight * A_.coeff(i, i);
-          A.coeffRef(i, i) += w;
-          b.row(i) += w * target.row(i);
-        }
-      solver.compute(A);
-      if (solver.info() != Eigen::Success) throw ConvergenceError("CollisionRefinement: the Laplacian system could not be factorized", 0, NAN);
-      x = solver.solve(b);
+        if (constrained[std::size_t(i)]) K_.valuePtr()[diagonal_[i]] += options_.weight * A_.valuePtr()[diagonal_[i]];
+      solver_.compute(policy, K_, 1);
+      for (int c = 0; c < 3; ++c) {
+        for (Index i = 0; i < n; ++i)
+          b[i] = kept(i, c) + (constrained[std::size_t(i)] ? options_.weight * A_.valuePtr()[diagonal_[i]] * target(i, c) : 0.0);
+        const physics::LinearSolveInfo info = solver_.solve(policy, b, xc);
+        if (!info.converged) throw ConvergenceError("CollisionRefinement: the Laplacian system", info.iterations, info.relative_residual);
+        x.col(c) = xc;
+      }
       ++report.solves;
       bool any = false;
       for (Index i = 0; i < n; ++i) {
@@ -147,7 +169,10 @@ class CollisionRefinement {
 
  private:
   CollisionRefinementOptions options_;
-  Eigen::SparseMatrix<double> A_;  ///< LᵀM⁻¹L + M/ℓ⁴
+  physics::SparseMatrix<double> A_;  ///< LᵀM⁻¹L + M/ℓ⁴
+  physics::SparseMatrix<double> K_;  ///< one solve's matrix (A_'s pattern)
+  std::vector<Index> diagonal_;      ///< per row, the index of its diagonal entry in A_'s (and K_'s) values
+  Linear solver_;                    ///< analyses K_'s pattern once, factors it per solve
 };
 
 }  // namespace simsr::shell
