@@ -239,14 +239,14 @@ int check(const std::string& model, const std::string& state, const std::string&
         nn::GroupPool<S>& pool;
         const Matrix<S>& values;
         Index group_size, n;
+        bool by_neighbour;  ///< edges of block 1's graph, whose rows PyTorch may order otherwise
       };
-      for (const Pool& p : {Pool{"edge_argmax", block.edge_conv().max_pool(), block.edge_conv().edge_values(), block.edge_conv().k(), N},
-                            Pool{"global_argmax", block.global_max(), block.edge_output(), N, 1}}) {
+      for (const Pool& p : {Pool{"edge_argmax", block.edge_conv().max_pool(), block.edge_conv().edge_values(), block.edge_conv().k(), N, b == 1},
+                            Pool{"global_argmax", block.global_max(), block.edge_output(), N, 1, false}}) {
         typename nn::GroupPool<S>::ArgmaxIndices theirs;
-        const bool by_neighbour = p.name == "edge_argmax" && b == 1;  // block 1's graph is PyTorch's row order, not ours
         const MaxAgreement a = max_agreement(p.values, p.group_size, p.pool.argmax(),
                                              fx.at(what + "/" + p.name + id).template to_vector<std::int64_t>(), p.n, tol, theirs,
-                                             by_neighbour ? std::optional{std::pair{&block.edge_conv().graph(), &their_graph}} : std::nullopt);
+                                             p.by_neighbour ? std::optional{std::pair{&block.edge_conv().graph(), &their_graph}} : std::nullopt);
         rep.j[what + "/" + p.name][std::to_string(b)] = {{"equal", a.equal}, {"tied", a.tied}, {"differ", a.differ}};
         if (a.differ) rep.fail(what + "/" + p.name + id);
         if (a.tied) p.pool.set_argmax(theirs);

@@ -16,19 +16,23 @@
 
 namespace simsr::io {
 
+namespace detail {
+/// A fingerprint array's string ("" for an empty one).
+inline std::string fingerprint_string(const NpyArray& a) {
+  const auto s = a.to_strings();
+  return s.empty() ? "" : s[0];
+}
+}  // namespace detail
+
 /// The fingerprint a run file carries ("" for none). A file may carry more than one, each under
 /// its own array name (a cloth sequence: "fine_fingerprint", its fine cloth's simulation alone).
 inline std::string fingerprint_of(const NpzArrays& z, const std::string& name = "fingerprint") {
-  if (!z.contains(name)) return "";
-  const auto s = z.at(name).to_strings();
-  return s.empty() ? "" : s[0];
+  return z.contains(name) ? detail::fingerprint_string(z.at(name)) : "";
 }
 
 /// The same, read from an open archive without reading its other members.
 inline std::string fingerprint_of(NpzReader& z, const std::string& name = "fingerprint") {
-  if (!z.contains(name)) return "";
-  const auto s = z.read(name).to_strings();
-  return s.empty() ? "" : s[0];
+  return z.contains(name) ? detail::fingerprint_string(z.read(name)) : "";
 }
 
 /// `print` as the file's fingerprint array (`name`: see fingerprint_of).

@@ -78,6 +78,11 @@ struct ClothEvaluation {
 /// mesh, but the network must learn a discontinuity. This is what replacing CoMISo's solver by
 /// propagation + local improvement can cost; 0 means nothing.
 struct FeatureJumps {
+  /// Vertices whose rotation vectors in a and b lie more than π apart.
+  static Index beyond_pi(const TsAcapFeatures<double>& a, const TsAcapFeatures<double>& b) {
+    return ((a.leftCols<3>() - b.leftCols<3>()).rowwise().norm().array() > std::numbers::pi).count();
+  }
+
   /// One resolution's counts over every frame added.
   struct Counts {
     Index temporal = 0, spatial = 0;        ///< vertex-frames / edge-frames with a jump > π
@@ -90,7 +95,7 @@ struct FeatureJumps {
       for (std::size_t f = 0; f < seq.size(); ++f) {
         const auto rho = seq[f].leftCols<3>();
         for (Index e = 0; e < edges.rows(); ++e) spatial += (rho.row(edges(e, 0)) - rho.row(edges(e, 1))).norm() > pi;
-        if (f > 0) temporal += ((rho - seq[f - 1].leftCols<3>()).rowwise().norm().array() > pi).count();
+        if (f > 0) temporal += beyond_pi(seq[f], seq[f - 1]);
         largest_angle = std::max(largest_angle, rho.rowwise().norm().maxCoeff());
         vertex_frames += rho.rows();
         edge_frames += edges.rows();
@@ -103,10 +108,6 @@ struct FeatureJumps {
   /// network is given it (after lift_rotations_toward with ResidualLift::nearest; else the same).
   Index residual_own = 0, residual_trained = 0, residual_vertex_frames = 0;
 
-  /// Vertices whose rotation vectors in a and b lie more than π apart.
-  static Index beyond_pi(const TsAcapFeatures<double>& a, const TsAcapFeatures<double>& b) {
-    return ((a.leftCols<3>() - b.leftCols<3>()).rowwise().norm().array() > std::numbers::pi).count();
-  }
 };
 
 namespace detail {
@@ -152,9 +153,10 @@ class ClothSynthesis {
           const std::vector<TsAcapFeatures<double>> base = fine_acap_.encode_sequence(policy, subdivided(s.coarse));
           for (std::size_t f = 0; f < base.size(); ++f) {
             TsAcapFeatures<double>& target = fine.back()[f];
-            feature_jumps_.residual_own += FeatureJumps::beyond_pi(target, base[f]);
-            if (net_.options().residual_lift == ResidualLift::nearest) lift_rotations_toward(target, base[f]);
-            feature_jumps_.residual_trained += FeatureJumps::beyond_pi(target, base[f]);
+            const Index own = FeatureJumps::beyond_pi(target, base[f]);
+            feature_jumps_.residual_own += own;
+            const bool lift = net_.options().residual_lift == ResidualLift::nearest && lift_rotations_toward(target, base[f]) > 0;
+            feature_jumps_.residual_trained += lift ? FeatureJumps::beyond_pi(target, base[f]) : own;
             feature_jumps_.residual_vertex_frames += target.rows();
             target -= base[f];
           }

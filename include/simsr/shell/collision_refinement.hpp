@@ -87,10 +87,19 @@ class CollisionRefinement {
     A_ = physics::SparseMatrix<double>(A);
     A_.makeCompressed();
     K_ = A_;
-    diagonal_.resize(A_.rows());  // where each row's diagonal entry sits in the values
-    for (Index i = 0; i < A_.rows(); ++i)
+    const Index n = A_.rows();
+    diagonal_.resize(std::size_t(n));  // where each row's diagonal entry sits in the values
+    for (Index i = 0; i < n; ++i)
       for (Index k = A_.outerIndexPtr()[i]; k < A_.outerIndexPtr()[i + 1]; ++k)
-        if (A_.innerIndexPtr()[k] == i) diagonal_[i] = k;
+        if (A_.innerIndexPtr()[k] == i) diagonal_[std::size_t(i)] = k;
+    target_weight_.resize(n);
+    for (Index i = 0; i < n; ++i) target_weight_[i] = options_.weight * A_.valuePtr()[diagonal_[std::size_t(i)]];
+    // the per-frame buffers, sized once
+    constrained_.assign(std::size_t(n), 0);
+    target_.resize(n, 3);
+    kept_.resize(n, 3);
+    b_.resize(n);
+    xc_.resize(n);
   }
 
   Index num_vertices() const { return A_.rows(); }
@@ -107,8 +116,9 @@ class CollisionRefinement {
     if (!x.allFinite()) throw ArgumentError("CollisionRefinement::refine: a position is not finite");
     CollisionRefinementReport report;
     const Index n = num_vertices();
-    std::vector<char> constrained(std::size_t(n), 0);
-    Points<> target = Points<>::Zero(n, 3);
+    std::vector<char>& constrained = constrained_;
+    Points<>& target = target_;
+    std::fill(constrained.begin(), constrained.end(), 0);
     auto inside = [&](Index i, double& d) {
       d = obstacle.distance(Vec3<>(x.row(i).transpose()));
       return d < 0;
@@ -127,21 +137,19 @@ class CollisionRefinement {
       }
     }
     if (report.inside_before == 0) return report;
-    const Points<> kept = A_ * x;  // the Laplacian and distance terms' right-hand side at x₀
-    VecX<> b(n), xc(n);
+    kept_.noalias() = A_ * x;  // the Laplacian and distance terms' right-hand side at x₀
     for (Index it = 0; it < options_.max_iterations; ++it) {
       // K = A_ with the constrained vertices' weights on the diagonal: A_'s pattern, analysed by
       // the solver at the first solve and kept (pattern version 1 for good)
       std::copy(A_.valuePtr(), A_.valuePtr() + A_.nonZeros(), K_.valuePtr());
       for (Index i = 0; i < n; ++i)
-        if (constrained[std::size_t(i)]) K_.valuePtr()[diagonal_[i]] += options_.weight * A_.valuePtr()[diagonal_[i]];
+        if (constrained[std::size_t(i)]) K_.valuePtr()[diagonal_[std::size_t(i)]] += target_weight_[i];
       solver_.compute(policy, K_, 1);
       for (int c = 0; c < 3; ++c) {
-        for (Index i = 0; i < n; ++i)
-          b[i] = kept(i, c) + (constrained[std::size_t(i)] ? options_.weight * A_.valuePtr()[diagonal_[i]] * target(i, c) : 0.0);
-        const physics::LinearSolveInfo info = solver_.solve(policy, b, xc);
+        for (Index i = 0; i < n; ++i) b_[i] = kept_(i, c) + (constrained[std::size_t(i)] ? target_weight_[i] * target(i, c) : 0.0);
+        const physics::LinearSolveInfo info = solver_.solve(policy, b_, xc_);
         if (!info.converged) throw ConvergenceError("CollisionRefinement: the Laplacian system", info.iterations, info.relative_residual);
-        x.col(c) = xc;
+        x.col(c) = xc_;
       }
       ++report.solves;
       bool any = false;
@@ -172,7 +180,12 @@ class CollisionRefinement {
   physics::SparseMatrix<double> A_;  ///< LᵀM⁻¹L + M/ℓ⁴
   physics::SparseMatrix<double> K_;  ///< one solve's matrix (A_'s pattern)
   std::vector<Index> diagonal_;      ///< per row, the index of its diagonal entry in A_'s (and K_'s) values
+  VecX<> target_weight_;             ///< w_i = weight × A_ii
   Linear solver_;                    ///< analyses K_'s pattern once, factors it per solve
+  // one frame's state, kept to reuse the memory: constrained vertices, their targets, A_ x₀, one column's rhs and solution
+  std::vector<char> constrained_;
+  Points<> target_, kept_;
+  VecX<> b_, xc_;
 };
 
 }  // namespace simsr::shell

@@ -330,7 +330,7 @@ class DetailSynthesisNet {
       throw ArgumentError(file.string() + ": a model of " + std::to_string(j["coarse_vertices"].get<Index>()) + " / " +
                           std::to_string(j["fine_vertices"].get<Index>()) + " vertices, this mesh pair has " + std::to_string(n_) + " / " +
                           std::to_string(m_));
-    if (const FineTarget t = target_of(j, file); t != opt_.fine_target)
+    if (const FineTarget t = named_option(j, "fine_target", "features", parse_fine_target, file); t != opt_.fine_target)
       throw ArgumentError(file.string() + ": a model whose fine side holds '" + fine_target_name(t) + "', this network's holds '" +
                           fine_target_name(opt_.fine_target) + "'");
     nn::load_state(store_, z);
@@ -361,12 +361,9 @@ class DetailSynthesisNet {
     o.transformer.heads = j.at("heads").get<Index>();
     o.transformer.blocks = j.at("blocks").get<Index>();
     o.transformer.frames = j.at("frames").get<Index>();
-    o.fine_target = target_of(j, file);
-    try {  // files written before the option lifted residuals as their own integer steps did
-      o.residual_lift = parse_residual_lift(j.value("residual_lift", std::string("own")));
-    } catch (const std::exception& e) {
-      throw ParseError(file.string(), 0, std::string("the model's residual_lift: ") + e.what());
-    }
+    // files written before these options held features, and lifted residuals as their own integer steps did
+    o.fine_target = named_option(j, "fine_target", "features", parse_fine_target, file);
+    o.residual_lift = named_option(j, "residual_lift", "own", parse_residual_lift, file);
     return o;
   }
 
@@ -380,13 +377,14 @@ class DetailSynthesisNet {
       throw ParseError(file.string(), 0, "not a detail-synthesis model");
     return j;
   }
-  /// A saved model's fine target; files written before the option hold features.
-  static FineTarget target_of(const nlohmann::json& j, const std::filesystem::path& file) {
-    if (!j.contains("fine_target")) return FineTarget::features;
+  /// A saved model's option `key` parsed by `parse` (`missing` where the file predates it);
+  /// ParseError naming the file and the key for a value `parse` refuses.
+  template <class Parse>
+  static auto named_option(const nlohmann::json& j, const char* key, const char* missing, Parse parse, const std::filesystem::path& file) {
     try {
-      return parse_fine_target(j.at("fine_target").get<std::string>());
+      return parse(j.value(key, std::string(missing)));
     } catch (const std::exception& e) {
-      throw ParseError(file.string(), 0, std::string("the model's fine_target: ") + e.what());
+      throw ParseError(file.string(), 0, std::string("the model's ") + key + ": " + e.what());
     }
   }
   static DetailSynthesisOptions check(DetailSynthesisOptions o) {
