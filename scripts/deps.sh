@@ -12,7 +12,9 @@
 #                          libopenblas0-pthread (the BLAS CHOLMOD's supernodal factorization calls:
 #                          with Debian's reference BLAS a Newton step of the 4,225-vertex cloth took
 #                          0.65 s, with OpenBLAS 0.21 s) and
-#                          libcgal-dev (CGAL, the optional isotropic_remesh and remeshed SoftDECA template)
+#                          libcgal-dev (CGAL, the optional isotropic_remesh and remeshed SoftDECA template);
+#                          pybind11-dev and python3-dev (the optional Python module, -DSIMSR_WITH_PYTHON=ON),
+#                          python3-pytest (its suite) and python3-matplotlib (its face example's plot)
 # Needs root (or sudo) only when something is missing.
 set -euo pipefail
 job=${1:-test}
@@ -25,7 +27,8 @@ pkgs=(build-essential cmake ninja-build
 # its own npm and conflicts with Debian's (apt then refuses: "nodejs : Conflicts: npm").
 command -v npm >/dev/null || pkgs+=(npm)
 if [[ $job == test ]]; then
-  pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium libsuitesparse-dev libopenblas0-pthread libcgal-dev)
+  pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium libsuitesparse-dev libopenblas0-pthread libcgal-dev
+         pybind11-dev python3-dev python3-pytest python3-matplotlib)
 fi
 
 missing=()

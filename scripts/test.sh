@@ -9,7 +9,8 @@
 #                   libgomp allocation checks; the demo, animate and ablation runs; the SoftDECA
 #                   template from the kit),
 #                   test_threads, the tool and examples, the peers (gmsh,
-#                   meshio, numpy, scipy, torch), install + consumer project, compile-fail checks,
+#                   meshio, numpy, scipy, torch), the Python module and its pytest suite (tests/python),
+#                   install + consumer project, compile-fail checks,
 #                   cuda-compile, and each benchmark compiled (clang syntax only, a ctest each: none
 #                   is built or run here; -DSIMSR_BUILD_BENCHMARKS=ON builds them)
 #   2. build-asan/  clang, SIMSR_SANITIZE=asan: every area's suite (pipeline's own parts) and the corpus replays under
@@ -76,7 +77,7 @@ run_ctest() {
 }
 
 # 1. the normal build
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON -DSIMSR_WITH_CHOLMOD=ON -DSIMSR_WITH_CGAL=ON
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=ON -DSIMSR_BUILD_BENCHMARKS=OFF -DSIMSR_CHECK_BENCHMARKS=ON -DSIMSR_WITH_CHOLMOD=ON -DSIMSR_WITH_CGAL=ON -DSIMSR_WITH_PYTHON=ON
 cmake --build "$build" -j "$jobs"
 step "build ($build)"
 run_ctest "$build"

@@ -22,6 +22,18 @@ using VIndex = std::int32_t;
 template <class S = Scalar>
 using Points = Eigen::Matrix<S, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
+/// #V×3 positions read in place: a Points, a row block of one, a Map of contiguous row-major
+/// memory (a NumPy array through the Python module). Any other layout (column-major, a row stride
+/// other than 3) is copied into a temporary by Eigen. What per-frame calls take (interp's
+/// `apply`), so that no caller has to copy its frame into a Points first.
+template <class S = Scalar>
+using ConstPointsRef = Eigen::Ref<const Points<S>, 0, Eigen::OuterStride<3>>;
+
+/// #V×3 positions written in place (contiguous row-major, as ConstPointsRef; never resized: the
+/// caller sizes the buffer, and another layout does not compile).
+template <class S = Scalar>
+using PointsRef = Eigen::Ref<Points<S>, 0, Eigen::OuterStride<3>>;
+
 /// #T×4 tetrahedra (vertex indices).
 using Tets = Eigen::Matrix<VIndex, Eigen::Dynamic, 4, Eigen::RowMajor>;
 

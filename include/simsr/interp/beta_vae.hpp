@@ -156,7 +156,7 @@ class BetaVaeBaseline {
   /// ArgumentError for a non-finite input or one beyond float's range, NumericalError for a
   /// non-finite prediction.
   template <exec::HostPolicy Policy>
-  void apply(Policy policy, const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
+  void apply(Policy policy, const ConstPointsRef<S>& lr_displacement, PointsRef<S> hr_displacement) const {
     if (!vae_) throw ArgumentError("BetaVaeBaseline::apply before train");
     if (lr_displacement.rows() != n_) throw ShapeError("BetaVaeBaseline::apply: LR displacement", {n_, 3}, {lr_displacement.rows(), 3});
     if (hr_displacement.rows() != m_) throw ShapeError("BetaVaeBaseline::apply: HR displacement", {m_, 3}, {hr_displacement.rows(), 3});

@@ -14,7 +14,8 @@
 /// Two phases: `fit(policy, problem)` once on the rest shapes (and, where
 /// `needs_neighborhoods_v<I>`, the §3.2 neighbourhoods of the problem), then
 /// `apply(policy, lr_displacement, hr_displacement)` per frame into a caller-sized M×3 buffer
-/// without allocating. Methods that learn from paired frames add `train(policy, frames, options)`
+/// without allocating (the library's methods take both as ConstPointsRef / PointsRef, so a Points,
+/// a row block of one or a NumPy array is read and written in place). Methods that learn from paired frames add `train(policy, frames, options)`
 /// with `frames` the training frames as displacements from the fitted rest shapes
 /// (data::displacements) and `options` of their `train_options` type.
 
@@ -66,7 +67,7 @@ template <class I>
 constexpr bool assert_interpolator() {
   static_assert(Interpolator<I>,
                 "this type is not an interp::Interpolator: it needs a scalar_type, fit(policy, UpsamplingProblem&), "
-                "apply(policy, const Points& lr_displacement, Points& hr_displacement) const for exec::seq and exec::omp, "
+                "apply(policy, lr_displacement, hr_displacement) const (N×3 in, caller-sized M×3 out, as Points) for exec::seq and exec::omp, "
                 "num_lr() and num_hr()");
   return Interpolator<I>;
 }

@@ -67,7 +67,7 @@ class IDW {
 
   /// hr_displacement (M×3, caller-sized) from lr_displacement (N×3); ShapeError otherwise.
   template <exec::HostPolicy Policy>
-  void apply(Policy policy, const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
+  void apply(Policy policy, const ConstPointsRef<S>& lr_displacement, PointsRef<S> hr_displacement) const {
     detail::check_apply_shapes("IDW::apply", n_, num_hr(), lr_displacement, hr_displacement);
     gather_.apply(policy, lr_displacement, hr_displacement);
   }

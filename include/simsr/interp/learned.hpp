@@ -170,7 +170,7 @@ class Learned {
 
   /// hr_displacement (M×3) from lr_displacement (N×3), both in mesh units.
   template <exec::HostPolicy Policy>
-  void apply(Policy policy, const Points<Scalar>& lr_displacement, Points<Scalar>& hr_displacement) const {
+  void apply(Policy policy, const ConstPointsRef<Scalar>& lr_displacement, PointsRef<Scalar> hr_displacement) const {
     if (!net_) throw ArgumentError("Learned::apply before fit");
     const Index n = num_lr(), m = num_hr();
     if (lr_displacement.rows() != n) throw ShapeError("Learned::apply: LR displacement", {n, 3}, {lr_displacement.rows(), 3});

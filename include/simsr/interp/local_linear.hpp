@@ -157,7 +157,7 @@ class LocalLinear {
 
   /// Δx^H_i = Σ_j W_ij Δx^L_j for one frame (N×3 → M×3); allocates nothing.
   template <exec::HostPolicy Policy>
-  void apply(Policy policy, const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
+  void apply(Policy policy, const ConstPointsRef<S>& lr_displacement, PointsRef<S> hr_displacement) const {
     if (!trained_) throw ArgumentError("LocalLinear::apply before train");
     if (lr_displacement.rows() != n_) throw ShapeError("LocalLinear::apply: LR displacement", {n_, 3}, {lr_displacement.rows(), 3});
     if (hr_displacement.rows() != m_) throw ShapeError("LocalLinear::apply: HR displacement", {m_, 3}, {hr_displacement.rows(), 3});

@@ -123,7 +123,7 @@ class MLS {
   /// hr_displacement (M×3, caller-sized) from lr_displacement (N×3): Δx_j^H = Σ_k α_jk ΔX_k^L
   /// (Eq. 16 per component). ShapeError for wrong sizes.
   template <exec::HostPolicy Policy>
-  void apply(Policy policy, const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
+  void apply(Policy policy, const ConstPointsRef<S>& lr_displacement, PointsRef<S> hr_displacement) const {
     detail::check_apply_shapes("MLS::apply", n_, num_hr(), lr_displacement, hr_displacement);
     gather_.apply(policy, lr_displacement, hr_displacement);
   }

@@ -328,7 +328,7 @@ class RBF {
   /// hr_displacement (M×3, caller-sized) from lr_displacement (N×3), Eq. 10–11. ShapeError for
   /// wrong sizes.
   template <exec::HostPolicy Policy>
-  void apply(Policy policy, const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
+  void apply(Policy policy, const ConstPointsRef<S>& lr_displacement, PointsRef<S> hr_displacement) const {
     detail::check_apply_shapes("RBF::apply", n_, m_, lr_displacement, hr_displacement);
     const S* x = lr_displacement.data();
     S* y = hr_displacement.data();
@@ -421,7 +421,7 @@ class RBF {
   }
 
   /// W[:, c] = K⁻¹ [ΔX^L[:, c]; 0] in place in the object's buffers (no allocation).
-  void solve_component(const Points<S>& lr, int c) const {
+  void solve_component(const ConstPointsRef<S>& lr, int c) const {
     auto b = work_.col(c);
     auto x = weights_.col(c);
     const Index np = n_ + p_;

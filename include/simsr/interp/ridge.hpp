@@ -173,7 +173,7 @@ class Ridge {
   /// Δx^H = base(x) + ȳ + Yᵀ G X (x − x̄) for one frame (N×3 → M×3). Not thread-safe per object
   /// (F-sized scratch vectors are reused; nothing is allocated).
   template <exec::HostPolicy Policy>
-  void apply(Policy policy, const Points<S>& lr_displacement, Points<S>& hr_displacement) const {
+  void apply(Policy policy, const ConstPointsRef<S>& lr_displacement, PointsRef<S> hr_displacement) const {
     if (!trained_) throw ArgumentError("Ridge::apply before train");
     if (lr_displacement.rows() != n_) throw ShapeError("Ridge::apply: LR displacement", {n_, 3}, {lr_displacement.rows(), 3});
     if (hr_displacement.rows() != m_) throw ShapeError("Ridge::apply: HR displacement", {m_, 3}, {hr_displacement.rows(), 3});

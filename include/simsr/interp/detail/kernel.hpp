@@ -30,8 +30,8 @@ double mean_edge_length(const Eigen::MatrixBase<DV>& V, const Eigen::MatrixBase<
 }
 
 /// ShapeError unless lr is N×3 and hr is M×3 (`apply` never resizes the caller's buffer).
-template <class S>
-void check_apply_shapes(const std::string& who, Index n, Index m, const Points<S>& lr, const Points<S>& hr) {
+template <class LR, class HR>
+void check_apply_shapes(const std::string& who, Index n, Index m, const LR& lr, const HR& hr) {
   if (lr.rows() != n) throw ShapeError(who + ": lr_displacement", {n, 3}, {lr.rows(), lr.cols()});
   if (hr.rows() != m) throw ShapeError(who + ": hr_displacement", {m, 3}, {hr.rows(), hr.cols()});
 }
@@ -51,7 +51,7 @@ struct NeighborGather {
 
   /// hr.row(j) = Σ_n weights(j, ·n) lr.row(indices(j, n)); hr must already be M×3.
   template <exec::HostPolicy Policy>
-  void apply(Policy policy, const Points<S>& lr, Points<S>& hr) const {
+  void apply(Policy policy, const ConstPointsRef<S>& lr, PointsRef<S> hr) const {
     const Index kk = k();
     const VIndex* idx = indices.data();
     const S* w = weights.data();
