@@ -74,21 +74,24 @@ inline PointsRef<Scalar> out_points(const py::array& out, Index rows, const std:
 }
 
 /// An integer NumPy array (any integer dtype) as an #rows×Cols int32 index matrix (Tets, Tris,
-/// Edges), checked: ShapeError for another shape, ArgumentError naming the first entry outside
+/// Edges; Cols = 1: an IndexVector), checked: ShapeError for another shape, ArgumentError naming the first entry outside
 /// int32's range or a non-integer dtype (pybind11's own cast would wrap int64 silently).
 template <int Cols>
-Eigen::Matrix<VIndex, Eigen::Dynamic, Cols, Eigen::RowMajor> index_matrix(const py::handle& h, const std::string& what) {
+using IndexMatrix = Eigen::Matrix<VIndex, Eigen::Dynamic, Cols, Cols == 1 ? Eigen::ColMajor : Eigen::RowMajor>;
+
+template <int Cols>
+IndexMatrix<Cols> index_matrix(const py::handle& h, const std::string& what) {
   py::array a = py::array::ensure(h);
   if (!a) throw ArgumentError(what + ": expected an integer array");
   if (a.size() == 0 && a.ndim() <= 2)  // an empty list or array: no elements, any dtype
-    return Eigen::Matrix<VIndex, Eigen::Dynamic, Cols, Eigen::RowMajor>(0, Cols);
+    return IndexMatrix<Cols>(0, Cols);
   const char kind = a.dtype().kind();
   if (kind != 'i' && kind != 'u') throw ArgumentError(what + ": expected an integer array, got dtype " + std::string(py::str(a.dtype())));
   if (a.ndim() != 2 || a.shape(1) != Cols)
     throw ShapeError(what, {-1, Cols}, std::vector<std::int64_t>(a.shape(), a.shape() + a.ndim()));
   auto v = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
   const std::int64_t* d = v.data();
-  Eigen::Matrix<VIndex, Eigen::Dynamic, Cols, Eigen::RowMajor> out(a.shape(0), Cols);
+  IndexMatrix<Cols> out(a.shape(0), Cols);
   for (Index i = 0; i < out.size(); ++i) {
     if (d[i] < std::numeric_limits<VIndex>::min() || d[i] > std::numeric_limits<VIndex>::max())
       throw ArgumentError(what + ": entry (" + std::to_string(i / Cols) + ", " + std::to_string(i % Cols) + ") = " + std::to_string(d[i]) +
@@ -134,5 +137,6 @@ void bind_mesh(py::module_& m);
 void bind_neighbors(py::module_& m);
 void bind_interp(py::module_& m);
 void bind_network(py::module_& m);
+void bind_physics(py::module_& m);
 
 }  // namespace simsr::python

@@ -20,4 +20,5 @@ PYBIND11_MODULE(_simsr, m) {
   bind_neighbors(m);
   bind_interp(m);
   bind_network(m);
+  bind_physics(m);
 }

@@ -2,6 +2,7 @@
 /// \file
 /// The constitutive models (SPEC §3): the Material concept and every material of simsr.
 
+#include "by_name.hpp"
 #include "corotated.hpp"
 #include "fibre_curves.hpp"
 #include "isotropic.hpp"
