@@ -14,22 +14,14 @@ into the objects that keep them.
 from ._simsr import *  # noqa: F401,F403  (the compiled module's public names)
 from ._simsr import __doc__ as _compiled_doc, __version__  # noqa: F401
 
-_METHOD_CLASSES = {
-    "embedded": "Embedded",
-    "idw": "IDW",
-    "rbf": "RBF",
-    "mls": "MLS",
-    "ridge": "Ridge",
-    "local_linear": "LocalLinear",
-    "beta_vae": "BetaVae",
-}
+from ._simsr import _method_classes
 
 
 def make_method(name, **options):
-    """The interpolation baseline called ``name`` (see ``method_names()``), built with ``options``
-    (the fields of its C++ options struct), as ``simsr interp --method NAME`` builds it."""
+    """The interpolation baseline called ``name`` (one of ``method_names()``), built with ``options``
+    (the fields of its C++ options struct), as ``simsr upsample --method NAME`` builds it."""
     try:
-        cls = globals()[_METHOD_CLASSES[name]]
+        cls = _method_classes[name]
     except KeyError:
         raise ArgumentError(f"unknown method '{name}' (known: {', '.join(method_names())})") from None
     return cls(**options)

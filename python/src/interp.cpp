@@ -10,7 +10,7 @@
 ///
 /// Each Python object guards its method with a mutex: several of them reuse scratch buffers in
 /// `apply` (one call at a time per object, as in C++), and the GIL is released while they run.
-#include "common.hpp"
+#include "problem.hpp"
 
 #include <mutex>
 
@@ -19,7 +19,6 @@
 namespace simsr::python {
 namespace {
 
-using Problem = interp::UpsamplingProblem<Scalar>;
 using Frames = data::PairedFrames<Scalar>;
 
 /// A method with the mutex that serializes calls on it.
@@ -62,10 +61,12 @@ Index neighborhood_k(const I& method) {
 template <class I>
 using PyClass = py::class_<Method<I>>;
 
-/// fit / apply / train and the sizes, for any interp::Interpolator.
+/// fit / apply / train and the sizes, for any interp::Interpolator; the class is registered under
+/// its library name (`library_name`, one of interp::method_names()) in `by_name`.
 template <class I, class Options>
-PyClass<I> bind_method(py::module_& m, const char* name, const char* doc) {
+PyClass<I> bind_method(py::module_& m, py::dict& by_name, const char* library_name, const char* name, const char* doc) {
   PyClass<I> c(m, name, doc);
+  by_name[library_name] = c;  // simsr.make_method's table, keyed by interp::method_names()
   const std::string who = name;
   if constexpr (std::is_same_v<Options, void>)
     c.def(py::init([] { return Method<I>{std::make_unique<I>()}; }));
@@ -75,9 +76,7 @@ PyClass<I> bind_method(py::module_& m, const char* name, const char* doc) {
   c.def(
        "fit",
        [](Method<I>& self, Problem& problem, const std::string& policy) {
-         py::gil_scoped_release release;
-         std::lock_guard lock(*self.mutex);
-         with_policy(policy, [&](auto p) { interp::prepare(p, *self.impl, problem, neighborhood_k(*self.impl)); });
+         fit_on(problem, *self.impl, *self.mutex, neighborhood_k(*self.impl), policy);
          self.fitted = true;
        },
        "problem"_a, py::kw_only(), policy_arg(), "Fits on the problem's rest shapes (computing its neighbourhoods first when needed and absent).")
@@ -136,29 +135,41 @@ void bind_interp(py::module_& m) {
                       "The rest shapes of one LR -> HR pair (LR tet mesh, HR surface) and their neighbourhoods, computed once and shared.")
       .def(py::init([](TetMesh<Scalar> lr, TriMesh<Scalar> hr) {
              Problem p;
-             p.lr = std::move(lr);
-             p.hr = std::move(hr);
+             p.problem.lr = std::move(lr);
+             p.problem.hr = std::move(hr);
              return p;
            }),
            "lr"_a, "hr"_a, "Copies both meshes.")
-      .def_readonly("lr", &Problem::lr)
-      .def_readonly("hr", &Problem::hr)
+      .def_property_readonly("lr", [](const Problem& p) { return p.problem.lr; }, "A copy of the LR rest mesh.")
+      .def_property_readonly("hr", [](const Problem& p) { return p.problem.hr; }, "A copy of the HR rest surface.")
       .def_property(
-          "neighborhoods", [](const Problem& p) { return p.neighborhoods; },
-          [](Problem& p, std::optional<neighbors::UpsamplingNeighborhoods> nb) {
-            p.neighborhoods = std::move(nb);
-            if (p.neighborhoods) p.checked_neighborhoods(1);
+          "neighborhoods",
+          [](const Problem& p) {
+            std::lock_guard lock(*p.mutex);
+            return p.problem.neighborhoods;
           },
-          "The §3.2 neighbourhoods (None until computed or set; set ones are checked against the sizes).")
+          [](Problem& p, std::optional<neighbors::UpsamplingNeighborhoods> nb) {
+            std::lock_guard lock(*p.mutex);
+            std::swap(p.problem.neighborhoods, nb);
+            try {
+              if (p.problem.neighborhoods) p.problem.checked_neighborhoods(1);
+            } catch (...) {
+              std::swap(p.problem.neighborhoods, nb);  // refused: the problem keeps what it had
+              throw;
+            }
+          },
+          "The §3.2 neighbourhoods, a copy (None until computed or set; set ones are checked against the sizes, and refused ones leave "
+          "the problem as it was).")
       .def(
           "ensure_neighborhoods",
           [](Problem& p, Index k, const std::string& policy) {
             py::gil_scoped_release release;
-            with_policy(policy, [&](auto pol) { p.ensure_neighborhoods(pol, k); });
+            std::lock_guard lock(*p.mutex);
+            with_policy(policy, [&](auto pol) { p.problem.ensure_neighborhoods(pol, k); });
           },
           "k"_a = 20, py::kw_only(), policy_arg())
-      .def_property_readonly("num_lr", &Problem::num_lr)
-      .def_property_readonly("num_hr", &Problem::num_hr);
+      .def_property_readonly("num_lr", [](const Problem& p) { return p.problem.num_lr(); })
+      .def_property_readonly("num_hr", [](const Problem& p) { return p.problem.num_hr(); });
 
   m.def(
       "displacements",
@@ -227,18 +238,22 @@ void bind_interp(py::module_& m) {
       .def_readwrite("seed", &interp::BetaVaeTrainOptions::seed)
       .def_readwrite("progress", &interp::BetaVaeTrainOptions::progress);
 
-  bind_method<interp::Embedded<Scalar>, void>(m, "Embedded", "Barycentric interpolation in the LR tet containing (or nearest to) each HR vertex.");
-  bind_method<interp::IDW<Scalar>, interp::IDWOptions>(m, "IDW", "Inverse-distance weighting over the §3.2 neighbourhoods (A.1).");
-  bind_method<interp::RBF<Scalar>, interp::RBFOptions>(m, "RBF", "Gaussian radial basis functions (A.2, Eq. 9-11).")
+  py::dict by_name;
+  bind_method<interp::Embedded<Scalar>, void>(m, by_name, "embedded", "Embedded", "Barycentric interpolation in the LR tet containing (or nearest to) each HR vertex.");
+  bind_method<interp::IDW<Scalar>, interp::IDWOptions>(m, by_name, "idw", "IDW", "Inverse-distance weighting over the §3.2 neighbourhoods (A.1).");
+  bind_method<interp::RBF<Scalar>, interp::RBFOptions>(m, by_name, "rbf", "RBF", "Gaussian radial basis functions (A.2, Eq. 9-11).")
       .def_property_readonly("sigma", [](const Method<interp::RBF<Scalar>>& s) { return s.impl->info().sigma; });
-  bind_method<interp::MLS<Scalar>, interp::MLSOptions>(m, "MLS", "Moving least squares over the §3.2 neighbourhoods (A.3, Eq. 12-16).")
+  bind_method<interp::MLS<Scalar>, interp::MLSOptions>(m, by_name, "mls", "MLS", "Moving least squares over the §3.2 neighbourhoods (A.3, Eq. 12-16).")
       .def_property_readonly("sigma", [](const Method<interp::MLS<Scalar>>& s) { return s.impl->info().sigma; });
-  bind_method<interp::Ridge<Scalar>, interp::RidgeOptions>(m, "Ridge", "Kernel ridge regression over the frames, on Embedded's residual by default.")
+  bind_method<interp::Ridge<Scalar>, interp::RidgeOptions>(m, by_name, "ridge", "Ridge", "Kernel ridge regression over the frames, on Embedded's residual by default.")
       .def_property_readonly("lambda_relative", [](const Method<interp::Ridge<Scalar>>& s) { return s.impl->info().lambda_relative; });
   bind_method<interp::LocalLinear<Scalar>, interp::LocalLinearOptions>(
-      m, "LocalLinear", "Per HR vertex a 3 x 3k linear map of its §3.2 neighbours' displacements, ridge-regularized by cross-validation.")
+      m, by_name, "local_linear", "LocalLinear", "Per HR vertex a 3 x 3k linear map of its §3.2 neighbours' displacements, ridge-regularized by cross-validation.")
       .def_property_readonly("lambda_relative", [](const Method<interp::LocalLinear<Scalar>>& s) { return s.impl->info().lambda_relative; });
-  bind_method<interp::BetaVaeBaseline<Scalar>, void>(m, "BetaVae", "The A.4 beta-VAE from LR to HR displacements (float32 network).");
+  bind_method<interp::BetaVaeBaseline<Scalar>, void>(m, by_name, "beta_vae", "BetaVae", "The A.4 beta-VAE from LR to HR displacements (float32 network).");
+  for (const auto& name : interp::method_names())  // a baseline added in C++ and not here fails at import, not at make_method
+    if (!by_name.contains(name)) throw std::logic_error("simsr module: interp method '" + name + "' has no Python class");
+  m.attr("_method_classes") = by_name;
 }
 
 }  // namespace simsr::python

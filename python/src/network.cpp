@@ -3,12 +3,11 @@
 /// as a Python object: a config by preset name and/or a dict of NetworkConfig's JSON fields, fit on
 /// an UpsamplingProblem, train with progress (a per-epoch callback, Ctrl-C honoured between
 /// epochs), resumable checkpoints, apply (inference), save and load of one model file.
-#include "common.hpp"
+#include "problem.hpp"
 
 #include <mutex>
 #include <nlohmann/json.hpp>
 
-#include <simsr/interp/fit_and_train.hpp>
 #include <simsr/interp/learned.hpp>
 
 namespace simsr::python {
@@ -29,25 +28,9 @@ nlohmann::json json_of(const py::handle& o) {
 
 py::object python_of(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
-/// A preset ("official", "paper") overlaid with `fields` (NetworkConfig's JSON keys); an unknown
-/// key is an ArgumentError naming it (the C++ reader ignores unknown keys of other tools' files).
-nn::NetworkConfig config_of(const std::string& preset, const py::dict& fields) {
-  nlohmann::json j = nn::NetworkConfig::preset(preset).to_json();
-  const nlohmann::json user = json_of(fields);
-  for (const auto& [key, value] : user.items()) {
-    if (!j.contains(key)) throw ArgumentError("Network: unknown config field '" + key + "' (see Network.config of a default Network)");
-    j[key] = value;
-  }
-  j["profile"] = preset;
-  nn::NetworkConfig c = nn::NetworkConfig::from_json(j);
-  c.validate();
-  const nlohmann::json read = c.to_json();  // nothing given may be dropped: config.py's shorthands (decoder_dim, ...) would be
-  for (const auto& [key, value] : user.items())
-    if (read.at(key) != value && !(value.is_number() && read.at(key).is_number() && read.at(key).get<double>() == value.get<double>()))
-      throw ArgumentError("Network: config field '" + key + "' = " + value.dump() + " does not hold (the config reads " + read.at(key).dump() +
-                          "): set the field it abbreviates (decoder_dims, up_hidden) or the preset instead");
-  return c;
-}
+/// A preset ("official", "paper") with NetworkConfig fields given as keywords (strict: an unknown
+/// field, or one that would not hold, is an ArgumentError naming it).
+nn::NetworkConfig config_of(const std::string& preset, const py::dict& fields) { return nn::NetworkConfig::with_fields(preset, json_of(fields)); }
 
 py::dict epoch_dict(const nn::EpochReport& r) {
   py::dict d;
@@ -87,10 +70,8 @@ void bind_network(py::module_& m) {
       .def_property_readonly("config", [](const Network& n) { return python_of(n.impl->config().to_json()); }, "The config as a dict (JSON).")
       .def(
           "fit",
-          [](Network& n, interp::UpsamplingProblem<Scalar>& problem, const std::string& policy) {
-            py::gil_scoped_release release;
-            std::lock_guard lock(*n.mutex);
-            with_policy(policy, [&](auto p) { interp::prepare(p, *n.impl, problem, Learned::neighborhoods_needed(n.impl->config())); });
+          [](Network& n, Problem& problem, const std::string& policy) {
+            fit_on(problem, *n.impl, *n.mutex, Learned::neighborhoods_needed(n.impl->config()), policy);
             n.fitted = true;
           },
           "problem"_a, py::kw_only(), policy_arg(),

@@ -3,6 +3,8 @@
 #include <simsr/core/error.hpp>
 #include <simsr/physics/materials/by_name.hpp>
 
+#include "../support/error_of.hpp"
+
 #include <string>
 
 using namespace simsr::physics;
@@ -44,13 +46,8 @@ TEST_CASE("with_material: each name builds its material from the named parameter
 }
 
 TEST_CASE("with_material: unknown names and refused parameters are ArgumentErrors naming them") {
-  auto message = [](const std::string& name, const MaterialParameters& p) -> std::string {
-    try {
-      with_material(name, p, [](const auto&) {});
-    } catch (const simsr::ArgumentError& e) {
-      return e.what();
-    }
-    return "";
+  auto message = [](const std::string& name, const MaterialParameters& p) {
+    return simsr::test::typed_error_of<simsr::ArgumentError>([&] { with_material(name, p, [](const auto&) {}); });
   };
   CHECK(message("stvk", {}) == "unknown material 'stvk' (known: neo_hookean, corotated, mooney_rivlin)");
   CHECK(message("teran_muscle", {}).find("per-tet fibres") != std::string::npos);

@@ -3,6 +3,7 @@ library called from C++) on bunny frames, IDW against its formula, Embedded agai
 field it must reproduce, RBF against SciPy's RBFInterpolator; apply reads C-contiguous float64 in
 place and writes out= in place (measured with tracemalloc); 1,000 warm calls grow no memory."""
 import gc
+import threading
 import tracemalloc
 
 import numpy as np
@@ -189,3 +190,38 @@ def test_warm_apply_does_not_grow_memory(bunny, bunny_problem, bunny_frames, rng
     out = np.empty((bunny["hr"].num_vertices, 3))
     # the process: less than one result's size (60 kB)
     assert_no_memory_growth(lambda: (m.apply(x, out=out), m.apply(x)), rss_limit=60_000)
+
+
+def test_fits_on_one_problem_from_threads(bunny, rng):
+    """Fits compute the problem's neighbourhoods with the GIL released: on one problem they take turns
+    (the problem's lock), and every method fits as it does alone."""
+    problem = simsr.UpsamplingProblem(bunny["lr"], bunny["hr"])
+    methods = [simsr.IDW(), simsr.MLS(), simsr.IDW(power=3.0), simsr.Embedded()]
+    errors = []
+
+    def fit(m):
+        try:
+            m.fit(problem)
+        except Exception as e:  # noqa: BLE001 (reported below)
+            errors.append(e)
+
+    threads = [threading.Thread(target=fit, args=(m,)) for m in methods]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    x = rng.normal(scale=0.01, size=(bunny["lr"].num_vertices, 3))
+    alone = simsr.UpsamplingProblem(bunny["lr"], bunny["hr"])
+    for m, fresh in zip(methods, [simsr.IDW(), simsr.MLS(), simsr.IDW(power=3.0), simsr.Embedded()]):
+        fresh.fit(alone)
+        np.testing.assert_array_equal(m.apply(x), fresh.apply(x))
+
+
+def test_refused_neighborhoods_leave_the_problem_as_it_was(bunny, bunny_problem):
+    other = simsr.UpsamplingProblem(simsr.box_tet_mesh(1, 1, 1), simsr.icosphere(1))
+    other.ensure_neighborhoods(4)
+    before = other.neighborhoods.indices.copy()
+    with pytest.raises(simsr.ShapeError):
+        other.neighborhoods = bunny_problem.neighborhoods  # the bunny's: another HR size
+    np.testing.assert_array_equal(other.neighborhoods.indices, before)

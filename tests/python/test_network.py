@@ -109,7 +109,7 @@ def test_callback_errors_stop_training(pair):
 
 
 def test_config_and_errors(pair):
-    with pytest.raises(simsr.ArgumentError, match="unknown config field 'kmn'"):
+    with pytest.raises(simsr.ArgumentError, match="unknown field 'kmn'"):
         simsr.Network(kmn=3)
     with pytest.raises(simsr.ArgumentError, match="unknown profile 'fast'"):
         simsr.Network(preset="fast")

@@ -14,10 +14,11 @@
 /// Two phases: `fit(policy, problem)` once on the rest shapes (and, where
 /// `needs_neighborhoods_v<I>`, the §3.2 neighbourhoods of the problem), then
 /// `apply(policy, lr_displacement, hr_displacement)` per frame into a caller-sized M×3 buffer
-/// without allocating (the library's methods take both as ConstPointsRef / PointsRef, so a Points,
-/// a row block of one or a NumPy array is read and written in place). Methods that learn from paired frames add `train(policy, frames, options)`
-/// with `frames` the training frames as displacements from the fitted rest shapes
-/// (data::displacements) and `options` of their `train_options` type.
+/// without allocating (the library's methods take both as ConstPointsRef / PointsRef, so a
+/// Points, a row block of one or a NumPy array is read and written in place). Methods that learn
+/// from paired frames add `train(policy, frames, options)` with `frames` the training frames as
+/// displacements from the fitted rest shapes (data::displacements) and `options` of their
+/// `train_options` type.
 
 #include <concepts>
 

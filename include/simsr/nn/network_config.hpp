@@ -317,6 +317,29 @@ struct NetworkConfig {
     return c;
   }
 
+  /// The preset `preset` with the fields given in `fields` (keys of to_json), strictly: where
+  /// from_json (a reader of other tools' files) ignores an unknown key and lets `decoder_dims` or
+  /// `up_hidden` override config.py's shorthands, this refuses both — an unknown key, or a field
+  /// that does not read back as given — with an ArgumentError naming it. For configs a user writes
+  /// field by field (the Python module's `simsr.Network(knn=3, ...)`).
+  static NetworkConfig with_fields(const std::string& preset_name, const nlohmann::json& fields) {
+    if (!fields.is_object()) throw ArgumentError("nn::NetworkConfig: the fields are not a JSON object");
+    nlohmann::json j = preset(preset_name).to_json();
+    for (const auto& [key, value] : fields.items()) {
+      if (key == "profile") throw ArgumentError("nn::NetworkConfig: 'profile' is the preset, not a field");
+      if (!j.contains(key)) throw ArgumentError("nn::NetworkConfig: unknown field '" + key + "'");
+      j[key] = value;
+    }
+    j["profile"] = preset_name;
+    NetworkConfig c = from_json(j);
+    const nlohmann::json read = c.to_json();
+    for (const auto& [key, value] : fields.items())
+      if (read.at(key) != value)
+        throw ArgumentError("nn::NetworkConfig: field '" + key + "' = " + value.dump() + " does not hold (the config reads " + read.at(key).dump() +
+                            "): set the field it abbreviates (decoder_dims, up_hidden) instead");
+    return c;
+  }
+
  private:
   static constexpr std::pair<UpsamplingKind, const char*> upsampling_names[] = {{UpsamplingKind::mlp, "mlp"}, {UpsamplingKind::table, "table"}};
   static constexpr std::pair<LatentRegularizer, const char*> zreg_names[] = {
