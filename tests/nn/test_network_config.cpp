@@ -13,7 +13,10 @@ TEST_CASE("nn::NetworkConfig::with_fields: the preset with each field given, eve
   for (const std::string preset : {"official", "paper"}) {
     const nn::NetworkConfig c = nn::NetworkConfig::with_fields(preset, fields);
     const json got = c.to_json(), base = nn::NetworkConfig::preset(preset).to_json();
-    for (const auto& [key, value] : got.items()) {
+    for (const auto& item : got.items()) {
+      // named copies, not a structured binding: clang 14 cannot capture a binding in doctest's lambdas
+      const std::string key = item.key();
+      const json& value = item.value();
       if (fields.contains(key))
         CHECK_MESSAGE(value == fields.at(key), key);
       else if (key != "decoder_dim")  // config.py's shorthand, derived from decoder_dims
