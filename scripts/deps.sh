@@ -14,7 +14,8 @@
 #                          0.65 s, with OpenBLAS 0.21 s) and
 #                          libcgal-dev (CGAL, the optional isotropic_remesh and remeshed SoftDECA template);
 #                          pybind11-dev and python3-dev (the optional Python module, -DSIMSR_WITH_PYTHON=ON) and
-#                          python3-pytest (its suite)
+#                          python3-pytest (its suite); python3-matplotlib for the module's face example
+#                          (examples/python/face_frame.py), which the test run runs
 # Needs root (or sudo) only when something is missing.
 set -euo pipefail
 job=${1:-test}
@@ -28,7 +29,7 @@ pkgs=(build-essential cmake ninja-build
 command -v npm >/dev/null || pkgs+=(npm)
 if [[ $job == test ]]; then
   pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium libsuitesparse-dev libopenblas0-pthread libcgal-dev
-         pybind11-dev python3-dev python3-pytest)
+         pybind11-dev python3-dev python3-pytest python3-matplotlib)
 fi
 
 missing=()

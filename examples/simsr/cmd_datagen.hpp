@@ -83,10 +83,7 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   o.simulation.max_iterations = a.max_iterations;
   o.simulation.newton_iterations = a.newton_iterations;
   o.skip_unconverged = !a.stop_on_unconverged;
-  if (a.solver == "newton")
-    o.simulation.solver = scenario::SoftDecaSolver::newton;
-  else if (a.solver != "local_global")
-    throw ArgumentError("--solver: local_global or newton (got '" + a.solver + "')");
+  o.simulation.solver = scenario::parse_softdeca_solver(a.solver);
   const auto say = [](const std::string& line) { std::fprintf(stderr, "softdeca: %s\n", line.c_str()); };
   nlohmann::ordered_json j;
   if (a.softdeca_template == "ict") {

@@ -138,5 +138,6 @@ void bind_neighbors(py::module_& m);
 void bind_interp(py::module_& m);
 void bind_network(py::module_& m);
 void bind_physics(py::module_& m);
+void bind_scenario(py::module_& m);
 
 }  // namespace simsr::python

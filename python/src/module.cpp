@@ -21,4 +21,5 @@ PYBIND11_MODULE(_simsr, m) {
   bind_interp(m);
   bind_network(m);
   bind_physics(m);
+  bind_scenario(m);
 }

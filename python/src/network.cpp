@@ -94,10 +94,13 @@ void bind_network(py::module_& m) {
             o.holdout = holdout ? &*holdout : nullptr;
             if (checkpoint) o.checkpoint = *checkpoint;
             if (resume) o.resume = *resume;
-            o.trainer.on_epoch = [on_epoch](const nn::EpochReport& r) {
+            // by pointer: the trainer may copy its options without the GIL (a py::object's copy
+            // would change its reference count unlocked)
+            const py::object* callback = &on_epoch;
+            o.trainer.on_epoch = [callback](const nn::EpochReport& r) {
               py::gil_scoped_acquire gil;
               if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C between epochs
-              if (!on_epoch.is_none()) on_epoch(epoch_dict(r));
+              if (!callback->is_none()) (*callback)(epoch_dict(r));
             };
             py::gil_scoped_release release;
             std::lock_guard lock(*n.mutex);

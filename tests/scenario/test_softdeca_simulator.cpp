@@ -9,6 +9,7 @@
 
 #include <doctest/doctest.h>
 
+#include "../support/error_of.hpp"
 #include "face_fixture.hpp"  // SIMSR_TEST_SANITIZED
 
 namespace scenario_test_softdeca_simulator {
@@ -22,6 +23,13 @@ SoftDecaTemplate ball_template() { return sphere_softdeca_template(exec::seq, 2,
 SoftDecaParameters calm() {
   SoftDecaParameters p;  // every weight 1, v = 1, ε = 1, 1 g down, skull as is, quasistatic
   return p;
+}
+
+TEST_CASE("parse_softdeca_solver: the two solvers by name; another name refused naming it") {
+  CHECK(parse_softdeca_solver("local_global") == SoftDecaSolver::local_global);
+  CHECK(parse_softdeca_solver("newton") == SoftDecaSolver::newton);
+  for (const std::string bad : {"", "Newton", "lbfgs", "local-global"})
+    CHECK(test::typed_error_of<ArgumentError>([&] { parse_softdeca_solver(bad); }) == "softdeca solver: local_global or newton (got '" + bad + "')");
 }
 
 TEST_CASE("SoftDecaSimulator: local-global and Newton agree on sampled parameters (both to 1e-9 of the forces)") {

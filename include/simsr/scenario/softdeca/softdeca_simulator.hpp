@@ -53,6 +53,14 @@ namespace simsr::scenario {
 /// Which solver a SoftDECA simulation uses.
 enum class SoftDecaSolver { local_global, newton };
 
+/// The solver a name gives ("local_global" or "newton": `simsr datagen --solver`, Python's
+/// `solver=`); ArgumentError naming the name otherwise.
+inline SoftDecaSolver parse_softdeca_solver(const std::string& name) {
+  if (name == "local_global") return SoftDecaSolver::local_global;
+  if (name == "newton") return SoftDecaSolver::newton;
+  throw ArgumentError("softdeca solver: local_global or newton (got '" + name + "')");
+}
+
 /// How one sample is simulated.
 struct SoftDecaSimulationOptions {
   SoftDecaSolver solver = SoftDecaSolver::local_global;
