@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages simsr needs for a given job, only those missing.
+#   scripts/deps.sh python the Python module alone (scripts/install_python.sh): the library's packages,
+#                          a compiler, cmake and ninja, pybind11-dev, python3-dev and NumPy
 #   scripts/deps.sh run    build + run the main job (tetgen for the face's HR mesh; python3-vtk9 with
 #                          xvfb for the renders of scripts/render_comparison.py; npm, with which the
 #                          build vendors three.js for the report page)
@@ -20,13 +22,18 @@
 set -euo pipefail
 job=${1:-test}
 
-pkgs=(build-essential cmake ninja-build
-      libeigen3-dev libxtensor-dev libnanoflann-dev libzip-dev
-      doctest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
-      python3 python3-numpy tetgen python3-vtk9 xvfb xauth)
-# npm: Debian's package where no npm command exists yet. A nodejs from another repository ships
-# its own npm and conflicts with Debian's (apt then refuses: "nodejs : Conflicts: npm").
-command -v npm >/dev/null || pkgs+=(npm)
+if [[ $job == python ]]; then
+  pkgs=(build-essential cmake ninja-build libeigen3-dev libxtensor-dev libnanoflann-dev libzip-dev nlohmann-json3-dev
+        python3 python3-numpy pybind11-dev python3-dev)
+else
+  pkgs=(build-essential cmake ninja-build
+        libeigen3-dev libxtensor-dev libnanoflann-dev libzip-dev
+        doctest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+        python3 python3-numpy tetgen python3-vtk9 xvfb xauth)
+  # npm: Debian's package where no npm command exists yet. A nodejs from another repository ships
+  # its own npm and conflicts with Debian's (apt then refuses: "nodejs : Conflicts: npm").
+  command -v npm >/dev/null || pkgs+=(npm)
+fi
 if [[ $job == test ]]; then
   pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium libsuitesparse-dev libopenblas0-pthread libcgal-dev
          pybind11-dev python3-dev python3-pytest python3-matplotlib)
