@@ -17,7 +17,9 @@
 #                          libcgal-dev (CGAL, the optional isotropic_remesh and remeshed SoftDECA template);
 #                          pybind11-dev and python3-dev (the optional Python module, -DSIMSR_WITH_PYTHON=ON) and
 #                          python3-pytest (its suite); python3-matplotlib for the module's face example
-#                          (examples/python/face_frame.py), which the test run runs
+#                          (examples/python/face_frame.py), which the test run runs; libopenmpi-dev and
+#                          openmpi-bin (mpirun) for the optional simsr::mpi, -DSIMSR_WITH_MPI=ON, whose
+#                          suite runs on 2 ranks
 # Needs root (or sudo) only when something is missing.
 set -euo pipefail
 job=${1:-test}
@@ -36,7 +38,7 @@ else
 fi
 if [[ $job == test ]]; then
   pkgs+=(python3-meshio python3-scipy python3-torch gmsh clang libclang-rt-dev libomp-dev llvm chromium libsuitesparse-dev libopenblas0-pthread libcgal-dev
-         pybind11-dev python3-dev python3-pytest python3-matplotlib)
+         pybind11-dev python3-dev python3-pytest python3-matplotlib libopenmpi-dev openmpi-bin)
 fi
 
 missing=()

@@ -16,16 +16,22 @@
 // (scenario/softdeca/softdeca_datagen.hpp), resumable, a progress line per sample. --skin-edge
 // remeshes the kit's outer wrap to that edge length first (needs a build with CGAL);
 // --linear-solver cholmod factors with CHOLMOD (needs a build with it).
+// Under `mpirun -np R` (a build with -DSIMSR_WITH_MPI=ON) the samples are shared over the ranks,
+// a contiguous block each (mpi/softdeca_datagen.hpp): the single process's files, bitwise.
 #include <simsr/scenario/scenario.hpp>
 #include <simsr/shell/cloth_datagen.hpp>
 #include <simsr/scenario/softdeca/softdeca_datagen.hpp>
 #include <simsr/scenario/softdeca/sphere_template.hpp>
+#if defined(SIMSR_HAVE_MPI)
+#include <simsr/mpi/softdeca_datagen.hpp>
+#endif
 #if defined(SIMSR_HAVE_CGAL)
 #include "remeshed_wrap.hpp"
 #endif
 #include "cloth_fine_options.hpp"
 #include "cloth_stepping_options.hpp"
 #include "linear_solver_choice.hpp"
+#include "mpi_session.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -70,6 +76,10 @@ template <class Template>
 nlohmann::ordered_json softdeca_dataset_with(const DatagenArgs& a, const Template& tpl, const std::string& name, const scenario::SoftDecaDatagenOptions& o,
                                              const std::function<void(const std::string&)>& say) {
   return with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) {
+#if defined(SIMSR_HAVE_MPI)
+    if (const MpiSession* session = mpi_session(); session != nullptr && session->size() > 1)  // shard r of R per rank
+      return mpi::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<L>>(*session->world(), exec::omp, tpl, name, o, a.out, say);
+#endif
     return scenario::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<L>>(exec::omp, tpl, name, o, a.out, say);
   });
 }
@@ -84,7 +94,8 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   o.simulation.newton_iterations = a.newton_iterations;
   o.skip_unconverged = !a.stop_on_unconverged;
   o.simulation.solver = scenario::parse_softdeca_solver(a.solver);
-  const auto say = [](const std::string& line) { std::fprintf(stderr, "softdeca: %s\n", line.c_str()); };
+  const std::string who = "softdeca" + rank_suffix();  // "softdeca (rank 1 of 2)" under mpirun
+  const auto say = [who](const std::string& line) { std::fprintf(stderr, "%s: %s\n", who.c_str(), line.c_str()); };
   nlohmann::ordered_json j;
   if (a.softdeca_template == "ict") {
     scenario::SoftDecaTemplateOptions t;
@@ -117,7 +128,7 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   }
   nlohmann::ordered_json brief = j;
   brief.erase("per_sample");
-  std::cout << brief.dump() << '\n';
+  if (prints_results()) std::cout << brief.dump() << '\n';  // rank 0's: every rank holds the same summary
   return 0;
 }
 
@@ -160,6 +171,8 @@ inline int datagen_cloth(const DatagenArgs& a) {
 
 inline int datagen(const DatagenArgs& a) {
   if (a.scenario == "softdeca") return datagen_softdeca(a);
+  if (mpi_session() != nullptr && mpi_session()->size() > 1)
+    throw ArgumentError("datagen --scenario " + a.scenario + " runs on one process; under mpirun only --scenario softdeca shares its work (by sample)");
   if (a.scenario == "sheet" || a.scenario == "disk") return datagen_cloth(a);
   if (a.scenario != "face") throw ArgumentError("--scenario: face, softdeca, sheet or disk (got '" + a.scenario + "')");
   scenario::FaceDatasetOptions o;

@@ -26,6 +26,7 @@
 #include "cmd_upsample.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
+#include "mpi_session.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -38,6 +39,8 @@ int main(int argc, char** argv) {
   // terminal or under `stdbuf -oL`), a failed write shows at the flush below with its errno; line
   // buffered, it failed at a newline and its errno was gone by then ("write failed", no reason).
   std::setvbuf(stdout, nullptr, _IOFBF, std::size_t(1) << 16);
+  const simsr::cli::MpiSession mpi(argc, argv);  // MPI under mpirun (a build with SIMSR_WITH_MPI), else nothing
+  simsr::cli::mpi_session() = &mpi;
   CLI::App app{"simsr: physics-based simulation super-resolution tools"};
   app.require_subcommand(1);
   std::function<int()> action;
@@ -61,7 +64,20 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : simsr::cli::exit_usage;
   }
-  const int code = simsr::cli::run_guarded(action);
+  if (mpi.size() > 1) {
+    const std::string name = app.get_subcommands().front()->get_name();
+    if (name != "datagen") {  // datagen checks its scenario itself
+      std::fprintf(stderr, "%s: invalid argument: simsr %s runs on one process; under mpirun -np %d only datagen --scenario softdeca shares its work\n",
+                   simsr::cli::program_name().c_str(), name.c_str(), mpi.size());
+      return simsr::cli::exit_argument;  // every rank refuses alike: no rank waits for another
+    }
+  }
+  const int code = simsr::cli::run_guarded(action, simsr::cli::program_name().c_str());
+  if (code != 0 && mpi.size() > 1) {
+    std::fflush(stdout);
+    std::fflush(stderr);
+    mpi.abort(code);  // the other ranks may wait for this one in a collective
+  }
   // The JSON goes to stdout: a failed write there (a full disk, /dev/full) is an error too.
   errno = 0;
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) {

@@ -4,7 +4,7 @@
 /// (core → mesh/io → discretize → physics → neighbors → data → scenario | nn → interp | shell → eval →
 /// pipeline).
 /// Include single areas (simsr/mesh/mesh.hpp, simsr/interp/interp.hpp, ...) to keep compile
-/// times short.
+/// times short. simsr/mpi/mpi.hpp is not among them: it needs MPI (the optional simsr::mpi).
 
 #include "core/core.hpp"
 #include "data/data.hpp"

@@ -9,3 +9,4 @@
 #include "parallel.hpp"
 #include "serial_gemm.hpp"
 #include "types.hpp"
+#include "work_shard.hpp"

@@ -44,6 +44,7 @@
 #include "../../core/error.hpp"
 #include "../../core/fingerprint.hpp"
 #include "../../core/parallel.hpp"
+#include "../../core/work_shard.hpp"
 #include "../../io/atomic_file.hpp"
 #include "../../io/detail/text_reader.hpp"
 #include "../../io/mesh_io.hpp"
@@ -70,6 +71,13 @@ struct SoftDecaDatagenOptions {
   /// it, and softdeca_samples.npz's `sample_index` names the samples it holds. False: such a
   /// sample stops the run with the error.
   bool skip_unconverged = true;
+  /// The samples this process simulates: shard `index` of `count`, a contiguous block
+  /// (WorkShard::range). With more than one shard the call simulates (or finds) its block's
+  /// per-sample files only and returns its part of the report; the data set's files
+  /// (softdeca_samples.npz, softdeca_data.json) are written by a call for the whole run once every
+  /// shard is done, which then finds every sample's file (simsr::mpi::generate_softdeca_dataset
+  /// does both). Not part of the fingerprint: the samples are the same for any split.
+  WorkShard shard;
 };
 
 /// Expression weights of sample `index` (see the file comment): E weights, `active` of them in (0, 1].
@@ -133,6 +141,8 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   if (active < 0 || active > E)
     throw ArgumentError("softdeca datagen: active expressions must be in [0, " + std::to_string(E) + "] (the template's), got " +
                         std::to_string(active));
+  o.shard.check("softdeca datagen");
+  const auto [first, last] = o.shard.range(o.samples);
   const auto t0 = std::chrono::steady_clock::now();
   const auto tell = [&](const std::string& s) {
     if (say) say(s);
@@ -143,8 +153,8 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
   const nlohmann::ordered_json sizes = softdeca_template_sizes(tpl);
   tell("template " + name + ": " + sizes.dump());
 
-  // the template's files
-  {
+  // the template's files (one shard writes them: the same bytes from every process)
+  if (o.shard.index == 0) {
     std::vector<VIndex> local(std::size_t(h.mesh.num_vertices()), -1);
     io::MeshData<double> skin;
     skin.V.resize(M, 3);
@@ -193,6 +203,7 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
     const VecX<> w = sample_expression_weights(o.seed, std::uint64_t(i), E, active);
     params.row(i) = p.to_vector().transpose();
     expressions.row(i) = w.transpose();
+    if (i < first || i >= last) continue;  // another shard's
     if (fs::exists(file)) {
       const io::NpzArrays z = io::read_npz(file);
       if (!z.contains("fingerprint") || z.at("fingerprint").to_strings() != std::vector<std::string>{print})
@@ -262,10 +273,22 @@ nlohmann::ordered_json generate_softdeca_dataset(P policy, const SoftDecaTemplat
     std::snprintf(line, sizeof line, "sample %lld/%lld: %lld iterations%s, %.1f s (%.1f s/sample, ETA %.0f s)", static_cast<long long>(i + 1),
                   static_cast<long long>(o.samples), static_cast<long long>(r.total_iterations()),
                   r.newton_fallbacks > 0 ? (" (" + std::to_string(r.newton_fallbacks) + " solve(s) finished by Newton)").c_str() : "", r.seconds, mean,
-                  mean * double(o.samples - i - 1));
+                  mean * double(last - i - 1));  // this shard's samples left
     tell(line);
   }
 
+  if (!o.shard.whole()) {  // this shard's part: the data set's files are the whole run's call's
+    nlohmann::ordered_json part;
+    part["scenario"] = "softdeca";
+    part["shard"] = {{"index", o.shard.index}, {"count", o.shard.count}, {"first_sample", first}, {"last_sample", last}};
+    part["simulated"] = simulated;
+    part["resumed"] = resumed;
+    part["failed_samples"] = failed;
+    part["seconds_simulating"] = sim_seconds;
+    part["fingerprint"] = print;
+    part["per_sample"] = per_sample;
+    return part;
+  }
   if (kept.empty()) throw Error("softdeca datagen: no sample converged (" + std::to_string(failed.size()) + " left out: DIR/samples/*.failed.json)");
   const Index K = Index(kept.size());
   Eigen::MatrixXd kept_params(K, SoftDecaParameters::size), kept_expressions(K, E);

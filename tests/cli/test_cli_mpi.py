@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""`mpirun -np 2 simsr datagen --scenario softdeca` (issue #16, a build with -DSIMSR_WITH_MPI=ON):
+the 2-rank run writes the single process's files (every array equal, the wall-clock seconds
+aside) and prints its summary once; a rank killed mid-run (SIGKILL) ends the run with every
+finished sample file whole, and the same command resumes it to the single process's files;
+commands that do not share their work are refused under 2 ranks.
+
+    /usr/bin/python3 tests/cli/test_cli_mpi.py SIMSR_EXE MPIEXEC WORK_DIR
+
+Exit 0: all checks passed; 1: a check failed; 77: numpy is missing (1 with SIMSR_REQUIRE_PEERS=1)."""
+import glob
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+from checks import check, finish, missing_peer, tool
+
+try:
+    import numpy as np
+except ImportError as e:
+    missing_peer(e)
+
+SIMSR, MPIEXEC, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
+shutil.rmtree(WORK, ignore_errors=True)
+os.makedirs(WORK)
+ENV = {**os.environ, "OMP_NUM_THREADS": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
+MPIRUN = [MPIEXEC, "-np", "2", "--oversubscribe", "--allow-run-as-root"]
+simsr = tool(SIMSR)
+
+
+def mpirun(*args):
+    return subprocess.run([*MPIRUN, SIMSR, *args], capture_output=True, text=True, env=ENV)
+
+
+def arrays(path):
+    with np.load(path, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
+def same_files(a, b, what):
+    """Every .npz of folder a equals b's, array for array (`seconds`, wall-clock, aside)."""
+    names = sorted(os.path.relpath(f, a) for f in glob.glob(os.path.join(a, "**", "*.npz"), recursive=True))
+    check(names and names == sorted(os.path.relpath(f, b) for f in glob.glob(os.path.join(b, "**", "*.npz"), recursive=True)),
+          f"{what}: the same .npz files ({len(names)})")
+    for n in names:
+        x, y = arrays(os.path.join(a, n)), arrays(os.path.join(b, n))
+        check(x.keys() == y.keys(), f"{what}: {n}: the same arrays")
+        for k in x:
+            if k != "seconds" and k in y:
+                check(x[k].dtype == y[k].dtype and np.array_equal(x[k], y[k]), f"{what}: {n}: {k} equal")
+
+
+# 1. two ranks against one process
+small = ["datagen", "--scenario", "softdeca", "--template", "sphere", "--sphere-level", "2", "--samples", "6", "--steps", "2"]
+simsr(*small, "--out", os.path.join(WORK, "single"))
+p = mpirun(*small, "--out", os.path.join(WORK, "ranks"))
+check(p.returncode == 0, f"mpirun -np 2 simsr datagen: exit {p.returncode}; stderr: {p.stderr[-600:]}")
+lines = [l for l in p.stdout.splitlines() if l.strip()]
+check(len(lines) == 1, f"the summary printed once (rank 0), got {len(lines)} lines")
+summary = json.loads(lines[0]) if lines else {}
+check(summary.get("ranks") == 2 and summary.get("simulated") == 6 and summary.get("kept") == 6, f"summary: {summary.get('ranks')} ranks, "
+      f"{summary.get('simulated')} simulated, {summary.get('kept')} kept")
+check("softdeca (rank 1 of 2): sample 4/6" in p.stderr, "rank 1's progress lines name it (its block starts at sample 4)")
+same_files(os.path.join(WORK, "ranks"), os.path.join(WORK, "single"), "2 ranks vs 1")
+
+# 2. a rank killed mid-run: finished files whole, the rerun resumes to the same files
+big = ["datagen", "--scenario", "softdeca", "--template", "sphere", "--sphere-level", "3", "--samples", "6", "--steps", "2"]
+killed = os.path.join(WORK, "killed")
+run = subprocess.Popen([*MPIRUN, SIMSR, *big, "--out", killed], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV)
+first = os.path.join(killed, "samples", "sample_000000.npz")  # rank 0's first sample
+deadline = time.time() + 300
+while not os.path.exists(first) and run.poll() is None and time.time() < deadline:
+    time.sleep(0.05)
+ranks = subprocess.run(["pgrep", "-f", "--", f"--out {killed}"], capture_output=True, text=True).stdout.split()
+victims = [int(pid) for pid in ranks if int(pid) != run.pid]
+check(run.poll() is None and len(victims) >= 1, f"the run was still going when its first sample was written ({len(victims)} rank processes)")
+if victims:
+    os.kill(victims[-1], signal.SIGKILL)
+out, err = run.communicate(timeout=300)
+check(run.returncode != 0, f"mpirun ends non-zero when a rank is killed (exit {run.returncode})")
+done = sorted(glob.glob(os.path.join(killed, "samples", "sample_*.npz")))
+check(0 < len(done) < 6, f"the killed run left {len(done)} of 6 sample files")
+for f in done:
+    try:
+        check("skin" in arrays(f), f"{os.path.basename(f)} whole")
+    except Exception as e:  # a torn file: the atomic writes failed their promise
+        check(False, f"{os.path.basename(f)} unreadable after the kill: {e}")
+check(not os.path.exists(os.path.join(killed, "softdeca_samples.npz")), "no data set written by the killed run")
+p = mpirun(*big, "--out", killed)
+check(p.returncode == 0, f"the rerun: exit {p.returncode}; stderr: {p.stderr[-600:]}")
+resumed = json.loads(p.stdout.strip().splitlines()[-1]) if p.returncode == 0 else {}
+check(resumed.get("resumed", 0) >= len(done) and resumed.get("simulated", 0) + resumed.get("resumed", 0) == 6,
+      f"the rerun resumed {resumed.get('resumed')} and simulated {resumed.get('simulated')} samples")
+simsr(*big, "--out", os.path.join(WORK, "big_single"))
+same_files(killed, os.path.join(WORK, "big_single"), "killed and resumed vs 1 process")
+
+# 3. what does not share its work is refused under 2 ranks (every rank alike: nothing hangs)
+p = mpirun("datagen", "--scenario", "sheet", "--cells", "3", "--levels", "1", "--sequences", "1", "--out", os.path.join(WORK, "sheet"))
+check(p.returncode != 0 and "runs on one process" in p.stderr and "rank 0 of 2" in p.stderr,
+      f"datagen --scenario sheet under 2 ranks refused: exit {p.returncode}; {p.stderr[-300:]}")
+p = mpirun("info", os.path.join(WORK, "single", "template_skin.obj"))
+check(p.returncode != 0 and "simsr info runs on one process" in p.stderr, f"simsr info under 2 ranks refused: exit {p.returncode}")
+
+finish()
