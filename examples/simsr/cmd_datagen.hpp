@@ -17,12 +17,14 @@
 // remeshes the kit's outer wrap to that edge length first (needs a build with CGAL);
 // --linear-solver cholmod factors with CHOLMOD (needs a build with it).
 // Under `mpirun -np R` (a build with -DSIMSR_WITH_MPI=ON) the samples are shared over the ranks,
-// a contiguous block each (mpi/softdeca_datagen.hpp): the single process's files, bitwise.
+// a contiguous block each (mpi/softdeca_datagen.hpp), and --scenario face's performances
+// (mpi/face_datagen.hpp): the single process's files, bitwise.
 #include <simsr/scenario/scenario.hpp>
 #include <simsr/shell/cloth_datagen.hpp>
 #include <simsr/scenario/softdeca/softdeca_datagen.hpp>
 #include <simsr/scenario/softdeca/sphere_template.hpp>
 #if defined(SIMSR_HAVE_MPI)
+#include <simsr/mpi/face_datagen.hpp>
 #include <simsr/mpi/softdeca_datagen.hpp>
 #endif
 #if defined(SIMSR_HAVE_CGAL)
@@ -171,8 +173,9 @@ inline int datagen_cloth(const DatagenArgs& a) {
 
 inline int datagen(const DatagenArgs& a) {
   if (a.scenario == "softdeca") return datagen_softdeca(a);
-  if (mpi_session() != nullptr && mpi_session()->size() > 1)
-    throw ArgumentError("datagen --scenario " + a.scenario + " runs on one process; under mpirun only --scenario softdeca shares its work (by sample)");
+  const bool ranks = mpi_session() != nullptr && mpi_session()->size() > 1;
+  if (ranks && a.scenario != "face")
+    throw ArgumentError("datagen --scenario " + a.scenario + " runs on one process; under mpirun only --scenario softdeca (by sample) and face (by performance) share their work");
   if (a.scenario == "sheet" || a.scenario == "disk") return datagen_cloth(a);
   if (a.scenario != "face") throw ArgumentError("--scenario: face, softdeca, sheet or disk (got '" + a.scenario + "')");
   scenario::FaceDatasetOptions o;
@@ -188,8 +191,16 @@ inline int datagen(const DatagenArgs& a) {
   o.vtk_every = a.vtk_every;
   o.unseen_forces = a.unseen_forces;
   o.unseen_frames = a.unseen_frames;
-  const auto j = scenario::generate_face_dataset(exec::omp, o, a.out, [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); });
-  std::cout << j.dump() << '\n';
+  const std::string who = rank_suffix();
+  const auto log = [who](const std::string& line) { std::fprintf(stderr, "%s%s\n", line.c_str(), who.c_str()); };
+  nlohmann::ordered_json j;
+#if defined(SIMSR_HAVE_MPI)
+  if (ranks)  // shard r of R of the performances per rank
+    j = mpi::generate_face_dataset(*mpi_session()->world(), exec::omp, o, a.out, log);
+  else
+#endif
+    j = scenario::generate_face_dataset(exec::omp, o, a.out, log);
+  if (prints_results()) std::cout << j.dump() << '\n';
   return 0;
 }
 

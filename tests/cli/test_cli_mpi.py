@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
-"""`mpirun -np 2 simsr datagen --scenario softdeca` (issue #16, a build with -DSIMSR_WITH_MPI=ON):
+"""`mpirun -np 2 simsr datagen --scenario softdeca|face` (issue #16, a build with -DSIMSR_WITH_MPI=ON):
 the 2-rank run writes the single process's files (every array equal, the wall-clock seconds
 aside) and prints its summary once; a rank killed mid-run (SIGKILL) ends the run with every
-finished sample file whole, and the same command resumes it to the single process's files;
-commands that do not share their work are refused under 2 ranks.
+finished sample file whole, and the same command resumes it to the single process's files; the
+face's two performances on two ranks give the single process's files; commands that do not
+share their work are refused under 2 ranks.
 
-    /usr/bin/python3 tests/cli/test_cli_mpi.py SIMSR_EXE MPIEXEC WORK_DIR
+    /usr/bin/python3 tests/cli/test_cli_mpi.py SIMSR_EXE MPIEXEC WORK_DIR ICT_KIT_DIR
 
 Exit 0: all checks passed; 1: a check failed; 77: numpy is missing (1 with SIMSR_REQUIRE_PEERS=1)."""
 import glob
@@ -24,7 +25,7 @@ try:
 except ImportError as e:
     missing_peer(e)
 
-SIMSR, MPIEXEC, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
+SIMSR, MPIEXEC, WORK, KIT = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
 shutil.rmtree(WORK, ignore_errors=True)
 os.makedirs(WORK)
 ENV = {**os.environ, "OMP_NUM_THREADS": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
@@ -104,5 +105,34 @@ check(p.returncode != 0 and "runs on one process" in p.stderr and "rank 0 of 2" 
       f"datagen --scenario sheet under 2 ranks refused: exit {p.returncode}; {p.stderr[-300:]}")
 p = mpirun("info", os.path.join(WORK, "single", "template_skin.obj"))
 check(p.returncode != 0 and "simsr info runs on one process" in p.stderr, f"simsr info under 2 ranks refused: exit {p.returncode}")
+
+# 4. the face by performance: two controls files (one frame each) on the coarse model
+if not (os.path.exists(os.path.join(KIT, "full_neutral.obj")) and shutil.which("tetgen")):
+    missing_peer(f"the ICT kit ({KIT}) or the tetgen program")
+for name, weights in (("smile", [[0.6, 0.6]]), ("jaw", [[0.3]])):  # one frame each: the HR solves are the cost
+    names = ["mouthSmile_L", "mouthSmile_R"] if name == "smile" else ["jawOpen"]
+    np.savez(os.path.join(WORK, f"{name}_controls.npz"), names=np.array(names), weights=np.array(weights))
+def face_args(*performances):
+    controls = [a for name in performances for a in ("--controls", os.path.join(WORK, f"{name}_controls.npz"))]
+    return ["datagen", "--scenario", "face", "--kit", KIT, "--performances", "", *controls, "--lr-cell", "2", "--skull-lattice", "1.6",
+            "--hr-max-volume", "1", "--vtk-every", "0", "--no-unseen-forces"]
+
+
+face = face_args("smile", "jaw")
+p = mpirun(*face, "--out", os.path.join(WORK, "face_ranks"))
+check(p.returncode == 0, f"mpirun -np 2 simsr datagen --scenario face: exit {p.returncode}; stderr: {p.stderr[-600:]}")
+lines = [l for l in p.stdout.splitlines() if l.strip()]
+check(len(lines) == 1 and json.loads(lines[0]).get("ranks") == 2, "the face summary printed once, with its ranks")
+check("(rank 1 of 2)" in p.stderr and "datagen: jaw" in p.stderr, "rank 1's progress lines: the second performance")
+# the single process, for rank 1's performance alone (a performance's file depends on the model,
+# the settled neutral and its controls only), from the ranks' settled neutral (its fingerprint
+# matches: read, not solved again; each HR solve is ~20 s here)
+alone = os.path.join(WORK, "face_single")
+os.makedirs(os.path.join(alone, ".state"))
+shutil.copy(os.path.join(WORK, "face_ranks", ".state", "neutral.npz"), os.path.join(alone, ".state", "neutral.npz"))
+simsr(*face_args("jaw"), "--out", alone)
+for name in ("jaw.npz", "jaw_controls.npz", "hr_lips.npz"):
+    x, y = arrays(os.path.join(WORK, "face_ranks", name)), arrays(os.path.join(alone, name))
+    check(x.keys() == y.keys() and all(np.array_equal(x[k], y[k]) for k in x), f"face: {name} of 2 ranks = the single process's")
 
 finish()

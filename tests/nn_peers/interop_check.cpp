@@ -176,9 +176,14 @@ nn::GraphIndices as_graph(const std::vector<std::int64_t>& v, Index k) {
 }
 
 /// Everything above in precision S; `grad_tol` bounds the gradients and the post-Adam weights.
+/// `reference_io` (float32 runs): PyTorch's float64 fixture of the same weights and inputs. A
+/// float32 gradient that misses PyTorch's float32 one by more than grad_tol is then held to the
+/// float64 gradient instead, within twice PyTorch's own float32 error there (or grad_tol): a
+/// BatchNorm bias's gradient is a sum over the batch that cancels to 2 % of its terms, and
+/// PyTorch's float32 value itself was measured 5.9e-2 (relative) from its float64 one on one CI run.
 template <class S>
 int check(const std::string& model, const std::string& state, const std::string& iofile, const std::string& data_dir, double tol,
-          double grad_tol) {
+          double grad_tol, const std::string& reference_io = {}) {
   Report rep;
   rep.tol = tol;
   const io::NpzArrays marr = io::read_npz(model);
@@ -308,9 +313,25 @@ int check(const std::string& model, const std::string& state, const std::string&
   };
   double worst_grad = 0, worst_after = 0;
   std::string worst_name;
+  const std::optional<io::NpzArrays> exact = reference_io.empty() ? std::nullopt : std::optional<io::NpzArrays>(io::read_npz(reference_io));
   for (const auto& e : net.store().entries()) {
     if (e.kind != nn::TensorEntry::Kind::parameter) continue;
-    const auto [r, ok] = compare_tensor("train/grad/", e.name, net.store().gradient(e));
+    auto [r, ok] = compare_tensor("train/grad/", e.name, net.store().gradient(e));
+    if (!ok && exact) {  // held to PyTorch's float64 gradient, within PyTorch's own float32 error (see above)
+      const auto ours = net.store().gradient(e);
+      const auto torch32 = fx.at("train/grad/" + e.name).template to_vector<S>();
+      const auto torch64 = exact->at("train/grad/" + e.name).template to_vector<double>();
+      double e_ours = 0, e_torch = 0, scale = 0;
+      if (torch64.size() == ours.size() && torch32.size() == ours.size())
+        for (std::size_t i = 0; i < ours.size(); ++i) {
+          e_ours = std::max(e_ours, std::abs(double(ours[i]) - torch64[i]));
+          e_torch = std::max(e_torch, std::abs(double(torch32[i]) - torch64[i]));
+          scale = std::max(scale, std::abs(torch64[i]));
+        }
+      ok = torch64.size() == ours.size() && e_ours <= std::max(grad_tol * scale, 2 * e_torch);
+      r["vs_float64"] = {{"ours", e_ours}, {"torch_float32", e_torch}, {"scale", scale}, {"ok", ok}};
+      rep.j["train/grad_held_to_float64"].push_back(e.name);
+    }
     if (!ok) rep.fail("train/grad/" + e.name);
     rep.j["train/grad"][e.name] = r;
     if (r.value("rel", 1.0) > worst_grad) worst_grad = r.value("rel", 1.0), worst_name = e.name;
@@ -348,7 +369,7 @@ int check(const std::string& model, const std::string& state, const std::string&
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string model, state, iofile, data_dir, dtype = "float32";
+  std::string model, state, iofile, data_dir, dtype = "float32", reference_io;
   double tol = 1e-5, grad_tol = -1;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
@@ -359,17 +380,19 @@ int main(int argc, char** argv) {
     else if (k == "--tol") tol = std::stod(v);
     else if (k == "--grad-tol") grad_tol = std::stod(v);
     else if (k == "--dtype") dtype = v;
+    else if (k == "--reference-io") reference_io = v;
     else {
       std::cerr << "interop_check: unknown option " << k << "\n";
       return 2;
     }
   }
   if (model.empty() || state.empty() || iofile.empty() || data_dir.empty()) {
-    std::cerr << "usage: interop_check --model MODEL.npz --state state_dict.npz --io io.npz --data-dir BUNNY [--tol 1e-5]\n";
+    std::cerr << "usage: interop_check --model MODEL.npz --state state_dict.npz --io io.npz --data-dir BUNNY [--tol 1e-5] [--grad-tol T] "
+                 "[--dtype float32|float64] [--reference-io FLOAT64_IO.npz]\n";
     return 2;
   }
   try {
-    if (dtype == "float32") return check<float>(model, state, iofile, data_dir, tol, grad_tol < 0 ? tol : grad_tol);
+    if (dtype == "float32") return check<float>(model, state, iofile, data_dir, tol, grad_tol < 0 ? tol : grad_tol, reference_io);
     if (dtype == "float64") return check<double>(model, state, iofile, data_dir, tol, grad_tol < 0 ? tol : grad_tol);
     std::cerr << "interop_check: --dtype float32|float64\n";
     return 2;

@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// simsr::mpi's umbrella (optional: `-DSIMSR_WITH_MPI=ON`, target `simsr::mpi`): the communicator
-/// and what runs over ranks (SoftDECA's datagen by sample). Not included by simsr/simsr.hpp,
+/// and what runs over ranks (SoftDECA's datagen by sample, the face's by performance). Not included by simsr/simsr.hpp,
 /// which needs no MPI.
 
 #include "communicator.hpp"
+#include "face_datagen.hpp"
 #include "softdeca_datagen.hpp"

@@ -44,6 +44,7 @@
 #include "../../core/error.hpp"
 #include "../../core/fingerprint.hpp"
 #include "../../core/parallel.hpp"
+#include "../../core/work_shard.hpp"
 #include "../../data/contact_patches_file.hpp"
 #include "../../data/paired_frames.hpp"
 #include "../../data/run_checkpoint.hpp"
@@ -64,6 +65,11 @@ struct FaceDatagenOptions {
   /// Called after every frame: performance, frame, frames of it, the two reports, seconds of the
   /// frame (LR, HR). Progress lines and ETA live in the caller.
   std::function<void(const std::string&, Index, Index, const physics::NewtonReport&, const physics::NewtonReport&, double, double)> on_frame;
+  /// The performances this process simulates: shard `index` of `count`, a contiguous block of the
+  /// list (WorkShard::range); the others are neither simulated nor checked. Each performance
+  /// starts from the settled neutral, so a shard's files equal the whole run's bitwise
+  /// (simsr::mpi::generate_face_dataset gives each rank one). Not part of any fingerprint.
+  WorkShard shard;
 };
 
 /// Per-performance figures of a run.
@@ -211,18 +217,21 @@ inline void write_face_rest_shapes(const FaceModel& face, const std::filesystem:
   data::write_contact_patches(dir / "hr_lips.npz", face_lip_patches(face), face.surface.num_vertices());
 }
 
-/// Simulates `performances` on `face` into `dir` (see the file comment). Returns the figures of
-/// this run, also written to DIR/face_data.json.
+/// Simulates `performances` on `face` into `dir` (see the file comment), or the block of them
+/// `opt.shard` names. Returns the figures of this run, one per performance simulated or reused.
 template <class Linear = physics::ConjugateGradient<physics::Multigrid<>>, exec::HostPolicy P>
 std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face, const std::vector<Performance>& performances,
                                                  const std::filesystem::path& dir, const FaceDatagenOptions& opt = {}) {
   if (opt.checkpoint_every < 1) throw ArgumentError("generate_face_data: checkpoint_every must be ≥ 1");
+  opt.shard.check("generate_face_data");
+  const auto [first_performance, last_performance] = opt.shard.range(Index(performances.size()));
+  const std::vector<Performance> mine(performances.begin() + first_performance, performances.begin() + last_performance);
   const auto state = dir / ".state";
   // every performance checked, and another run's checkpoint refused, before anything is written
   // or solved; the checkpoints read here are the ones resumed below
   std::vector<std::string> prints;
   std::vector<std::optional<io::NpzArrays>> checkpoints;
-  for (const auto& p : performances) {
+  for (const auto& p : mine) {
     if (p.name.empty() || p.name.find_first_of("/\\. ") != std::string::npos)
       throw ArgumentError("generate_face_data: performance name '" + p.name + "' cannot be a file name");
     if (p.num_frames() < 1) throw ArgumentError("generate_face_data: performance '" + p.name + "' has no frames");
@@ -234,6 +243,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     if (io::fingerprint_of(*checkpoints.back()) != prints.back())
       throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
   }
+  if (mine.empty()) return {};  // a shard with no performance (more shards than performances)
   std::filesystem::create_directories(state);
   write_face_rest_shapes(face, dir);
   const std::string model_print = detail::face_run_fingerprint(face, opt.simulation, nullptr);
@@ -269,8 +279,8 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
   }
 
   std::vector<PerformanceStats> stats;
-  for (std::size_t pi = 0; pi < performances.size(); ++pi) {
-    const Performance& perf = performances[pi];
+  for (std::size_t pi = 0; pi < mine.size(); ++pi) {
+    const Performance& perf = mine[pi];
     const Index F = perf.num_frames(), N = face.lr.num_vertices(), M = face.surface.num_vertices();
     PerformanceStats st;
     st.name = perf.name;

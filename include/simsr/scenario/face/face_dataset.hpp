@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../../core/work_shard.hpp"
 #include "../../io/atomic_file.hpp"
 #include "face_datagen.hpp"
 #include "face_model.hpp"
@@ -49,46 +50,76 @@ inline std::vector<std::string> face_performance_names(const FaceDatasetOptions&
   return names;
 }
 
-/// Builds the model, simulates what `o` asks for into `out` and returns the summary (also written
-/// to out/face_data.json). `log` receives the progress lines (may be empty).
+/// What the three steps of a data set share: the model and the performances, built once.
+struct FaceDatasetParts {
+  FaceModel face;
+  std::vector<Performance> performances;
+  std::chrono::steady_clock::time_point started;
+};
+
+/// Step 1: reads the kit, builds the model (tetgen works in `mesh_dir`, default out/mesh) and the
+/// performances `o` asks for.
 template <exec::HostPolicy P>
-nlohmann::ordered_json generate_face_dataset(P policy, const FaceDatasetOptions& o, const std::filesystem::path& out,
-                                             const std::function<void(const std::string&)>& log = {}) {
+FaceDatasetParts prepare_face_dataset(P policy, const FaceDatasetOptions& o, const std::filesystem::path& out,
+                                      const std::function<void(const std::string&)>& log = {}, const std::filesystem::path& mesh_dir = {}) {
   using clock = std::chrono::steady_clock;
-  auto say = [&](const std::string& s) {
-    if (log) log(s);
-  };
+  FaceDatasetParts parts;
+  parts.started = clock::now();
   char buf[512];
-  const auto t0 = clock::now();
   const auto kit = read_ict_kit(o.kit);
-  say("datagen: building the face model (tetgen, lattice, muscles)...");
-  const FaceModel face = build_face_model(policy, kit, o.model, out / "mesh");
+  if (log) log("datagen: building the face model (tetgen, lattice, muscles)...");
+  parts.face = build_face_model(policy, kit, o.model, mesh_dir.empty() ? out / "mesh" : mesh_dir);
+  const FaceModel& face = parts.face;
   std::snprintf(buf, sizeof buf, "datagen: HR %lld tets, LR %lld tets (%.1fx), surface %lld vertices; built in %.1f s", (long long)face.hr.num_tets(),
                 (long long)face.lr.num_tets(), double(face.hr.num_tets()) / double(face.lr.num_tets()), (long long)face.surface.num_vertices(),
-                std::chrono::duration<double>(clock::now() - t0).count());
-  say(buf);
-  std::vector<Performance> perfs;
+                std::chrono::duration<double>(clock::now() - parts.started).count());
+  if (log) log(buf);
   PerformanceOptions po;
   po.frames = o.frames;
-  for (const auto& name : o.performances) perfs.push_back(builtin_performance(name, face.expression_names, o.seed, po));
-  for (const auto& file : o.controls) perfs.push_back(read_controls(file, performance_name_of(file)));
+  for (const auto& name : o.performances) parts.performances.push_back(builtin_performance(name, face.expression_names, o.seed, po));
+  for (const auto& file : o.controls) parts.performances.push_back(read_controls(file, performance_name_of(file)));
+  return parts;
+}
+
+/// Step 2: simulates the performances (the block `shard` names, or all) into `out`, a progress
+/// line per frame to `log` (frames/s over this call's frames, ETA over its block).
+template <exec::HostPolicy P>
+std::vector<PerformanceStats> simulate_face_dataset(P policy, const FaceDatasetParts& parts, const FaceDatasetOptions& o, const std::filesystem::path& out,
+                                                    const std::function<void(const std::string&)>& log = {}, WorkShard shard = {}) {
+  using clock = std::chrono::steady_clock;
+  const auto [first, last] = shard.range(Index(parts.performances.size()));
   Index total = 0;
-  for (const auto& p : perfs) total += p.num_frames();
+  for (Index p = first; p < last; ++p) total += parts.performances[std::size_t(p)].num_frames();
   Index done = 0;
   const auto start = clock::now();
   FaceDatagenOptions opt;
   opt.checkpoint_every = o.checkpoint_every;
+  opt.shard = shard;
   opt.on_frame = [&](const std::string& perf, Index f, Index F, const physics::NewtonReport& rl, const physics::NewtonReport& rh, double sl, double sh) {
     ++done;
+    if (!log) return;
     const double el = std::chrono::duration<double>(clock::now() - start).count();
     const double fps = double(done) / el;
     const double eta = double(total - done) / fps;  // an upper bound: resumed frames are not simulated
+    char buf[512];
     std::snprintf(buf, sizeof buf, "datagen: %-10s frame %4lld/%lld | %.2f frames/s | LR %lld it %.2f s | HR %lld it %.2f s | ETA %d:%02d", perf.c_str(),
                   (long long)f + 1, (long long)F, fps, (long long)rl.iterations, sl, (long long)rh.iterations, sh, int(eta) / 60, int(eta) % 60);
-    say(buf);
+    log(buf);
   };
-  const auto stats = generate_face_data(policy, face, perfs, out, opt);
+  return generate_face_data(policy, parts.face, parts.performances, out, opt);
+}
+
+/// Step 3: the VTU series, the unseen-force frames and the summary (out/face_data.json, returned)
+/// from the stats of every performance.
+template <exec::HostPolicy P>
+nlohmann::ordered_json finish_face_dataset(P policy, const FaceDatasetParts& parts, const std::vector<PerformanceStats>& stats, const FaceDatasetOptions& o,
+                                           const std::filesystem::path& out, const std::function<void(const std::string&)>& log = {}) {
+  auto say = [&](const std::string& s) {
+    if (log) log(s);
+  };
+  const FaceModel& face = parts.face;
   auto j = face_data_report(face, stats);
+  char buf[512];
   for (const auto& s : stats)
     if (s.lip_intersecting_frames) {
       std::snprintf(buf, sizeof buf,
@@ -98,7 +129,7 @@ nlohmann::ordered_json generate_face_dataset(P policy, const FaceDatasetOptions&
     }
   if (o.vtk_every > 0) {
     std::vector<std::string> names;
-    for (const auto& p : perfs) names.push_back(p.name);
+    for (const auto& p : parts.performances) names.push_back(p.name);
     say("datagen: VTU series (every " + std::to_string(o.vtk_every) + " frames) in " + (out / "vtk").string());
     write_face_data_views(policy, face, out, names, o.vtk_every);
   }
@@ -109,9 +140,20 @@ nlohmann::ordered_json generate_face_dataset(P policy, const FaceDatasetOptions&
     const auto us = generate_unseen_force_frames(policy, face, out, uo);
     j["unseen_forces"] = unseen_force_report(us);
   }
-  j["seconds"] = std::chrono::duration<double>(clock::now() - t0).count();
+  j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - parts.started).count();
   io::write_file_atomic(out / "face_data.json", j.dump(2) + "\n");
   return j;
+}
+
+/// Builds the model, simulates what `o` asks for into `out` and returns the summary (also written
+/// to out/face_data.json). `log` receives the progress lines (may be empty). The three steps
+/// above in a row; simsr::mpi::generate_face_dataset shares step 2 over ranks.
+template <exec::HostPolicy P>
+nlohmann::ordered_json generate_face_dataset(P policy, const FaceDatasetOptions& o, const std::filesystem::path& out,
+                                             const std::function<void(const std::string&)>& log = {}) {
+  const FaceDatasetParts parts = prepare_face_dataset(policy, o, out, log);
+  const auto stats = simulate_face_dataset(policy, parts, o, out, log);
+  return finish_face_dataset(policy, parts, stats, o, out, log);
 }
 
 }  // namespace simsr::scenario
