@@ -80,7 +80,7 @@ nlohmann::ordered_json softdeca_dataset_with(const DatagenArgs& a, const Templat
   return with_linear_solver(a.linear_solver, [&]<class L>(LinearSolverTag<L>) {
 #if defined(SIMSR_HAVE_MPI)
     if (const MpiSession* session = mpi_session(); session != nullptr && session->size() > 1)  // shard r of R per rank
-      return mpi::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<L>>(*session->world(), exec::omp, tpl, name, o, a.out, say);
+      return mpi::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<L>>(exec::omp, *session->world(), tpl, name, o, a.out, say);
 #endif
     return scenario::generate_softdeca_dataset<scenario::BasicSoftDecaSimulator<L>>(exec::omp, tpl, name, o, a.out, say);
   });
@@ -134,15 +134,6 @@ inline int datagen_softdeca(const DatagenArgs& a) {
   return 0;
 }
 
-/// The mesh options of a preset, then the explicit overrides.
-inline scenario::FaceModelOptions face_model_options(const DatagenArgs& a) {
-  scenario::FaceModelOptions o = scenario::face_model_preset(a.preset);
-  if (a.lr_cell > 0) o.lr_cell = a.lr_cell;
-  if (a.skull_lattice > 0) o.skull_lattice = a.skull_lattice;
-  if (a.hr_max_volume > 0) o.hr.max_volume = a.hr_max_volume;
-  return o;
-}
-
 /// The thin-shell datasets (shell/cloth_datagen.hpp): a progress line per 10 frames on stderr,
 /// the summary (DIR/cloth_data.json) on stdout.
 inline int datagen_cloth(const DatagenArgs& a) {
@@ -180,7 +171,7 @@ inline int datagen(const DatagenArgs& a) {
   if (a.scenario != "face") throw ArgumentError("--scenario: face, softdeca, sheet or disk (got '" + a.scenario + "')");
   scenario::FaceDatasetOptions o;
   o.kit = a.kit;
-  o.model = face_model_options(a);
+  o.model = scenario::face_model_preset(a.preset, a.lr_cell, a.skull_lattice, a.hr_max_volume);
   o.performances.clear();  // `--performances ""`: none (only --controls)
   for (const auto& p : a.performances)
     if (!p.empty()) o.performances.push_back(p);
@@ -196,7 +187,7 @@ inline int datagen(const DatagenArgs& a) {
   nlohmann::ordered_json j;
 #if defined(SIMSR_HAVE_MPI)
   if (ranks)  // shard r of R of the performances per rank
-    j = mpi::generate_face_dataset(*mpi_session()->world(), exec::omp, o, a.out, log);
+    j = mpi::generate_face_dataset(exec::omp, *mpi_session()->world(), o, a.out, log);
   else
 #endif
     j = scenario::generate_face_dataset(exec::omp, o, a.out, log);

@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include <simsr/core/error.hpp>
 #include <simsr/core/parallel.hpp>
 #include <simsr/core/types.hpp>
@@ -44,6 +46,13 @@ decltype(auto) with_policy(const std::string& policy, F&& f) {
   if (policy == "omp") return f(exec::omp);
   if (policy == "seq") return f(exec::seq);
   throw ArgumentError("policy: expected 'omp' or 'seq', got '" + policy + "'");
+}
+
+/// A JSON value of the library's (a config, a run's summary) as the Python object json.loads makes
+/// of it (dict, list, str, int, float, bool, None).
+template <class Json>
+py::object python_of(const Json& j) {
+  return py::module_::import("json").attr("loads")(j.dump());
 }
 
 /// The `policy` keyword argument, keyword-only, default "omp".

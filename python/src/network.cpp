@@ -26,8 +26,6 @@ nlohmann::json json_of(const py::handle& o) {
   return nlohmann::json::parse(std::string(py::str(py::module_::import("json").attr("dumps")(o))));
 }
 
-py::object python_of(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
-
 /// A preset ("official", "paper") with NetworkConfig fields given as keywords (strict: an unknown
 /// field, or one that would not hold, is an ArgumentError naming it).
 nn::NetworkConfig config_of(const std::string& preset, const py::dict& fields) { return nn::NetworkConfig::with_fields(preset, json_of(fields)); }

@@ -29,8 +29,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-py::object python_of(const nlohmann::ordered_json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
-
 /// A line-progress callback for the library: `callback(line)` under the GIL (nothing when None),
 /// after a check for Ctrl-C.
 std::function<void(const std::string&)> line_progress(const py::object* callback) {
@@ -71,10 +69,7 @@ void bind_scenario(py::module_& m) {
          Index vtk_every, bool unseen_forces, Index unseen_frames, const py::object& on_progress, const std::string& policy) {
         scenario::FaceDatasetOptions o;
         o.kit = kit;
-        o.model = scenario::face_model_preset(preset);
-        if (lr_cell > 0) o.model.lr_cell = lr_cell;
-        if (skull_lattice > 0) o.model.skull_lattice = skull_lattice;
-        if (hr_max_volume > 0) o.model.hr.max_volume = hr_max_volume;
+        o.model = scenario::face_model_preset(preset, lr_cell, skull_lattice, hr_max_volume);
         o.performances = performances;
         o.controls = controls;
         o.frames = frames;

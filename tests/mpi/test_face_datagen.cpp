@@ -12,6 +12,7 @@
 
 #include "../scenario/face_fixture.hpp"
 #include "../support/require.hpp"
+#include "../support/same_arrays.hpp"
 
 namespace mpi_test_face_datagen {
 
@@ -54,7 +55,7 @@ TEST_CASE("mpi::generate_face_dataset: 2 ranks, a performance each, write the si
   world.barrier();
 
   std::vector<std::string> lines;
-  const auto j = mpi::generate_face_dataset(world, exec::omp, o, ranks, [&](const std::string& l) { lines.push_back(l); });
+  const auto j = mpi::generate_face_dataset(exec::omp, world, o, ranks, [&](const std::string& l) { lines.push_back(l); });
   // rank 0 simulates smile, rank 1 jaw: each reports its own frames only
   const std::string mine = world.rank() == 0 ? "smile" : "jaw", theirs = world.rank() == 0 ? "jaw" : "smile";
   const auto frame_lines_of = [&](const std::string& name) {
@@ -82,17 +83,8 @@ TEST_CASE("mpi::generate_face_dataset: 2 ranks, a performance each, write the si
   scenario::FaceDatasetOptions other = o;
   other.controls = {root / "controls" / (theirs + "_controls.npz")};
   const auto s = scenario::generate_face_dataset(exec::omp, other, alone);
-  for (const std::string& name : {theirs + ".npz", theirs + "_controls.npz", std::string("hr_lips.npz")}) {
-    CAPTURE(name);
-    const io::NpzArrays a = io::read_npz(ranks / name), b = io::read_npz(alone / name);
-    REQUIRE(a.size() == b.size());
-    for (const auto& entry : a) {  // no structured binding: clang 14 cannot CAPTURE one
-      const std::string& array = entry.first;
-      CAPTURE(array);
-      REQUIRE(b.contains(array));
-      CHECK(entry.second.bytes == b.at(array).bytes);
-    }
-  }
+  for (const std::string& name : {theirs + ".npz", theirs + "_controls.npz", std::string("hr_lips.npz")})
+    test::check_same_arrays(ranks / name, alone / name, {});
   for (const char* f : {"lr_rest.msh", "hr_rest.obj", "hr_volume.msh"})
     CHECK(io::detail::read_text_file(ranks / f) == io::detail::read_text_file(alone / f));
   const std::size_t p = world.rank() == 0 ? 1 : 0;  // the other performance's entry in the ranks' summary

@@ -13,26 +13,12 @@
 #include <vector>
 
 #include "../support/error_of.hpp"
+#include "../support/same_arrays.hpp"
 
 namespace mpi_test_softdeca_datagen {
 
 using namespace simsr;
 namespace fs = std::filesystem;
-
-/// Every array of two .npz files equal byte for byte, those named `seconds` (wall-clock) aside.
-void check_same_arrays(const fs::path& a, const fs::path& b) {
-  const io::NpzArrays x = io::read_npz(a), y = io::read_npz(b);
-  REQUIRE(x.size() == y.size());
-  for (const auto& entry : x) {  // no structured binding: clang 14 cannot CAPTURE one
-    const std::string& name = entry.first;
-    const io::NpyArray& array = entry.second;
-    CAPTURE(name);
-    REQUIRE(y.contains(name));
-    if (name == "seconds") continue;
-    CHECK(array.shape == y.at(name).shape);
-    CHECK(array.bytes == y.at(name).bytes);
-  }
-}
 
 TEST_CASE("mpi::generate_softdeca_dataset: 2 ranks write the single process's files; a lost sample is simulated again alone") {
   const mpi::Communicator world = mpi::Communicator::world();
@@ -47,7 +33,7 @@ TEST_CASE("mpi::generate_softdeca_dataset: 2 ranks write the single process's fi
   world.barrier();
 
   std::vector<std::string> lines;
-  const auto j = mpi::generate_softdeca_dataset(world, exec::omp, tpl, "ball", o, ranks, [&](const std::string& l) { lines.push_back(l); });
+  const auto j = mpi::generate_softdeca_dataset(exec::omp, world, tpl, "ball", o, ranks, [&](const std::string& l) { lines.push_back(l); });
   const Index mine = world.rank() == 0 ? 3 : 2;
   CHECK(std::count_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("sample ", 0) == 0; }) == mine);
   CHECK(j["ranks"] == 2);
@@ -65,23 +51,23 @@ TEST_CASE("mpi::generate_softdeca_dataset: 2 ranks write the single process's fi
   if (world.is_root()) {  // the single-process run beside it
     const auto s = scenario::generate_softdeca_dataset(exec::omp, tpl, "ball", o, single);
     CHECK(s["simulated"] == 5);
-    check_same_arrays(ranks / "softdeca_samples.npz", single / "softdeca_samples.npz");
-    for (Index i = 0; i < o.samples; ++i) check_same_arrays(ranks / "samples" / scenario::detail::sample_file_name(i), single / "samples" / scenario::detail::sample_file_name(i));
+    test::check_same_arrays(ranks / "softdeca_samples.npz", single / "softdeca_samples.npz");
+    for (Index i = 0; i < o.samples; ++i) test::check_same_arrays(ranks / "samples" / scenario::detail::sample_file_name(i), single / "samples" / scenario::detail::sample_file_name(i));
     for (const char* f : {"template_skin.obj", "template_soft_tissue.msh", "template_muscle.msh"})
       CHECK(io::detail::read_text_file(ranks / f) == io::detail::read_text_file(single / f));
     fs::remove(ranks / "samples" / scenario::detail::sample_file_name(4));  // rank 1's: as if it was killed while simulating it
   }
   world.barrier();
-  const auto again = mpi::generate_softdeca_dataset(world, exec::omp, tpl, "ball", o, ranks);
+  const auto again = mpi::generate_softdeca_dataset(exec::omp, world, tpl, "ball", o, ranks);
   CHECK(again["simulated"] == 1);
   CHECK(again["resumed"] == 4);
   CHECK(again["per_rank"][1]["simulated"] == 1);
-  if (world.is_root()) check_same_arrays(ranks / "softdeca_samples.npz", single / "softdeca_samples.npz");
+  if (world.is_root()) test::check_same_arrays(ranks / "softdeca_samples.npz", single / "softdeca_samples.npz");
   world.barrier();
 
   scenario::SoftDecaDatagenOptions sharded = o;
   sharded.shard = {1, 2};
-  CHECK(test::typed_error_of<ArgumentError>([&] { mpi::generate_softdeca_dataset(world, exec::omp, tpl, "ball", sharded, ranks); })
+  CHECK(test::typed_error_of<ArgumentError>([&] { mpi::generate_softdeca_dataset(exec::omp, world, tpl, "ball", sharded, ranks); })
             .find("the options name a shard already") != std::string::npos);
 }
 

@@ -13,6 +13,7 @@
 
 #include "face_fixture.hpp"
 
+#include <cmath>
 #include <cstdlib>
 #include <set>
 
@@ -192,6 +193,20 @@ TEST_CASE("face model presets: the LR cell of each (the HR mesh the same), a bad
     CHECK(o->skull_lattice == d.skull_lattice);
   }
   CHECK_THROWS_WITH_AS(scenario::face_model_preset("paper"), doctest::Contains("got 'paper'"), ArgumentError);
+}
+
+TEST_CASE("face model presets with overrides: each override > 0 replaces its size, 0 keeps the preset's, a negative or NaN one is refused by name") {
+  const scenario::FaceModelOptions r = scenario::face_model_preset("paper-ratio");
+  const scenario::FaceModelOptions a = scenario::face_model_preset("paper-ratio", 2.5, 0, 0), b = scenario::face_model_preset("default", 0, 1.7, 0.8);
+  CHECK(a.lr_cell == 2.5);
+  CHECK(a.skull_lattice == r.skull_lattice);
+  CHECK(a.hr.max_volume == r.hr.max_volume);
+  CHECK(b.lr_cell == scenario::FaceModelOptions{}.lr_cell);
+  CHECK(b.skull_lattice == 1.7);
+  CHECK(b.hr.max_volume == 0.8);
+  CHECK_THROWS_WITH_AS(scenario::face_model_preset("default", -1, 0, 0), doctest::Contains("lr_cell = -1"), ArgumentError);
+  CHECK_THROWS_WITH_AS(scenario::face_model_preset("default", 0, 0, std::nan("")), doctest::Contains("hr_max_volume"), ArgumentError);
+  CHECK_THROWS_WITH_AS(scenario::face_model_preset("huge", 1, 1, 1), doctest::Contains("got 'huge'"), ArgumentError);
 }
 
 TEST_CASE("face_lip_patches: the skin's lip triangles, upper in a and lower in b, facing each other: still at rest, crossing when the upper lip drops") {

@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <vector>
 
+#include "../support/same_arrays.hpp"
+
 namespace scenario_test_softdeca_datagen {
 
 using namespace simsr;
@@ -120,14 +122,7 @@ TEST_CASE("generate_softdeca_dataset: shards one after another, then the whole r
   const auto j = generate_softdeca_dataset(exec::seq, tpl, "ball", o, parts);
   CHECK(j["simulated"] == 0);
   CHECK(j["resumed"] == 5);
-  const io::NpzArrays a = io::read_npz(whole / "softdeca_samples.npz"), b = io::read_npz(parts / "softdeca_samples.npz");
-  REQUIRE(a.size() == b.size());
-  for (const auto& entry : a) {  // no structured binding: clang 14 cannot CAPTURE one
-    const std::string& name = entry.first;
-    const io::NpyArray& array = entry.second;
-    CAPTURE(name);
-    if (name != "seconds") CHECK(array.bytes == b.at(name).bytes);
-  }
+  test::check_same_arrays(whole / "softdeca_samples.npz", parts / "softdeca_samples.npz");
   SoftDecaDatagenOptions bad = o;
   bad.shard = {3, 3};
   CHECK_THROWS_AS(generate_softdeca_dataset(exec::seq, tpl, "ball", bad, parts), ArgumentError);

@@ -201,6 +201,18 @@ class Communicator {
   int rank_ = 0, size_ = 1;
 };
 
+/// The pattern of a sharded run's end: every rank's `part` (its share's summary) gathered in rank
+/// order, `finish(parts)` run on rank 0 alone (it assembles the whole run's files and returns the
+/// summary), and rank 0's summary returned on every rank. The gather is also the point where
+/// every rank's files are written.
+template <class Finish>
+std::string finish_on_root(const Communicator& comm, const std::string& part, Finish&& finish) {
+  const std::vector<std::string> parts = comm.allgather(part);
+  std::string summary;
+  if (comm.is_root()) summary = finish(parts);
+  return comm.broadcast(summary, 0);
+}
+
 /// Runs `f(comm)` on this rank and returns its result; an exception ends the whole run: "simsr:
 /// rank R of S: <message>" on stderr, then MPI_Abort with exit code `code` (the other ranks may be
 /// waiting in a collective and could not be told otherwise).

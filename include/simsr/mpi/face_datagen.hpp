@@ -14,7 +14,7 @@
 ///
 /// Not shared yet: the frames within one performance (so R ranks help up to R performances).
 ///
-///     auto report = mpi::generate_face_dataset(comm, exec::omp, options, "out/face", log);
+///     auto report = mpi::generate_face_dataset(exec::omp, comm, options, "out/face", log);
 
 #include <filesystem>
 #include <functional>
@@ -44,15 +44,13 @@ inline nlohmann::json stats_json(const std::vector<scenario::PerformanceStats>& 
 /// The face data set of `o`, every rank taking part; every rank returns rank 0's summary. `log`
 /// gets this rank's progress lines.
 template <exec::HostPolicy P>
-nlohmann::ordered_json generate_face_dataset(const Communicator& comm, P policy, const scenario::FaceDatasetOptions& o, const std::filesystem::path& out,
+nlohmann::ordered_json generate_face_dataset(P policy, const Communicator& comm, const scenario::FaceDatasetOptions& o, const std::filesystem::path& out,
                                              const std::function<void(const std::string&)>& log = {}) {
   if (comm.size() == 1) return scenario::generate_face_dataset(policy, o, out, log);
   const auto mesh_dir = comm.is_root() ? out / "mesh" : out / "mesh" / (".rank_" + std::to_string(comm.rank()));
   const scenario::FaceDatasetParts parts = scenario::prepare_face_dataset(policy, o, out, log, mesh_dir);
   const auto mine = scenario::simulate_face_dataset(policy, parts, o, out, log, comm.shard());
-  const std::vector<std::string> all = comm.allgather(detail::stats_json(mine).dump());  // also: every rank's files are written
-  std::string summary;
-  if (comm.is_root()) {
+  return nlohmann::ordered_json::parse(finish_on_root(comm, detail::stats_json(mine).dump(), [&](const std::vector<std::string>& all) {
     auto stats = scenario::simulate_face_dataset(policy, parts, o, out, {});  // every performance's file is there: reused
     for (const auto& text : all)
       for (const auto& r : nlohmann::json::parse(text))
@@ -65,12 +63,8 @@ nlohmann::ordered_json generate_face_dataset(const Communicator& comm, P policy,
             s.lr_iterations = r["lr_iterations"].get<Index>();
             s.hr_iterations = r["hr_iterations"].get<Index>();
           }
-    nlohmann::ordered_json j = scenario::finish_face_dataset(policy, parts, stats, o, out, log);
-    j["ranks"] = comm.size();
-    io::write_file_atomic(out / "face_data.json", j.dump(2) + "\n");
-    summary = j.dump();
-  }
-  return nlohmann::ordered_json::parse(comm.broadcast(summary, 0));
+    return scenario::finish_face_dataset(policy, parts, stats, o, out, log, {{"ranks", comm.size()}}).dump();
+  }));
 }
 
 }  // namespace simsr::mpi

@@ -11,7 +11,7 @@
 /// ranks) resumes from the files. The summary adds `ranks` and each rank's part, and counts
 /// `simulated` / `resumed` over the ranks.
 ///
-///     auto report = mpi::generate_softdeca_dataset(comm, exec::omp, tpl, "ict", options, "out/softdeca");
+///     auto report = mpi::generate_softdeca_dataset(exec::omp, comm, tpl, "ict", options, "out/softdeca");
 
 #include <filesystem>
 #include <functional>
@@ -29,7 +29,7 @@ namespace simsr::mpi {
 /// taking part; every rank returns the whole run's summary (rank 0's). `say` gets each rank's
 /// progress lines (prefix them with the rank to tell them apart).
 template <class Simulator = scenario::SoftDecaSimulator, exec::HostPolicy P>
-nlohmann::ordered_json generate_softdeca_dataset(const Communicator& comm, P policy, const scenario::SoftDecaTemplate& tpl, const std::string& name,
+nlohmann::ordered_json generate_softdeca_dataset(P policy, const Communicator& comm, const scenario::SoftDecaTemplate& tpl, const std::string& name,
                                                  const scenario::SoftDecaDatagenOptions& o, const std::filesystem::path& dir,
                                                  const std::function<void(const std::string&)>& say = {}) {
   if (!o.shard.whole()) throw ArgumentError("mpi::generate_softdeca_dataset: the options name a shard already (the ranks are the shards)");
@@ -37,11 +37,8 @@ nlohmann::ordered_json generate_softdeca_dataset(const Communicator& comm, P pol
   scenario::SoftDecaDatagenOptions mine = o;
   mine.shard = comm.shard();
   const nlohmann::ordered_json part = scenario::generate_softdeca_dataset<Simulator>(policy, tpl, name, mine, dir, say);
-  const std::vector<std::string> parts = comm.allgather(part.dump());  // also: every rank's files are written
-  std::string summary;
-  if (comm.is_root()) {
-    scenario::SoftDecaDatagenOptions whole = o;
-    nlohmann::ordered_json j = scenario::generate_softdeca_dataset<Simulator>(policy, tpl, name, whole, dir, {});
+  return nlohmann::ordered_json::parse(finish_on_root(comm, part.dump(), [&](const std::vector<std::string>& parts) {
+    nlohmann::ordered_json j = scenario::generate_softdeca_dataset<Simulator>(policy, tpl, name, o, dir, {});  // every sample's file is there
     Index simulated = 0, resumed = 0;
     double seconds = 0;
     nlohmann::ordered_json per_rank = nlohmann::ordered_json::array(), per_sample = nlohmann::ordered_json::array();
@@ -60,10 +57,9 @@ nlohmann::ordered_json generate_softdeca_dataset(const Communicator& comm, P pol
     j["ranks"] = comm.size();
     j["per_rank"] = per_rank;
     j["per_sample"] = per_sample;
-    io::write_file_atomic(dir / "softdeca_data.json", j.dump(2) + "\n");
-    summary = j.dump();
-  }
-  return nlohmann::ordered_json::parse(comm.broadcast(summary, 0));
+    io::write_file_atomic(dir / "softdeca_data.json", j.dump(2) + "\n");  // the whole run's summary, with the ranks' counts
+    return j.dump();
+  }));
 }
 
 }  // namespace simsr::mpi

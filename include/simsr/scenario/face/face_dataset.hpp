@@ -110,10 +110,12 @@ std::vector<PerformanceStats> simulate_face_dataset(P policy, const FaceDatasetP
 }
 
 /// Step 3: the VTU series, the unseen-force frames and the summary (out/face_data.json, returned)
-/// from the stats of every performance.
+/// from the stats of every performance; `extra`'s fields are added to the summary before it is
+/// written (the MPI layer's `ranks`).
 template <exec::HostPolicy P>
 nlohmann::ordered_json finish_face_dataset(P policy, const FaceDatasetParts& parts, const std::vector<PerformanceStats>& stats, const FaceDatasetOptions& o,
-                                           const std::filesystem::path& out, const std::function<void(const std::string&)>& log = {}) {
+                                           const std::filesystem::path& out, const std::function<void(const std::string&)>& log = {},
+                                           const nlohmann::ordered_json& extra = nlohmann::ordered_json::object()) {
   auto say = [&](const std::string& s) {
     if (log) log(s);
   };
@@ -140,6 +142,7 @@ nlohmann::ordered_json finish_face_dataset(P policy, const FaceDatasetParts& par
     const auto us = generate_unseen_force_frames(policy, face, out, uo);
     j["unseen_forces"] = unseen_force_report(us);
   }
+  for (const auto& [key, value] : extra.items()) j[key] = value;
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - parts.started).count();
   io::write_file_atomic(out / "face_data.json", j.dump(2) + "\n");
   return j;

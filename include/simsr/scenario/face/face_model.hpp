@@ -31,6 +31,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../../core/error.hpp"
@@ -88,6 +89,20 @@ inline FaceModelOptions face_model_preset(const std::string& name) {
   } else if (name != "default") {
     throw ArgumentError("face model preset must be default, paper-ratio or paper-lr (got '" + name + "')");
   }
+  return o;
+}
+
+/// The preset `name` with each size override that is > 0 put in (`simsr datagen --preset
+/// --lr-cell --skull-lattice --hr-max-volume`, Python's keywords of the same names): the LR cell
+/// and the skull lattice in cm, the largest HR tet in cm³. ArgumentError for an unknown preset or a
+/// negative or non-finite override.
+inline FaceModelOptions face_model_preset(const std::string& name, double lr_cell, double skull_lattice, double hr_max_volume) {
+  FaceModelOptions o = face_model_preset(name);
+  for (const auto& [what, v] : {std::pair{"lr_cell", lr_cell}, std::pair{"skull_lattice", skull_lattice}, std::pair{"hr_max_volume", hr_max_volume}})
+    if (!(v >= 0) || !std::isfinite(v)) throw ArgumentError(std::string("face model: ") + what + " = " + std::to_string(v) + " (need > 0, or 0 for the preset's)");
+  if (lr_cell > 0) o.lr_cell = lr_cell;
+  if (skull_lattice > 0) o.skull_lattice = skull_lattice;
+  if (hr_max_volume > 0) o.hr.max_volume = hr_max_volume;
   return o;
 }
 
