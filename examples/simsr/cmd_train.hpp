@@ -7,6 +7,9 @@
 // frames. Writes MODEL.npz (one self-contained file: weights, config, geometry), a checkpoint
 // every epoch when --checkpoint is given (resumable with --resume), and with --out-dir the
 // per-epoch history as CSV and SVG. stdout: one JSON object with the run's figures.
+// Under `mpirun -np R` (a build with SIMSR_WITH_MPI): data-parallel, each rank its block of every
+// global batch (mpi::MpiBatchGroup); the files are the single process's, bit for bit, and rank 0
+// alone writes them and prints.
 #include <simsr/data/data.hpp>
 #include <simsr/eval/evaluate.hpp>
 #include <simsr/eval/training_history.hpp>
@@ -22,6 +25,11 @@
 #include <string>
 
 #include "methods.hpp"
+#include "mpi_session.hpp"
+
+#if defined(SIMSR_HAVE_MPI)
+#include <simsr/mpi/batch_group.hpp>
+#endif
 
 namespace simsr::cli {
 
@@ -67,6 +75,14 @@ inline int train_cmd(const TrainArgs& a) {
   interp::NetworkTrainOptions o;
   o.trainer.seed = a.recipe.seed;
   o.trainer.progress = !a.quiet;
+  const bool root = prints_results();
+#if defined(SIMSR_HAVE_MPI)
+  std::unique_ptr<mpi::MpiBatchGroup> group;
+  if (const MpiSession* s = mpi_session(); s != nullptr && s->size() > 1) {
+    group = std::make_unique<mpi::MpiBatchGroup>(*s->world());
+    o.trainer.group = group.get();
+  }
+#endif
   o.trainer.lr_decay_epochs = a.recipe.lr_decay_epochs;
   if (test.num_frames() > 0) o.holdout = &held;
   o.checkpoint = a.checkpoint;
@@ -79,6 +95,7 @@ inline int train_cmd(const TrainArgs& a) {
   }
   net.train(exec::omp, train_displacements, o);
   const auto t_train = clock::now();
+  if (!root) return 0;  // every rank holds the same network: rank 0 writes and prints
   net.save(a.out);
 
   const double diag = eval::bbox_diagonal(problem.hr.V);
@@ -92,6 +109,11 @@ inline int train_cmd(const TrainArgs& a) {
   j["epochs"] = net.epoch();
   j["steps"] = net.steps();
   j["batch_size"] = net.batch_size();
+  j["ranks"] = mpi_session() ? mpi_session()->size() : 1;
+  if (net.gathers() > 0) {  // data-parallel: what rank 0 received per optimizer step (the README's scaling model)
+    j["gathers_per_step"] = double(net.gathers()) / double(std::max<std::int64_t>(1, net.steps()));
+    j["bytes_received_per_step"] = double(net.bytes_received()) / double(std::max<std::int64_t>(1, net.steps()));
+  }
   if (const auto* b = net.base_info()) j["residual_base"] = b->to_json();
   j["geometry_seconds"] = sec(t_geo - t_start);
   j["training_seconds"] = sec(t_train - t_geo);

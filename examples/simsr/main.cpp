@@ -66,8 +66,8 @@ int main(int argc, char** argv) {
   }
   if (mpi.size() > 1) {
     const std::string name = app.get_subcommands().front()->get_name();
-    if (name != "datagen") {  // datagen checks its scenario itself
-      std::fprintf(stderr, "%s: invalid argument: simsr %s runs on one process; under mpirun -np %d only datagen (--scenario softdeca, face) shares its work\n",
+    if (name != "datagen" && name != "train") {  // datagen checks its scenario itself
+      std::fprintf(stderr, "%s: invalid argument: simsr %s runs on one process; under mpirun -np %d only datagen (--scenario softdeca, face) and train share their work\n",
                    simsr::cli::program_name().c_str(), name.c_str(), mpi.size());
       return simsr::cli::exit_argument;  // every rank refuses alike: no rank waits for another
     }

@@ -1,8 +1,9 @@
 #pragma once
 // The tool under `mpirun -np R simsr ...` (a build with -DSIMSR_WITH_MPI=ON): MPI is initialized
 // only when mpirun started the process (mpi::launched_by_mpirun), so a plain `simsr` never pays
-// for it. With more than one rank only the commands that shard their work run (today: datagen
-// --scenario softdeca, by sample, and face, by performance); any other is refused before it runs, rather than run R times
+// for it. With more than one rank only the commands that shard their work run (datagen
+// --scenario softdeca, by sample, and face, by performance; train, each rank its block of every
+// batch); any other is refused before it runs, rather than run R times
 // over the same files. An error on one rank is printed with the rank and ends every rank
 // (MPI_Abort: the others may be waiting for it in a collective).
 #include <cstdlib>

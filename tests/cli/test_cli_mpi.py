@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
-"""`mpirun -np 2 simsr datagen --scenario softdeca|face` (issue #16, a build with -DSIMSR_WITH_MPI=ON):
+"""`mpirun -np 2 simsr datagen --scenario softdeca|face` and `mpirun -np 2 simsr train` (issue #16, a
+build with -DSIMSR_WITH_MPI=ON):
 the 2-rank run writes the single process's files (every array equal, the wall-clock seconds
 aside) and prints its summary once; a rank killed mid-run (SIGKILL) ends the run with every
 finished sample file whole, and the same command resumes it to the single process's files; the
 face's two performances on two ranks give the single process's files; commands that do not
-share their work are refused under 2 ranks.
+share their work are refused under 2 ranks; training on 2 ranks writes the single process's model
+and checkpoint bit for bit, and a checkpoint resumes on the other rank count.
 
     /usr/bin/python3 tests/cli/test_cli_mpi.py SIMSR_EXE MPIEXEC WORK_DIR ICT_KIT_DIR
 
@@ -106,7 +108,51 @@ check(p.returncode != 0 and "runs on one process" in p.stderr and "rank 0 of 2" 
 p = mpirun("info", os.path.join(WORK, "single", "template_skin.obj"))
 check(p.returncode != 0 and "simsr info runs on one process" in p.stderr, f"simsr info under 2 ranks refused: exit {p.returncode}")
 
-# 4. the face by performance: two controls files (one frame each) on the coarse model
+# 4. data-parallel training: 2 ranks write the single process's model and checkpoint bit for bit,
+# and a checkpoint resumes on the other rank count as the uninterrupted run
+from test_cli_nn import write_box_pair  # noqa: E402  (the small synthetic pair of the train tests)
+
+tw = os.path.join(WORK, "train")
+os.makedirs(tw)
+write_box_pair(tw, 4, 7, 12, 5)  # 12 frames: 9 trained on (batches of 3), 3 held out
+T = lambda *a: os.path.join(tw, *a)  # noqa: E731
+def train_args(batch):
+    return ["train", "--lr-rest", T("lr.mesh"), "--hr-rest", T("hr.obj"), "--frames", T("frames.npz"), "--knn", "3", "--upk", "4",
+            "--batch-size", str(batch), "--quiet"]
+
+
+train = train_args(3)
+
+
+def same_arrays(a, b, what):
+    x, y = arrays(a), arrays(b)
+    check(x.keys() == y.keys() and len(x) > 10, f"{what}: the same {len(x)} arrays")
+    differ = [k for k in x if k in y and not (x[k].dtype == y[k].dtype and x[k].shape == y[k].shape and
+                                             (np.array_equal(x[k], y[k]) if x[k].dtype.kind in "OUS" else x[k].tobytes() == y[k].tobytes()))]
+    check(not differ, f"{what}: every array equal bit for bit{'' if not differ else ' (differ: ' + ', '.join(differ[:5]) + ')'}")
+
+
+simsr(*train, "--epochs", "2", "--out", T("single.npz"), "--checkpoint", T("single_ckpt.npz"))
+p = mpirun(*train, "--epochs", "2", "--out", T("ranks.npz"), "--checkpoint", T("ranks_ckpt.npz"))
+check(p.returncode == 0, f"mpirun -np 2 simsr train: exit {p.returncode}; stderr: {p.stderr[-600:]}")
+lines = [l for l in p.stdout.splitlines() if l.strip()]
+check(len(lines) == 1 and json.loads(lines[0]).get("ranks") == 2 and json.loads(lines[0]).get("steps") == 6,
+      f"the train summary printed once, 2 ranks, 6 steps: {lines[:1]}")
+same_arrays(T("ranks.npz"), T("single.npz"), "train: the 2-rank model vs 1 process")
+same_arrays(T("ranks_ckpt.npz"), T("single_ckpt.npz"), "train: the 2-rank checkpoint vs 1 process")
+p = mpirun(*train, "--epochs", "1", "--out", T("half.npz"), "--checkpoint", T("half_ckpt.npz"))
+check(p.returncode == 0, f"mpirun -np 2 simsr train --epochs 1: exit {p.returncode}")
+simsr(*train, "--epochs", "2", "--resume", T("half_ckpt.npz"), "--out", T("resumed_on_1.npz"))
+same_arrays(T("resumed_on_1.npz"), T("single.npz"), "train: 2 ranks' epoch-1 checkpoint resumed on 1 process vs uninterrupted")
+simsr(*train, "--epochs", "1", "--out", T("half1.npz"), "--checkpoint", T("half1_ckpt.npz"))
+p = mpirun(*train, "--epochs", "2", "--resume", T("half1_ckpt.npz"), "--out", T("resumed_on_2.npz"))
+check(p.returncode == 0, f"mpirun -np 2 simsr train --resume: exit {p.returncode}; {p.stderr[-300:]}")
+same_arrays(T("resumed_on_2.npz"), T("single.npz"), "train: 1 process's epoch-1 checkpoint resumed on 2 ranks vs uninterrupted")
+p = mpirun(*train_args(4), "--epochs", "1", "--out", T("x.npz"))
+check(p.returncode != 0 and "end with a batch of 1" in p.stderr and "simsr (rank " in p.stderr,
+      f"batches of 4 (the last of 1 frame) refused on 2 ranks, naming it: exit {p.returncode}; {p.stderr[-300:]}")
+
+# 5. the face by performance: two controls files (one frame each) on the coarse model
 if not (os.path.exists(os.path.join(KIT, "full_neutral.obj")) and shutil.which("tetgen")):
     missing_peer(f"the ICT kit ({KIT}) or the tetgen program")
 for name, weights in (("smile", [[0.6, 0.6]]), ("jaw", [[0.3]])):  # one frame each: the HR solves are the cost

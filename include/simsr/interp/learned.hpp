@@ -162,6 +162,8 @@ class Learned {
       if (!options.checkpoint.empty()) trainer.save_checkpoint(options.checkpoint, model_);
     }
     history_ = trainer.history();
+    gathers_ = trainer.batch_split().gathers();
+    bytes_received_ = trainer.batch_split().bytes_received();
     epoch_ = trainer.epoch();
     steps_ = trainer.steps();
     batch_size_ = trainer.batch_size();
@@ -208,6 +210,10 @@ class Learned {
   Index epoch() const { return epoch_; }
   std::int64_t steps() const { return steps_; }
   Index batch_size() const { return batch_size_; }
+  /// Data-parallel training (TrainerOptions::group): the last train's collectives and the bytes
+  /// this rank received (0 on one process).
+  std::int64_t gathers() const { return gathers_; }
+  std::int64_t bytes_received() const { return bytes_received_; }
 
  private:
   /// normalized positions of the rest shapes, and the float32 range check of every input.
@@ -276,7 +282,7 @@ class Learned {
   nn::ModelData model_;
   std::string loaded_from_;
   std::vector<nn::EpochReport> history_;
-  std::int64_t steps_ = 0;
+  std::int64_t steps_ = 0, gathers_ = 0, bytes_received_ = 0;
   Index epoch_ = 0, batch_size_ = 0;
   nn::Matrix<network_scalar> lr0_;
   Points<double> lr_rest_;

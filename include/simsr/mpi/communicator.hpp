@@ -132,23 +132,37 @@ class Communicator {
     static_assert(std::is_trivially_copyable_v<T>, "mpi::Communicator::allgather: T must be trivially copyable (sent as bytes)");
     const std::int64_t bytes = std::int64_t(values.size() * sizeof(T));
     const std::vector<std::int64_t> sizes = allgather(bytes);
-    std::vector<int> counts(sizes.size()), displs(sizes.size());
-    std::int64_t total = 0;
-    for (std::size_t r = 0; r < sizes.size(); ++r) {
-      if (total + sizes[r] > std::int64_t(std::numeric_limits<int>::max()))
-        throw ArgumentError("mpi::Communicator::allgather: " + std::to_string(total + sizes[r]) + " bytes in all, more than one MPI call sends");
-      counts[r] = int(sizes[r]);
-      displs[r] = int(total);
-      total += sizes[r];
-    }
-    std::vector<unsigned char> buffer(static_cast<std::size_t>(total));
-    detail::check(MPI_Allgatherv(values.data(), int(bytes), MPI_BYTE, buffer.data(), counts.data(), displs.data(), MPI_BYTE, comm_), "MPI_Allgatherv");
+    const std::vector<std::size_t> counts(sizes.begin(), sizes.end());
+    std::size_t total = 0;
+    for (std::size_t c : counts) total += c;
+    std::vector<unsigned char> buffer(total);
+    allgather_bytes(values.data(), counts, buffer.data());
     std::vector<std::vector<T>> out(sizes.size());
+    std::size_t at = 0;
     for (std::size_t r = 0; r < sizes.size(); ++r) {
-      out[r].resize(std::size_t(sizes[r]) / sizeof(T));
-      if (sizes[r] > 0) std::memcpy(out[r].data(), buffer.data() + displs[r], std::size_t(sizes[r]));
+      out[r].resize(counts[r] / sizeof(T));
+      if (counts[r] > 0) std::memcpy(out[r].data(), buffer.data() + at, counts[r]);
+      at += counts[r];
     }
     return out;
+  }
+
+  /// `all` ← every rank's bytes[r] bytes, concatenated in rank order (`mine`: bytes[rank()] of
+  /// them); every rank passes the same `bytes`. One MPI_Allgatherv: ArgumentError beyond what
+  /// its int counts hold.
+  void allgather_bytes(const void* mine, const std::vector<std::size_t>& bytes, void* all) const {
+    if (bytes.size() != std::size_t(size_))
+      throw ArgumentError("mpi::Communicator::allgather_bytes: " + std::to_string(bytes.size()) + " byte counts for " + std::to_string(size_) + " ranks");
+    std::vector<int> counts(bytes.size()), displs(bytes.size());
+    std::size_t total = 0;
+    for (std::size_t r = 0; r < bytes.size(); ++r) {
+      if (total + bytes[r] > std::size_t(std::numeric_limits<int>::max()))
+        throw ArgumentError("mpi::Communicator::allgather: " + std::to_string(total + bytes[r]) + " bytes in all, more than one MPI call sends");
+      counts[r] = int(bytes[r]);
+      displs[r] = int(total);
+      total += bytes[r];
+    }
+    detail::check(MPI_Allgatherv(mine, counts[std::size_t(rank_)], MPI_BYTE, all, counts.data(), displs.data(), MPI_BYTE, comm_), "MPI_Allgatherv");
   }
 
   /// Every rank's string, in rank order, on every rank.

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "batch_split.hpp"
 #include "layer.hpp"
 #include "parameters.hpp"
 
@@ -67,6 +68,10 @@ class BatchNorm1d {
   VectorMap<S> running_var() { return buf(rv_off_, c_); }
   S num_batches_tracked() { return buf(nbt_off_, 1)[0]; }
 
+  /// The batch split of data-parallel training (nullptr: none): the statistics are then those of the
+  /// whole global batch (per-item partial sums added in global item order), the same on every rank.
+  void set_batch_split(BatchSplit* split) { split_ = split; }
+
   /// The normalized input x̂ of the last forward (rows×C); kept for backward.
   const Matrix<S>& normalized() const { return xhat_; }
 
@@ -80,15 +85,16 @@ class BatchNorm1d {
     ensure_size(mean_, c_);
     ensure_size(inv_std_, c_);
     if (batch_stats_) {
-      if (R < 2) throw ArgumentError(where() + ": batch statistics need more than 1 row per channel, got " + std::to_string(R));
+      const Index rows = batch_rows(R);
+      if (rows < 2) throw ArgumentError(where() + ": batch statistics need more than 1 row per channel, got " + std::to_string(rows));
       column_sums(policy, R, [&](Index r, auto acc) { acc += in.row(r).template cast<double>(); });
-      mean_ = total_ / double(R);
+      mean_ = total_ / double(rows);
       column_sums(policy, R, [&](Index r, auto acc) { acc += (in.row(r).template cast<double>() - mean_.transpose()).cwiseAbs2(); });
       ensure_size(var_, c_);
-      var_ = total_ / double(R);
+      var_ = total_ / double(rows);
       inv_std_ = (var_.array() + opt_.eps).rsqrt();
       if (mode == Mode::train && opt_.track_running_stats) {
-        const double m = opt_.momentum, unbias = double(R) / double(R - 1);
+        const double m = opt_.momentum, unbias = double(rows) / double(rows - 1);
         auto rm = running_mean(), rv = running_var();
         for (Index c = 0; c < c_; ++c) {
           rm[c] = static_cast<S>((1 - m) * double(rm[c]) + m * mean_[c]);
@@ -154,8 +160,9 @@ class BatchNorm1d {
     ensure_size(dmean_, c_);
     ensure_size(dxmean_, c_);
     if (batch_stats_) {
-      dmean_ = (dsum_ / double(R)).template cast<S>();
-      dxmean_ = (dxsum_ / double(R)).template cast<S>();
+      const Index rows = batch_rows(R);
+      dmean_ = (dsum_ / double(rows)).template cast<S>();
+      dxmean_ = (dxsum_ / double(rows)).template cast<S>();
     } else {
       dmean_.setZero(), dxmean_.setZero();
     }
@@ -195,22 +202,33 @@ class BatchNorm1d {
     if (off < 0) throw ArgumentError(where() + " does not track running statistics");
     return store_->buffer(off, n);
   }
+  /// Rows of the whole batch: R, or under a batch split R's rows per item × the global items.
+  Index batch_rows(Index R) const { return split_ ? split_->rows_per_item(R, where_) * split_->items() : R; }
+
   /// total_ (C) = Σ_rows of the per-row contributions, in double, summed per fixed row chunk and
-  /// then over chunks in order (so seq and omp agree bit for bit).
+  /// then over chunks in order (so seq and omp agree bit for bit); under a batch split, per item
+  /// and then over the global batch's items in order (so any number of ranks agrees too).
   template <class Policy, class Add>
   void column_sums(Policy policy, Index R, Add&& add) {
-    const Index nr = exec::chunk_count(R, reduction_chunks), workers = exec::worker_count(policy, nr);
+    const auto chunks = detail::row_chunks(split_, R, reduction_chunks, where_);
+    const Index nr = chunks.count(), workers = exec::worker_count(policy, nr);
     ensure_shape(parts_, nr, c_);
-    exec::for_chunks(policy, R, nr, workers, [&](Index, Index c, Index b, Index e) {
+    detail::for_row_chunks(policy, chunks, workers, [&](Index, Index c, Index b, Index e) {
       parts_.row(c).setZero();
       for (Index r = b; r < e; ++r) add(r, parts_.row(c));
     });
     ensure_size(total_, c_);
     total_.setZero();
-    for (Index c = 0; c < nr; ++c) total_ += parts_.row(c).transpose();
+    if (!split_) {
+      for (Index c = 0; c < nr; ++c) total_ += parts_.row(c).transpose();
+      return;
+    }
+    detail::fold_item_partials(chunks, parts_.data(), c_);
+    split_->sum_items(parts_.data(), c_, total_.data());
   }
 
   ParameterStore<S>* store_;
+  BatchSplit* split_ = nullptr;
   std::string name_, where_;
   Index c_;
   Options opt_;

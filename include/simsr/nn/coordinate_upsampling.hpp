@@ -146,6 +146,9 @@ class CoordinateUpsampling {
     precomputed_ = true;
   }
   bool has_precomputed_weights() const { return precomputed_; }
+  /// The batch split of data-parallel training: the gather over the batch items takes part; f_θ
+  /// does not (its rows, the queries of the rest shapes, are the same on every rank).
+  void set_batch_split(BatchSplit* split) { up_.set_batch_split(split); }
   /// Forgets the precomputed weights (call after the parameters change).
   void invalidate() { precomputed_ = false; }
 

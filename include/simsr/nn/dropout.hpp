@@ -8,6 +8,7 @@
 
 #include <string>
 
+#include "batch_split.hpp"
 #include "layer.hpp"
 
 namespace simsr::nn {
@@ -29,6 +30,11 @@ class Dropout {
   double p() const { return p_; }
   Index out_features(Index in_cols) const { return in_cols; }
   Rng& rng() { return rng_; }
+  /// The batch split of data-parallel training (nullptr: none): the mask of each batch item is then
+  /// drawn from its own stream (one draw of rng() per forward, mixed with the item's global index),
+  /// so an item gets the same mask on whichever rank holds it.
+  void set_batch_split(const BatchSplit* split) { split_ = split; }
+
   /// The mask of the last train forward (0 or 1/(1 − p) per entry); empty after an identity forward.
   const Matrix<S>& mask() const { return mask_; }
 
@@ -40,7 +46,17 @@ class Dropout {
     if (masked_) {
       ensure_shape(mask_, R, C);
       const S keep = p_ < 1 ? static_cast<S>(1.0 / (1.0 - p_)) : S(0);
-      for (Index i = 0; i < mask_.size(); ++i) mask_.data()[i] = uniform(rng_, 0, 1) < p_ ? S(0) : keep;
+      if (!split_) {
+        for (Index i = 0; i < mask_.size(); ++i) mask_.data()[i] = uniform(rng_, 0, 1) < p_ ? S(0) : keep;
+      } else {
+        const Index per_item = split_->rows_per_item(R, "nn::Dropout") * C;
+        const std::uint64_t base = rng_();
+        for (Index item = 0; item < split_->count(); ++item) {
+          Rng r(base ^ (0x9E3779B97F4A7C15ull * std::uint64_t(split_->first() + item + 1)));
+          S* m = mask_.data() + item * per_item;
+          for (Index i = 0; i < per_item; ++i) m[i] = uniform(r, 0, 1) < p_ ? S(0) : keep;
+        }
+      }
     }
     const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
     exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
@@ -71,6 +87,7 @@ class Dropout {
  private:
   double p_;
   Rng rng_;
+  const BatchSplit* split_ = nullptr;
   bool masked_ = false;
   Matrix<S> mask_;
 };

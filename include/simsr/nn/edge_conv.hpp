@@ -87,6 +87,8 @@ class EdgeConv {
     return mlp_.linear(1);
   }
   Mlp<S>& edge_function() { return mlp_; }
+  /// The batch split of data-parallel training (the edge rows are batch rows: k per point).
+  void set_batch_split(BatchSplit* split) { mlp_.set_batch_split(split); }
   /// The max over each point's k edges; its argmax() says which edge each channel took.
   GroupPool<S>& max_pool() { return pool_; }
   /// The edge function's output of the last forward, (B·N·k)×out: what max_pool() pooled.

@@ -43,6 +43,11 @@ class EmbeddingBlock {
   Index out_features(Index = -1) const { return out_; }
   EdgeConv<S, Search>& edge_conv() { return edge_; }
   Mlp<S>& fc_out() { return fc_out_; }
+  /// The batch split of data-parallel training (nn/batch_split.hpp) for the edge MLP and fc_out.
+  void set_batch_split(BatchSplit* split) {
+    edge_.set_batch_split(split);
+    fc_out_.set_batch_split(split);
+  }
   /// The global max over each item's points (of edge_output()); its argmax() says which point.
   GroupPool<S>& global_max() { return gmax_; }
   /// The edge convolution's output of the last forward, (B·N)×out.
@@ -163,6 +168,11 @@ class FeatureEmbedding {
   }
 
   Index blocks() const { return Index(blocks_.size()); }
+  /// The batch split of data-parallel training for every block and dropout (nullptr: none).
+  void set_batch_split(BatchSplit* split) {
+    for (auto& b : blocks_) b->set_batch_split(split);
+    for (auto& d : drops_) d->set_batch_split(split);
+  }
   EmbeddingBlock<S, Search>& block(Index b) { return *blocks_.at(std::size_t(b)); }
   /// The dropout after block b (its Rng is reseeded by the trainer at every step).
   Dropout<S>& dropout(Index b) { return *drops_.at(std::size_t(b)); }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../core/serial_gemm.hpp"
+#include "batch_split.hpp"
 #include "layer.hpp"
 #include "parameters.hpp"
 
@@ -100,16 +101,21 @@ class Linear {
     bias() = b.template cast<S>();
   }
 
+  /// The batch split of data-parallel training (nn/batch_split.hpp; nullptr: none): rows are then
+  /// chunked per batch item and the weight gradient is summed per item in global item order.
+  void set_batch_split(BatchSplit* split) { split_ = split; }
+
   /// out (rows×out) = in (rows×in)·Wᵀ + b. The mode does not matter here.
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
     detail::check_shape(where_, "input", in, -1, in_);
     const Index R = in.rows();
     ensure_shape(out, R, out_);
-    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    const auto chunks = detail::row_chunks(split_, R, product_chunks, where_);
+    const Index workers = exec::worker_count(policy, chunks.count());
     if (gemm_fwd_.size() < std::size_t(workers)) gemm_fwd_.resize(std::size_t(workers));
-    for (Index w = 0; w < workers; ++w) reserve_forward(gemm_fwd_[std::size_t(w)], R);
-    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+    for (Index w = 0; w < workers; ++w) gemm_fwd_[std::size_t(w)].reserve(chunks.max_size(), out_, in_);
+    detail::for_row_chunks_dynamic(policy, chunks, workers, [&](Index w, Index, Index b, Index e) {
       forward_block(gemm_fwd_[std::size_t(w)], e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out_, out_);
     });
   }
@@ -139,30 +145,39 @@ class Linear {
     const auto W = std::as_const(*store_).value(w_off_, out_, in_);
     if (d_in) {
       ensure_shape(*d_in, R, in_);
-      const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
-      reserve(gemm_din_, workers, exec::max_chunk_size(R, nc), in_, out_);
-      detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+      const auto chunks = detail::row_chunks(split_, R, product_chunks, where_);
+      const Index workers = exec::worker_count(policy, chunks.count());
+      reserve(gemm_din_, workers, chunks.max_size(), in_, out_);
+      detail::for_row_chunks_dynamic(policy, chunks, workers, [&](Index w, Index, Index b, Index e) {
         gemm_din_[std::size_t(w)].run(e - b, in_, out_, d_out.data() + b * d_out.outerStride(), d_out.outerStride(), false, W.data(),
                                       in_, false, d_in->data() + b * in_, in_, false);
       });
     }
     if (R == 0) return;
-    // Weight gradient: one partial product per fixed row chunk, summed in chunk order.
-    const Index nr = exec::chunk_count(R, reduction_chunks), workers = exec::worker_count(policy, nr);
-    reserve(gemm_dw_, workers, out_, in_, exec::max_chunk_size(R, nr));
-    if (dw_parts_.size() < std::size_t(nr)) dw_parts_.resize(std::size_t(nr));
-    for (Index c = 0; c < nr; ++c) ensure_shape(dw_parts_[std::size_t(c)], out_, in_);
-    if (has_bias()) ensure_shape(db_parts_, nr, out_);
-    detail::for_chunks_dynamic(policy, R, nr, workers, [&](Index w, Index c, Index b, Index e) {
+    // Weight gradient: one partial product per fixed row chunk (row c of parts_: W's then b's),
+    // summed in chunk order; under a batch split folded per item and summed in global item order.
+    const auto chunks = detail::row_chunks(split_, R, reduction_chunks, where_);
+    const Index nr = chunks.count(), workers = exec::worker_count(policy, nr), wsize = out_ * in_, width = wsize + (has_bias() ? out_ : 0);
+    reserve(gemm_dw_, workers, out_, in_, chunks.max_size());
+    ensure_shape(parts_, nr, width);
+    detail::for_row_chunks_dynamic(policy, chunks, workers, [&](Index w, Index c, Index b, Index e) {
+      S* part = parts_.data() + c * width;
       gemm_dw_[std::size_t(w)].run(out_, in_, e - b, d_out.data() + b * d_out.outerStride(), d_out.outerStride(), true,
-                                   in.data() + b * in.outerStride(), in.outerStride(), false, dw_parts_[std::size_t(c)].data(), in_, false);
-      if (has_bias()) db_parts_.row(c) = d_out.middleRows(b, e - b).colwise().sum();
+                                   in.data() + b * in.outerStride(), in.outerStride(), false, part, in_, false);
+      if (has_bias()) VectorMap<S>(part + wsize, out_) = d_out.middleRows(b, e - b).colwise().sum().transpose();
     });
+    const S* all = parts_.data();
+    Index count = nr;
+    if (split_) {
+      detail::fold_item_partials(chunks, parts_.data(), width);
+      all = split_->gather(parts_.data(), width);
+      count = split_->items();
+    }
     auto gW = weight_grad();
-    for (Index c = 0; c < nr; ++c) gW += dw_parts_[std::size_t(c)];
+    for (Index c = 0; c < count; ++c) gW += ConstMatrixMap<S>(all + c * width, out_, in_);
     if (has_bias()) {
       auto gb = store_->gradient(b_off_, 1, out_);
-      for (Index c = 0; c < nr; ++c) gb += db_parts_.row(c);
+      for (Index c = 0; c < count; ++c) gb += ConstMatrixMap<S>(all + c * width + wsize, 1, out_);
     }
   }
 
@@ -181,9 +196,9 @@ class Linear {
   std::string name_, where_;
   Index in_, out_;
   Index w_off_ = -1, b_off_ = -1;
+  BatchSplit* split_ = nullptr;
   std::vector<SerialGemm<S>> gemm_fwd_, gemm_din_, gemm_dw_;
-  std::vector<Matrix<S>> dw_parts_;
-  Matrix<S> db_parts_;
+  Matrix<S> parts_;  ///< weight-gradient partials, one row per chunk (W's out·in, then b's out)
 };
 static_assert(assert_layer<Linear<float>>());
 

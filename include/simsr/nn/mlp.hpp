@@ -146,6 +146,15 @@ class Mlp {
   }
   const MlpStage& spec(Index i) const { return stages_.at(std::size_t(i))->spec; }
 
+  /// The batch split of data-parallel training for every Linear and BatchNorm of the stack
+  /// (nullptr: none). Only for an Mlp whose rows are batch rows.
+  void set_batch_split(BatchSplit* split) {
+    for (auto& s : stages_) {
+      s->linear->set_batch_split(split);
+      if (s->bn) s->bn->set_batch_split(split);
+    }
+  }
+
   /// Eval mode (every BatchNorm on running statistics): all stages run on one row chunk after the
   /// other (the chunks of Linear::forward), BatchNorm and the activation applied in place on the
   /// chunk (same arithmetic, same values); only the output is stored, and a backward after it

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <string>
 
+#include "batch_split.hpp"
 #include "graph_features.hpp"
 #include "layer.hpp"
 
@@ -101,7 +102,9 @@ class NeighborUpsample {
     if (w_.size() == 0) throw ArgumentError("nn::NeighborUpsample: backward needs a forward first");
     const bool shared = check_weights("weights (last forward)", w_, B);
     detail::check_shape("nn::NeighborUpsample", "output gradient", d_out, B * M, C);
-    if (d_logits) {
+    if (d_logits && shared && split_) {
+      split_logit_gradient(policy, z, d_out, *d_logits);
+    } else if (d_logits) {
       const Index R = w_.rows();
       ensure_shape(*d_logits, R, K);
       const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
@@ -138,7 +141,42 @@ class NeighborUpsample {
     }
   }
 
+  /// The batch split of data-parallel training (nullptr: none): the gradient of shared logits, a
+  /// sum over the batch items, is then summed over the global batch's items in order.
+  void set_batch_split(BatchSplit* split) { split_ = split; }
+
  private:
+  /// d_logits under a batch split: dw per local item (count × M·upK), gathered, summed over the
+  /// global items in order from 0 (the order of the loop above), then the softmax's backward.
+  template <class Policy>
+  void split_logit_gradient(Policy policy, const ConstView<S>& z, const ConstView<S>& d_out, Matrix<S>& d_logits) {
+    const Index M = idx_.rows(), K = idx_.cols(), L = split_->count();
+    split_->rows_per_item(z.rows(), "nn::NeighborUpsample");
+    ensure_shape(item_dw_, L, M * K);
+    const Index nc = exec::chunk_count(M, product_chunks), workers = exec::worker_count(policy, nc);
+    exec::for_chunks(policy, M, nc, workers, [&](Index, Index, Index b, Index e) {
+      for (Index item = 0; item < L; ++item)
+        for (Index j = b; j < e; ++j)
+          for (Index i = 0; i < K; ++i) item_dw_(item, j * K + i) = d_out.row(item * M + j).dot(z.row(item * n_ + idx_(j, i)));
+    });
+    const S* all = split_->gather(item_dw_.data(), M * K);
+    const Index items = split_->items();
+    ensure_shape(d_logits, M, K);
+    exec::for_chunks(policy, M, nc, workers, [&](Index, Index, Index b, Index e) {
+      for (Index j = b; j < e; ++j) {
+        auto dl = d_logits.row(j);
+        S dot = 0;
+        for (Index i = 0; i < K; ++i) {
+          S dw = 0;
+          for (Index item = 0; item < items; ++item) dw += all[item * M * K + j * K + i];
+          dl[i] = dw;
+          dot += w_(j, i) * dw;
+        }
+        for (Index i = 0; i < K; ++i) dl[i] = w_(j, i) * (dl[i] - dot);
+      }
+    });
+  }
+
   /// Number of batch items B of z ((B·N)×C); ShapeError otherwise.
   Index check_z(const ConstView<S>& z) const {
     if (z.rows() % n_ || z.cols() < 1)
@@ -158,6 +196,8 @@ class NeighborUpsample {
   Index n_;
   detail::ReverseAdjacency rev_;
   Matrix<S> w_;
+  BatchSplit* split_ = nullptr;
+  Matrix<S> item_dw_;
 };
 
 }  // namespace simsr::nn

@@ -36,6 +36,11 @@ class SirenDecoder {
     net_.template layer<1>().linear(0).bias().setZero();
   }
   Index out_features(Index = -1) const { return net_.template layer<1>().out_features(); }
+  /// The batch split of data-parallel training (its rows are the batch's HR vertices).
+  void set_batch_split(BatchSplit* split) {
+    net_.template layer<0>().set_batch_split(split);
+    net_.template layer<1>().set_batch_split(split);
+  }
 
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode mode, const ConstView<S>& zH, Matrix<S>& out) {

@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 
+#include "batch_split.hpp"
 #include "contact_loss.hpp"
 #include "face_normal_loss.hpp"
 #include "latent_norm_loss.hpp"
@@ -68,6 +69,12 @@ class SuperResolutionLoss {
   bool has_contact() const { return contact_.has_value(); }
   const ContactLoss<S>* contact() const { return contact_ ? &*contact_ : nullptr; }
 
+  /// The batch split of data-parallel training (nullptr: none): pred, target and z then hold this
+  /// rank's items of the global batch; every term is taken item by item with the global batch's
+  /// normalization, and the items' values are added in global item order, so the terms are the
+  /// whole batch's on every rank (the gradients are this rank's rows of the whole batch's).
+  void set_batch_split(BatchSplit* split) { split_ = split; }
+
   /// Loss of `pred` ((B·M)×3) against `target` with code z ((B·N)×latent) at optimizer step
   /// `step`; with d_pred / d_z, writes the gradients of the total (overwritten).
   template <exec::HostPolicy Policy>
@@ -77,6 +84,7 @@ class SuperResolutionLoss {
     const Index M = fn_.vertices();
     if (pred.rows() == 0 || pred.rows() % M)
       throw ShapeError("nn::SuperResolutionLoss: prediction (B·" + std::to_string(M) + " rows)", {-1, 3}, {pred.rows(), pred.cols()});
+    if (split_) return evaluate_split(policy, pred, target, z, step, d_pred, d_z);
     const double B = double(pred.rows() / M);
     const Index N_rows = z.rows();
     Terms t;
@@ -126,7 +134,82 @@ class SuperResolutionLoss {
   }
 
  private:
+  /// evaluate under a batch split: each local item alone (B = 1 inside each term) with the terms'
+  /// weights scaled as the global batch of B items gives them; the per-item values gathered and
+  /// added in global item order.
+  template <class Policy>
+  Terms evaluate_split(Policy policy, const ConstView<S>& pred, const ConstView<S>& target, const ConstView<S>& z, long step, Matrix<S>* d_pred,
+                       Matrix<S>* d_z) {
+    const Index M = fn_.vertices(), L = split_->count();
+    split_->rows_per_item(pred.rows(), "nn::SuperResolutionLoss: prediction");
+    const Index N = split_->rows_per_item(z.rows(), "nn::SuperResolutionLoss: code");
+    const double B = double(split_->items());
+    if (d_pred) ensure_shape(*d_pred, pred.rows(), 3);
+    if (d_z) {
+      ensure_shape(*d_z, z.rows(), z.cols());
+      d_z->setZero();
+    }
+    // per item: recon, face normals, z_reg, contact (each already weighted), penetrating pairs
+    constexpr Index width = 5;
+    item_terms_.assign(std::size_t(L * width), 0.0);
+    double recon_scale = cfg_.w_recon;
+    if (cfg_.recon_divide_by_batch) recon_scale /= B;
+    if (cfg_.sum_reductions) recon_scale *= double(M * 3);
+    const double fn_scale = cfg_.w_fn / B;  // sum: w_fn/B · Σ items; mean: w_fn · (1/B) Σ item means
+    double beta = 0;
+    for (Index item = 0; item < L; ++item) {
+      double* v = item_terms_.data() + item * width;
+      const ConstView<S> p = pred.middleRows(item * M, M), y = target.middleRows(item * M, M), zi = z.middleRows(item * N, N);
+      // reconstruction: the batch mean of the item means (mean over all entries), its gradient /B
+      v[0] = recon_scale / B * double(l1_loss(policy, p, y, d_pred ? &d_item_ : nullptr, recon_scale / B));
+      if (d_pred) d_pred->middleRows(item * M, M) = d_item_;
+      if (cfg_.w_fn > 0) {
+        v[1] = fn_scale * fn_.value_and_gradient(policy, p, y, d_pred ? &d_fn_ : nullptr, fn_scale);
+        if (d_pred) d_pred->middleRows(item * M, M) += d_fn_;
+      }
+      switch (cfg_.zreg) {
+        case LatentRegularizer::mean_abs:
+        case LatentRegularizer::mean_square: {
+          beta = cfg_.w_zreg;
+          const double s = beta / B;
+          const bool abs = cfg_.zreg == LatentRegularizer::mean_abs;
+          v[2] = s * double(abs ? mean_abs(policy, zi, d_z ? &d_item_ : nullptr, s) : mean_square(policy, zi, d_z ? &d_item_ : nullptr, s));
+          if (d_z) d_z->middleRows(item * N, N) = d_item_;
+          break;
+        }
+        case LatentRegularizer::ramped_norm: {
+          beta = ramp_.at(step);
+          const double scale = beta / B;
+          for (const auto& [off, width_s] : blocks_) {
+            const auto block = zi.middleCols(off, width_s);
+            v[2] += scale * row_norm_sum(policy, block, d_z ? &d_block_ : nullptr, scale);
+            if (d_z) d_z->middleRows(item * N, N).middleCols(off, width_s) = d_block_;
+          }
+          break;
+        }
+      }
+      if (cfg_.w_contact > 0) {
+        if (!contact_) throw ArgumentError("nn::SuperResolutionLoss: w_contact > 0 but no contact patches (set_contact)");
+        if (d_pred) d_item_ = d_pred->middleRows(item * M, M);
+        v[3] = cfg_.w_contact / B * contact_->value_and_gradient(policy, p, d_pred ? &d_item_ : nullptr, cfg_.w_contact / B);
+        if (d_pred) d_pred->middleRows(item * M, M) = d_item_;
+        v[4] = double(contact_->penetrating());
+      }
+    }
+    double sums[width] = {0, 0, 0, 0, 0};
+    split_->sum_items(item_terms_.data(), width, sums);
+    Terms t;
+    t.recon = sums[0], t.face_normals = sums[1], t.z_reg = sums[2], t.contact = sums[3];
+    t.penetrating = Index(sums[4]);
+    t.beta = beta;
+    t.total = t.recon + t.z_reg + t.face_normals + t.contact;
+    return t;
+  }
+
   NetworkConfig cfg_;
+  BatchSplit* split_ = nullptr;
+  std::vector<double> item_terms_;
+  Matrix<S> d_item_;
   FaceNormalLoss<S> fn_;
   RampedWeight ramp_;
   std::vector<std::pair<Index, Index>> blocks_;

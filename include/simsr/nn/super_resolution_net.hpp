@@ -185,6 +185,16 @@ class SuperResolutionNet {
     decode(policy, Mode::eval, ldx, pred);
   }
 
+  /// The batch split of data-parallel training (nn/batch_split.hpp; nullptr: none) for every part
+  /// whose rows are batch rows: a forward and backward on this rank's items of the global batch
+  /// then give the whole batch's BatchNorm statistics and parameter gradients on every rank, in
+  /// bits that do not depend on how many ranks share the batch. Set it for training steps only.
+  void set_batch_split(BatchSplit* split) {
+    if (fe_) fe_->set_batch_split(split);
+    up_->set_batch_split(split);
+    decoder_->set_batch_split(split);
+  }
+
   /// Drops precomputed upsampling weights (after loading or changing parameters).
   void parameters_changed() { up_->invalidate(); }
 

@@ -109,13 +109,17 @@ struct TrainerOptions {
   double lr_decay_gamma = 0.5;
   Index holdout_every_epochs = 1;  ///< evaluate held-out frames every that many epochs (0: never)
   std::function<void(const EpochReport&)> on_epoch;  ///< called after every epoch
+  /// Data-parallel training (issue #16): the ranks that share every global batch (not owned;
+  /// simsr::mpi::MpiBatchGroup), or nullptr for one process. Each rank takes its block of every
+  /// batch's items (nn::BatchSplit); the run's numbers do not depend on the rank count.
+  BatchGroup* group = nullptr;
 };
 
 template <class S = float, class Search = neighbors::BruteForceKnn<S>>
 class Trainer {
  public:
   Trainer(SuperResolutionNet<S, Search>& net, const Tris& hr_faces, TrainingFrames<S> frames, TrainerOptions options = {})
-      : net_(&net), data_(std::move(frames)), opt_(std::move(options)), rng_(opt_.seed),
+      : net_(&net), data_(std::move(frames)), opt_(std::move(options)), split_(opt_.group), rng_(opt_.seed),
         adam_(net.store(), {.lr = opt_.lr > 0 ? opt_.lr : net.config().lr}),
         loss_(net.config(), net.hr_rest_normalized(), hr_faces, total_steps_estimate()), hr_faces_(hr_faces) {
     if (data_.frames < 1) throw ArgumentError("nn::Trainer: no training frames");
@@ -123,7 +127,15 @@ class Trainer {
       throw ShapeError("nn::Trainer: frames (N, M)", {net.lr_points(), net.hr_points()}, {data_.n, data_.m});
     if (batch_size() < 1) throw ArgumentError("nn::Trainer: batch_size must be >= 1");
     if (epochs() < 0) throw ArgumentError("nn::Trainer: epochs must be >= 0");
+    const Index last_batch = data_.frames - (steps_per_epoch() - 1) * batch_size();
+    if (last_batch < split_.size())
+      throw ArgumentError("nn::Trainer: on " + std::to_string(split_.size()) + " ranks every batch needs at least " + std::to_string(split_.size()) +
+                          " items (one per rank), and the " + std::to_string(data_.frames) + " training frames in batches of " +
+                          std::to_string(batch_size()) + " end with a batch of " + std::to_string(last_batch));
   }
+
+  /// The batch split of every step (its group: TrainerOptions::group).
+  const BatchSplit& batch_split() const { return split_; }
 
   Index epochs() const { return opt_.epochs >= 0 ? opt_.epochs : net_->config().epochs; }
   Index batch_size() const { return std::min(opt_.batch_size > 0 ? opt_.batch_size : net_->config().batch_size, data_.frames); }
@@ -165,14 +177,19 @@ class Trainer {
     const Index bs = batch_size(), nb = steps_per_epoch();
     for (Index b = 0; b < nb; ++b) {
       const Index first = b * bs, count = std::min(bs, data_.frames - first);
-      gather(order, first, count);
+      split_.set_batch(count);
+      gather(order, first + split_.first(), split_.count());  // this rank's items of the batch
       reseed_dropout();
       net_->store().zero_grad();
-      net_->forward(policy, Mode::train, ldx_, pred_);
-      const auto t = loss_.evaluate(policy, pred_, hdx_, net_->code(), long(adam_.steps()), &d_pred_, &d_code_);
       const std::int64_t step = adam_.steps() + 1;  // the step this batch makes (1-based)
-      require_finite_loss("nn::Trainer", t.total, step);
-      net_->backward(policy, d_pred_, &d_code_);
+      typename SuperResolutionLoss<S>::Terms t;
+      {
+        const SplitScope scope(*this);  // the step's sums over the batch taken over the global batch, in item order
+        net_->forward(policy, Mode::train, ldx_, pred_);
+        t = loss_.evaluate(policy, pred_, hdx_, net_->code(), long(adam_.steps()), &d_pred_, &d_code_);
+        require_finite_loss("nn::Trainer", t.total, step);
+        net_->backward(policy, d_pred_, &d_code_);
+      }
       require_finite_gradients("nn::Trainer", net_->store(), step);
       adam_.step(policy);
       require_finite_state("nn::Trainer (after the optimizer step)", net_->store(), step);
@@ -182,7 +199,7 @@ class Trainer {
       rep.face_normals += t.face_normals / double(nb);
       rep.contact += t.contact / double(nb);
       rep.penetrating += t.penetrating;
-      if (opt_.progress) progress(rep, b + 1, nb, t, std::chrono::steady_clock::now() - t0);
+      if (prints()) progress(rep, b + 1, nb, t, std::chrono::steady_clock::now() - t0);
     }
     net_->parameters_changed();
     ++epoch_;
@@ -190,7 +207,7 @@ class Trainer {
     if (holdout_.frames > 0 && opt_.holdout_every_epochs > 0 && (epoch_ % opt_.holdout_every_epochs == 0 || epoch_ == epochs()))
       rep.holdout_mean_error = holdout_error(policy);
     rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (opt_.progress) {
+    if (prints()) {
       std::fprintf(stderr, "\repoch %lld/%lld  loss %.5f (recon %.5f  z %.5f  normals %.6f)  %.1f s", (long long)rep.epoch, (long long)epochs(),
                    rep.loss, rep.recon, rep.z_reg, rep.face_normals, rep.seconds);
       if (loss_.has_contact()) std::fprintf(stderr, "  contact %.5f (%lld penetrating pairs)", rep.contact, (long long)rep.penetrating);
@@ -223,7 +240,9 @@ class Trainer {
   /// as text), `train/options` and `train/data` (JSON: what load_checkpoint compares). A model file
   /// loads from it as is. Written before the first step it resumes too (epoch 0, no moments).
   /// NumericalError (nothing written) when a weight, buffer or moment is not finite.
+  /// In data-parallel training only rank 0 writes (every rank holds the same state).
   void save_checkpoint(const std::filesystem::path& path, const ModelData& data) const {
+    if (!split_.is_root()) return;
     io::NpzArrays a = model_arrays(*net_, data);  // checks the weights and buffers
     const std::int64_t ep = epoch_;
     a["train/epoch"] = io::make_npy<std::int64_t>({}, &ep);
@@ -314,6 +333,22 @@ class Trainer {
   }
 
  private:
+  /// The batch split set on the network and the loss for one step's forward and backward, and
+  /// unset after it (an exception too): evaluation and inference run on whole frames.
+  struct SplitScope {
+    Trainer& t;
+    explicit SplitScope(Trainer& tr) : t(tr) {
+      t.net_->set_batch_split(&t.split_);
+      t.loss_.set_batch_split(&t.split_);
+    }
+    ~SplitScope() {
+      t.net_->set_batch_split(nullptr);
+      t.loss_.set_batch_split(nullptr);
+    }
+    SplitScope(const SplitScope&) = delete;
+    SplitScope& operator=(const SplitScope&) = delete;
+  };
+  bool prints() const { return opt_.progress && split_.is_root(); }
   long total_steps_estimate() const {
     const Index bs = std::min(opt_.batch_size > 0 ? opt_.batch_size : net_->config().batch_size, std::max<Index>(1, data_.frames));
     const Index ep = opt_.epochs >= 0 ? opt_.epochs : net_->config().epochs;
@@ -381,6 +416,7 @@ class Trainer {
   SuperResolutionNet<S, Search>* net_;
   TrainingFrames<S> data_, holdout_;
   TrainerOptions opt_;
+  BatchSplit split_;
   Rng rng_;
   Adam<S> adam_;
   SuperResolutionLoss<S> loss_;
