@@ -19,6 +19,7 @@ test::RunState<S> train(const test::Problem<S>& p, nn::BatchGroup* group, Index 
   nn::Rng init(5);
   nn::SuperResolutionNet<S> net(p.cfg, p.geo, init);
   nn::Trainer<S> tr(net, p.faces, p.frames, test::options<S>(epochs, group));
+  tr.set_holdout(p.holdout);  // 2 frames: one per rank
   tr.run(exec::omp);
   if (!checkpoint.empty()) tr.save_checkpoint(checkpoint, nn::ModelData{p.cfg, p.geo, {}, p.faces});
   return test::state_of(net, tr);

@@ -25,6 +25,7 @@ struct Problem {
   nn::NetworkGeometry geo;
   Tris faces;
   nn::TrainingFrames<S> frames;
+  nn::TrainingFrames<S> holdout;  ///< 2 frames (shared by 2 ranks; 3 ranks evaluate both each)
 };
 
 /// A small problem: HR displacements a smooth function of the LR ones, F frames.
@@ -51,6 +52,11 @@ Problem<S> make_problem(nn::NetworkConfig base, std::uint64_t seed, Index F, Ind
       d.hdx.row(f * M + j) = (0.5 * s + 0.1 * s.cwiseAbs2()).cast<S>();
     }
   for (Index f = 0; f < F; ++f) d.ids.push_back(f);
+  p.holdout = d;
+  p.holdout.frames = 2;
+  p.holdout.ldx = d.ldx.topRows(2 * N);
+  p.holdout.hdx = d.hdx.topRows(2 * M) * S(1.1);
+  p.holdout.ids = {0, 1};
   return p;
 }
 
@@ -71,7 +77,7 @@ RunState<S> state_of(nn::SuperResolutionNet<S>& net, nn::Trainer<S>& tr) {
   const auto& q = tr.optimizer().state().exp_avg_sq;
   r.exp_avg.assign(m.data(), m.data() + m.size());
   r.exp_avg_sq.assign(q.data(), q.data() + q.size());
-  for (const auto& e : tr.history()) r.losses.insert(r.losses.end(), {e.loss, e.recon, e.z_reg, e.face_normals});
+  for (const auto& e : tr.history()) r.losses.insert(r.losses.end(), {e.loss, e.recon, e.z_reg, e.face_normals, e.holdout_mean_error});
   return r;
 }
 

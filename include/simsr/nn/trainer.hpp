@@ -119,7 +119,7 @@ template <class S = float, class Search = neighbors::BruteForceKnn<S>>
 class Trainer {
  public:
   Trainer(SuperResolutionNet<S, Search>& net, const Tris& hr_faces, TrainingFrames<S> frames, TrainerOptions options = {})
-      : net_(&net), data_(std::move(frames)), opt_(std::move(options)), split_(opt_.group), rng_(opt_.seed),
+      : net_(&net), data_(std::move(frames)), opt_(std::move(options)), split_(opt_.group), holdout_split_(opt_.group), rng_(opt_.seed),
         adam_(net.store(), {.lr = opt_.lr > 0 ? opt_.lr : net.config().lr}),
         loss_(net.config(), net.hr_rest_normalized(), hr_faces, total_steps_estimate()), hr_faces_(hr_faces) {
     if (data_.frames < 1) throw ArgumentError("nn::Trainer: no training frames");
@@ -220,15 +220,28 @@ class Trainer {
   }
 
   /// Mean HR vertex error (raw units: the network's error × σ / displacement_scale) over the held-out frames, eval mode.
+  /// In data-parallel training each rank infers its block of the frames (at least one frame per
+  /// rank; else every rank all of them) and the per-frame sums are added in frame order: the
+  /// single process's value, bit for bit.
   template <exec::HostPolicy Policy>
   double holdout_error(Policy policy) {
     if (holdout_.frames == 0) return -1;
     net_->prepare_inference(policy);
     const Index N = data_.n, M = data_.m;
-    double sum = 0;
-    for (Index f = 0; f < holdout_.frames; ++f) {
+    const bool shared = holdout_split_.size() > 1 && holdout_.frames >= holdout_split_.size();
+    if (shared) holdout_split_.set_batch(holdout_.frames);
+    const Index first = shared ? holdout_split_.first() : 0, count = shared ? holdout_split_.count() : holdout_.frames;
+    frame_sums_.assign(std::size_t(count), 0.0);
+    for (Index i = 0; i < count; ++i) {
+      const Index f = first + i;
       net_->infer(policy, holdout_.ldx.middleRows(f * N, N), pred_eval_);
-      sum += (pred_eval_ - holdout_.hdx.middleRows(f * M, M)).template cast<double>().rowwise().norm().sum();
+      frame_sums_[std::size_t(i)] = (pred_eval_ - holdout_.hdx.middleRows(f * M, M)).template cast<double>().rowwise().norm().sum();
+    }
+    double sum = 0;
+    if (shared) {
+      holdout_split_.sum_items(frame_sums_.data(), 1, &sum);
+    } else {
+      for (double s : frame_sums_) sum += s;
     }
     const double error = sum / double(holdout_.frames * M) * net_->config().displacement_unit();
     if (!std::isfinite(error)) throw NumericalError("nn::Trainer", "the held-out mean error", adam_.steps(), error);
@@ -416,7 +429,7 @@ class Trainer {
   SuperResolutionNet<S, Search>* net_;
   TrainingFrames<S> data_, holdout_;
   TrainerOptions opt_;
-  BatchSplit split_;
+  BatchSplit split_, holdout_split_;  ///< the training batches' split; the held-out frames' (evaluation)
   Rng rng_;
   Adam<S> adam_;
   SuperResolutionLoss<S> loss_;
@@ -425,6 +438,7 @@ class Trainer {
   Index epoch_ = 0;
   std::vector<EpochReport> history_;
   std::vector<Index> order_;
+  std::vector<double> frame_sums_;
   Matrix<S> ldx_, hdx_, pred_, d_pred_, d_code_, pred_eval_;
 };
 
