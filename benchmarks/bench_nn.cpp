@@ -28,6 +28,7 @@
 #include <simsr/nn/adam.hpp>
 #include <simsr/nn/super_resolution_loss.hpp>
 #include <simsr/nn/super_resolution_net.hpp>
+#include <simsr/nn/trainer.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -181,6 +182,60 @@ void BM_official_train_step_bunny(benchmark::State& state) {
   state.counters["loss"] = total;
 }
 
+/// One optimizer step through nn::Trainer (an epoch of B frames in one batch): the per-item path
+/// of data-parallel training (nn/batch_split.hpp) on one process, beside BM_official_train_step_bunny
+/// at the same B (the plain whole-batch step): their ratio is what the rank-independent order costs.
+void BM_trainer_step_bunny(benchmark::State& state) {
+  const Bunny* b = bunny();
+  if (!b) {
+    state.SkipWithError("bunny data not found (SIMSR_DATA_DIR/bunny)");
+    return;
+  }
+  const Index B = state.range(0);
+  auto cfg = nn::NetworkConfig::official();
+  cfg.batch_size = B;
+  nn::Rng rng(0);
+  nn::SuperResolutionNet<float> net(cfg, b->geo, rng);
+  std::vector<Index> which(static_cast<std::size_t>(B));
+  for (Index f = 0; f < B; ++f) which[std::size_t(f)] = f;
+  nn::Trainer<float> trainer(net, b->hr_faces, nn::training_frames<float>(cfg, b->geo.lr_rest, b->geo.hr_rest, b->low, b->high, which),
+                             {.epochs = 1 << 20, .seed = 0, .progress = false});
+  trainer.run_epoch(exec::omp);  // warm
+  for (auto _ : state) trainer.run_epoch(exec::omp);
+}
+
+/// The upsampling's part of one training step on the bunny (B frames): f_θ's forward and backward
+/// on the M·upK queries of the rest shapes (batch-independent) and the gather. Data-parallel
+/// training computes f_θ on every rank (its rows are not batch rows): beside
+/// BM_official_train_step_bunny at the same B this ratio is the part R ranks do not divide
+/// (the README's scaling model).
+void BM_upsampling_step_bunny(benchmark::State& state) {
+  const Bunny* b = bunny();
+  if (!b) {
+    state.SkipWithError("bunny data not found (SIMSR_DATA_DIR/bunny)");
+    return;
+  }
+  const Index B = state.range(0);
+  const auto cfg = nn::NetworkConfig::official();
+  nn::Rng rng(0);
+  nn::SuperResolutionNet<float> net(cfg, b->geo, rng);
+  const Index N = net.lr_points();
+  Matrix<float> ldx(B * N, 3), pred, zh, d_zh, d_z;
+  for (Index f = 0; f < B; ++f)
+    nn::normalized_displacements(b->low.frame_points(f), net.lr_rest_normalized(), cfg.norm_mean, cfg.norm_std, ldx.middleRows(f * N, N));
+  net.forward(exec::omp, nn::Mode::train, ldx, pred);  // the code z the upsampling reads
+  const Matrix<float> z = net.code();
+  auto& up = net.upsampling();
+  auto step = [&] {
+    up.forward(exec::omp, nn::Mode::train, z, zh);
+    d_zh = zh;  // any gradient of the same shape
+    up.backward(exec::omp, z, d_zh, &d_z);
+  };
+  step();  // warm
+  for (auto _ : state) step();
+  state.counters["query_rows"] = double(net.hr_points() * cfg.up_k);
+}
+
 void BM_official_forward_paper_size_seq(benchmark::State& s) { BM_official_forward_paper_size(exec::seq, s); }
 void BM_official_forward_paper_size_omp(benchmark::State& s) { BM_official_forward_paper_size(exec::omp, s); }
 
@@ -190,5 +245,7 @@ BENCHMARK(BM_official_forward_paper_size_seq)->Name("BM_official_forward_paper_s
 BENCHMARK(BM_official_forward_paper_size_omp)->Name("BM_official_forward_paper_size/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 BENCHMARK(BM_official_forward_train_mode_paper_size)->Name("BM_official_forward_train_mode_paper_size/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_official_train_step_bunny)->Name("BM_official_train_step_bunny/omp")->Arg(32)->Arg(8)->ArgName("B")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
+BENCHMARK(BM_trainer_step_bunny)->Name("BM_trainer_step_bunny/omp")->Arg(8)->ArgName("B")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
+BENCHMARK(BM_upsampling_step_bunny)->Name("BM_upsampling_step_bunny/omp")->Arg(8)->ArgName("B")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 
 BENCHMARK_MAIN();

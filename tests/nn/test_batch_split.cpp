@@ -158,3 +158,37 @@ TEST_CASE("nn::BatchSplit: refusals name what is wrong") {
   CHECK_THROWS_WITH_AS(nn::Trainer<double>(net, p.faces, p.frames, options<double>(1, &groups.member(0))),
                        doctest::Contains("end with a batch of 2"), ArgumentError);
 }
+
+TEST_CASE("nn::BatchSplit::set_items: unequal items, item-aligned chunks over this rank's rows, rows gathered in item order") {
+  const std::vector<Index> rows = {5, 3, 7, 4, 6};  // 3 ranks: items {0, 1}, {2, 3}, {4}
+  std::vector<std::vector<double>> gathered(3);
+  std::vector<Index> begin(3), local(3), total(3);
+  std::vector<std::vector<std::pair<Index, Index>>> ranges(3);
+  test::ThreadBatchGroups groups(3);
+  groups.run([&](int r, nn::BatchGroup& g) {
+    nn::BatchSplit s(&g);
+    s.set_items(rows);
+    begin[std::size_t(r)] = s.local_row_begin();
+    local[std::size_t(r)] = s.local_rows();
+    total[std::size_t(r)] = s.total_rows(s.local_rows(), "test");
+    const auto c = s.chunks(s.local_rows(), 7, "test");  // ⌈7/5⌉ = 2 chunks per item
+    for (Index i = 0; i < c.count(); ++i) ranges[std::size_t(r)].push_back(c.range(i));
+    std::vector<double> mine(std::size_t(s.local_rows()));
+    for (Index i = 0; i < s.local_rows(); ++i) mine[std::size_t(i)] = double(s.local_row_begin() + i);
+    const double* all = s.gather_rows(mine.data(), 1);
+    gathered[std::size_t(r)].assign(all, all + 25);
+  });
+  CHECK(begin == std::vector<Index>{0, 8, 19});
+  CHECK(local == std::vector<Index>{8, 11, 6});
+  CHECK(total == std::vector<Index>{25, 25, 25});
+  // rank 1: item 2 (7 rows: 4 + 3), item 3 (4 rows: 2 + 2), local row numbers
+  CHECK(ranges[1] == std::vector<std::pair<Index, Index>>{{0, 4}, {4, 7}, {7, 9}, {9, 11}});
+  for (int r = 0; r < 3; ++r) {
+    CAPTURE(r);
+    for (Index i = 0; i < 25; ++i) CHECK(gathered[std::size_t(r)][std::size_t(i)] == double(i));
+  }
+  nn::BatchSplit one;
+  CHECK_THROWS_AS(one.set_items({3, 0, 2}), ArgumentError);
+  one.set_items({3, 4});
+  CHECK_THROWS_AS(one.total_rows(6, "here"), ShapeError);
+}

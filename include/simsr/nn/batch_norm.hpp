@@ -203,7 +203,7 @@ class BatchNorm1d {
     return store_->buffer(off, n);
   }
   /// Rows of the whole batch: R, or under a batch split R's rows per item × the global items.
-  Index batch_rows(Index R) const { return split_ ? split_->rows_per_item(R, where_) * split_->items() : R; }
+  Index batch_rows(Index R) const { return split_ ? split_->total_rows(R, where_) : R; }
 
   /// total_ (C) = Σ_rows of the per-row contributions, in double, summed per fixed row chunk and
   /// then over chunks in order (so seq and omp agree bit for bit); under a batch split, per item

@@ -61,6 +61,7 @@ class BatchSplit {
       throw ArgumentError("nn::BatchSplit: a batch of " + std::to_string(items) + " items cannot be split over " + std::to_string(size()) +
                           " ranks (each needs at least one)");
     items_ = items;
+    item_rows_.clear();
     std::tie(first_, last_) = WorkShard{rank(), size()}.range(items);
     counts_.resize(std::size_t(size()));
     for (int r = 0; r < size(); ++r) {
@@ -68,6 +69,31 @@ class BatchSplit {
       counts_[std::size_t(r)] = e - b;
     }
   }
+
+  /// Items of unequal sizes: item i is `rows[i]` rows of one fixed tensor (the upsampling's
+  /// queries, in groups of HR vertices); this rank takes its block of the items, the contiguous
+  /// rows [local_row_begin(), + local_rows()). ArgumentError for fewer items than ranks or an
+  /// empty item.
+  void set_items(const std::vector<Index>& rows) {
+    set_batch(Index(rows.size()));
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (rows[i] < 1) throw ArgumentError("nn::BatchSplit::set_items: item " + std::to_string(i) + " has no rows");
+    item_rows_ = rows;
+    local_offsets_.assign(1, 0);
+    row_begin_ = 0;
+    for (Index i = 0; i < first_; ++i) row_begin_ += rows[std::size_t(i)];
+    for (Index i = first_; i < last_; ++i) local_offsets_.push_back(local_offsets_.back() + rows[std::size_t(i)]);
+    total_rows_ = 0;
+    min_rows_ = rows.empty() ? 0 : rows[0];
+    for (Index r : rows) total_rows_ += r, min_rows_ = std::min(min_rows_, r);
+    rank_rows_.assign(std::size_t(size()), 0);
+    Index item = 0;
+    for (int r = 0; r < size(); ++r)
+      for (Index c = 0; c < counts_[std::size_t(r)]; ++c) rank_rows_[std::size_t(r)] += rows[std::size_t(item++)];
+  }
+  /// Unequal items (set_items): this rank's first row and its rows.
+  Index local_row_begin() const { return row_begin_; }
+  Index local_rows() const { return local_offsets_.empty() ? 0 : local_offsets_.back(); }
   /// Items of the global batch, the first of this rank's, how many this rank holds.
   Index items() const { return items_; }
   Index first() const { return first_; }
@@ -81,23 +107,42 @@ class BatchSplit {
     return rows / count();
   }
 
+  /// Rows of the whole batch for a tensor of `rows` local rows (BatchNorm's count).
+  Index total_rows(Index rows, const std::string& where) const {
+    if (item_rows_.empty()) return rows_per_item(rows, where) * items_;
+    if (rows != local_rows()) throw ShapeError(where + ": rows of this rank's items", {local_rows(), -1}, {rows, -1});
+    return total_rows_;
+  }
+
   /// Item-aligned chunks of `rows` local rows: each item cut into k = ⌈target / items()⌉ chunks
-  /// (at most its rows), the same on every rank. chunk c is item c / k's sub-chunk c % k.
+  /// (at most the smallest item's rows), the same on every rank. chunk c is item c / k's
+  /// sub-chunk c % k; max_size is the largest chunk of any rank (GEMM buffers are sized by it,
+  /// and their rounding depends on the size).
   struct Chunks {
-    Index rows_per_item = 0, per_item = 1, items = 0;
+    Index rows_per_item = 0, per_item = 1, items = 0, largest = 0;
+    const Index* offsets = nullptr;  ///< unequal items: the local items' row offsets (items + 1)
     Index count() const { return items * per_item; }
     std::pair<Index, Index> range(Index c) const {
       const Index item = c / per_item;
-      const auto [b, e] = exec::chunk_range(rows_per_item, per_item, c % per_item);
-      return {item * rows_per_item + b, item * rows_per_item + e};
+      const Index base = offsets ? offsets[item] : item * rows_per_item, n = offsets ? offsets[item + 1] - base : rows_per_item;
+      const auto [b, e] = exec::chunk_range(n, per_item, c % per_item);
+      return {base + b, base + e};
     }
-    Index max_size() const { return exec::max_chunk_size(rows_per_item, per_item); }
+    Index max_size() const { return largest; }
   };
   Chunks chunks(Index rows, Index target, const std::string& where) const {
     Chunks c;
-    c.rows_per_item = rows_per_item(rows, where);
-    c.per_item = std::clamp<Index>((target + items_ - 1) / items_, 1, std::max<Index>(1, c.rows_per_item));
     c.items = count();
+    if (item_rows_.empty()) {
+      c.rows_per_item = rows_per_item(rows, where);
+      c.per_item = std::clamp<Index>((target + items_ - 1) / items_, 1, std::max<Index>(1, c.rows_per_item));
+      c.largest = exec::max_chunk_size(c.rows_per_item, c.per_item);
+      return c;
+    }
+    total_rows(rows, where);  // checks the rows
+    c.offsets = local_offsets_.data();
+    c.per_item = std::clamp<Index>((target + items_ - 1) / items_, 1, std::max<Index>(1, min_rows_));
+    for (Index r : item_rows_) c.largest = std::max(c.largest, exec::max_chunk_size(r, c.per_item));
     return c;
   }
 
@@ -120,11 +165,19 @@ class BatchSplit {
     if (size() == 1) return local;
     std::vector<std::size_t> bytes(counts_.size());
     for (std::size_t r = 0; r < counts_.size(); ++r) bytes[r] = std::size_t(counts_[r] * width) * sizeof(T);
-    scratch_.resize(std::size_t(items_ * width) * sizeof(T) / sizeof(double) + 1);
-    group_->allgather_bytes(local, bytes, scratch_.data());
-    ++gathers_;
-    for (std::size_t r = 0; r < bytes.size(); ++r) bytes_received_ += r == std::size_t(rank()) ? 0 : bytes[r];
-    return reinterpret_cast<const T*>(scratch_.data());
+    return exchange<T>(local, bytes, items_ * width);
+  }
+
+  /// Unequal items (set_items): every rank's rows (local_rows() × width, row-major) concatenated
+  /// in item order, total rows × width. The pointer is valid until the next call.
+  template <class T>
+  const T* gather_rows(const T* local, Index width) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (item_rows_.empty()) throw ArgumentError("nn::BatchSplit::gather_rows: needs items of given rows (set_items)");
+    if (size() == 1) return local;
+    std::vector<std::size_t> bytes(rank_rows_.size());
+    for (std::size_t r = 0; r < bytes.size(); ++r) bytes[r] = std::size_t(rank_rows_[r] * width) * sizeof(T);
+    return exchange<T>(local, bytes, total_rows_ * width);
   }
 
   /// Collectives made and bytes this rank received from the others so far (the communication
@@ -133,8 +186,19 @@ class BatchSplit {
   std::int64_t bytes_received() const { return bytes_received_; }
 
  private:
+  template <class T>
+  const T* exchange(const T* local, const std::vector<std::size_t>& bytes, Index total) {
+    scratch_.resize(std::size_t(total) * sizeof(T) / sizeof(double) + 1);
+    group_->allgather_bytes(local, bytes, scratch_.data());
+    ++gathers_;
+    for (std::size_t r = 0; r < bytes.size(); ++r) bytes_received_ += r == std::size_t(rank()) ? 0 : bytes[r];
+    return reinterpret_cast<const T*>(scratch_.data());
+  }
+
   BatchGroup* group_ = nullptr;
   std::int64_t gathers_ = 0, bytes_received_ = 0;
+  std::vector<Index> item_rows_, local_offsets_, rank_rows_;  ///< unequal items (set_items) only
+  Index row_begin_ = 0, total_rows_ = 0, min_rows_ = 0;
   Index items_ = 0, first_ = 0, last_ = 0;
   std::vector<Index> counts_;
   std::vector<double> scratch_;  ///< double-aligned bytes of the last gather

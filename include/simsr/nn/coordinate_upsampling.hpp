@@ -135,6 +135,11 @@ class CoordinateUpsampling {
     }
     const Index MK = up_.hr_points() * up_.neighbors();
     const ConstView<S> d_col(Eigen::Map<const Matrix<S>>(d_logits_.data(), MK, 1));
+    if (split_queries_) {  // this rank's groups of query rows (d_logits is the whole batch's on every rank)
+      const Index r0 = query_split_->local_row_begin(), n = query_split_->local_rows();
+      mlp_->backward(policy, query_.middleRows(r0, n), local_logits_, d_col.middleRows(r0, n), nullptr);
+      return;
+    }
     mlp_->backward(policy, query_, logits_, d_col, nullptr);
   }
 
@@ -146,9 +151,30 @@ class CoordinateUpsampling {
     precomputed_ = true;
   }
   bool has_precomputed_weights() const { return precomputed_; }
-  /// The batch split of data-parallel training: the gather over the batch items takes part; f_θ
-  /// does not (its rows, the queries of the rest shapes, are the same on every rank).
-  void set_batch_split(BatchSplit* split) { up_.set_batch_split(split); }
+  /// The batch split of data-parallel training: the gather over the batch items takes part, and
+  /// f_θ's rows (the queries of the rest shapes, the same for every item) are split too, in
+  /// `query_groups` fixed groups of HR vertices (WorkShard's partition of M, each group its upK
+  /// rows per vertex) shared among the ranks: each rank runs f_θ on its groups, the logits are
+  /// gathered, and f_θ's weight gradients and BatchNorm statistics are summed per group in group
+  /// order — the same bits on any number of ranks (at most query_groups of them), one process too.
+  void set_batch_split(BatchSplit* split) {
+    up_.set_batch_split(split);
+    if (kind_ == UpsamplingKind::table) return;
+    if (split && (!query_split_ || query_split_->group() != split->group())) {
+      query_split_ = std::make_unique<BatchSplit>(split->group());
+      const Index M = up_.hr_points(), K = up_.neighbors(), groups = std::min(query_groups, M);
+      std::vector<Index> rows(static_cast<std::size_t>(groups));
+      for (Index g = 0; g < groups; ++g) {
+        const auto [b, e] = WorkShard{g, groups}.range(M);
+        rows[std::size_t(g)] = (e - b) * K;
+      }
+      query_split_->set_items(rows);
+    }
+    split_queries_ = split != nullptr;
+    mlp_->set_batch_split(split ? query_split_.get() : nullptr);
+  }
+  /// The fixed number of f_θ's row groups under a batch split (see set_batch_split).
+  static constexpr Index query_groups = 32;
   /// Forgets the precomputed weights (call after the parameters change).
   void invalidate() { precomputed_ = false; }
 
@@ -181,6 +207,14 @@ class CoordinateUpsampling {
       Eigen::Map<Matrix<S>>(logits_.data(), M, K) = std::as_const(*store_).value(logits_off_, M, K);
       return;
     }
+    if (split_queries_) {  // this rank's groups of query rows, then every rank's logits
+      const Index r0 = query_split_->local_row_begin(), n = query_split_->local_rows(), MK = up_.hr_points() * up_.neighbors();
+      mlp_->forward(policy, mode, query_.middleRows(r0, n), local_logits_);
+      const S* all = query_split_->gather_rows(local_logits_.data(), 1);
+      ensure_shape(logits_, MK, 1);
+      std::copy(all, all + MK, logits_.data());
+      return;
+    }
     mlp_->forward(policy, mode, query_, logits_);
   }
   /// The (M·upK)×1 logits seen as M×upK (row-major: the same memory).
@@ -192,7 +226,9 @@ class CoordinateUpsampling {
   ParameterStore<S>* store_;
   Index logits_off_ = -1;
   std::unique_ptr<Mlp<S>> mlp_;
-  Matrix<S> logits_, d_logits_, weights_;
+  std::unique_ptr<BatchSplit> query_split_;  ///< f_θ's row groups under a batch split
+  bool split_queries_ = false;
+  Matrix<S> logits_, d_logits_, weights_, local_logits_;
   bool precomputed_ = false;
 };
 
