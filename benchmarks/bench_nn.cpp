@@ -148,12 +148,16 @@ const Bunny* bunny() {
   return b.get();
 }
 
-void BM_official_train_step_bunny(benchmark::State& state) {
+/// The bunny, or nullptr with the benchmark marked skipped (no data).
+const Bunny* bunny_or_skip(benchmark::State& state) {
   const Bunny* b = bunny();
-  if (!b) {
-    state.SkipWithError("bunny data not found (SIMSR_DATA_DIR/bunny)");
-    return;
-  }
+  if (!b) state.SkipWithError("bunny data not found (SIMSR_DATA_DIR/bunny)");
+  return b;
+}
+
+void BM_official_train_step_bunny(benchmark::State& state) {
+  const Bunny* b = bunny_or_skip(state);
+  if (!b) return;
   const Index B = state.range(0);
   const auto cfg = nn::NetworkConfig::official();
   nn::Rng rng(0);
@@ -186,11 +190,8 @@ void BM_official_train_step_bunny(benchmark::State& state) {
 /// of data-parallel training (nn/batch_split.hpp) on one process, beside BM_official_train_step_bunny
 /// at the same B (the plain whole-batch step): their ratio is what the rank-independent order costs.
 void BM_trainer_step_bunny(benchmark::State& state) {
-  const Bunny* b = bunny();
-  if (!b) {
-    state.SkipWithError("bunny data not found (SIMSR_DATA_DIR/bunny)");
-    return;
-  }
+  const Bunny* b = bunny_or_skip(state);
+  if (!b) return;
   const Index B = state.range(0);
   auto cfg = nn::NetworkConfig::official();
   cfg.batch_size = B;
@@ -205,16 +206,13 @@ void BM_trainer_step_bunny(benchmark::State& state) {
 }
 
 /// The upsampling's part of one training step on the bunny (B frames): f_θ's forward and backward
-/// on the M·upK queries of the rest shapes (batch-independent) and the gather. Data-parallel
-/// training computes f_θ on every rank (its rows are not batch rows): beside
-/// BM_official_train_step_bunny at the same B this ratio is the part R ranks do not divide
-/// (the README's scaling model).
+/// on the M·upK queries of the rest shapes (batch-independent) and the gather, beside
+/// BM_official_train_step_bunny at the same B: f_θ's rows are not batch rows, so data-parallel
+/// training splits them among the ranks separately (groups of HR vertices, coordinate_upsampling.hpp);
+/// computed whole on every rank, this ratio would be the part R ranks do not divide.
 void BM_upsampling_step_bunny(benchmark::State& state) {
-  const Bunny* b = bunny();
-  if (!b) {
-    state.SkipWithError("bunny data not found (SIMSR_DATA_DIR/bunny)");
-    return;
-  }
+  const Bunny* b = bunny_or_skip(state);
+  if (!b) return;
   const Index B = state.range(0);
   const auto cfg = nn::NetworkConfig::official();
   nn::Rng rng(0);

@@ -162,8 +162,8 @@ class Learned {
       if (!options.checkpoint.empty()) trainer.save_checkpoint(options.checkpoint, model_);
     }
     history_ = trainer.history();
-    gathers_ = trainer.batch_split().gathers();
-    bytes_received_ = trainer.batch_split().bytes_received();
+    gathers_ = trainer.gathers();
+    bytes_received_ = trainer.bytes_received();
     epoch_ = trainer.epoch();
     steps_ = trainer.steps();
     batch_size_ = trainer.batch_size();

@@ -173,6 +173,8 @@ class CoordinateUpsampling {
     split_queries_ = split != nullptr;
     mlp_->set_batch_split(split ? query_split_.get() : nullptr);
   }
+  /// f_θ's row split (nullptr before the first batch split): its collectives and bytes received.
+  const BatchSplit* query_split() const { return query_split_.get(); }
   /// The fixed number of f_θ's row groups under a batch split (see set_batch_split).
   static constexpr Index query_groups = 32;
   /// Forgets the precomputed weights (call after the parameters change).

@@ -136,6 +136,16 @@ class Trainer {
 
   /// The batch split of every step (its group: TrainerOptions::group).
   const BatchSplit& batch_split() const { return split_; }
+  /// Collectives made and bytes this rank received so far in training (the batch split's, and
+  /// the upsampling's f_θ row groups'; the held-out evaluation's aside): 0 on one process.
+  std::int64_t gathers() const {
+    const BatchSplit* q = net_->upsampling().query_split();
+    return split_.gathers() + (q ? q->gathers() : 0);
+  }
+  std::int64_t bytes_received() const {
+    const BatchSplit* q = net_->upsampling().query_split();
+    return split_.bytes_received() + (q ? q->bytes_received() : 0);
+  }
 
   Index epochs() const { return opt_.epochs >= 0 ? opt_.epochs : net_->config().epochs; }
   Index batch_size() const { return std::min(opt_.batch_size > 0 ? opt_.batch_size : net_->config().batch_size, data_.frames); }
