@@ -6,7 +6,8 @@ aside) and prints its summary once; a rank killed mid-run (SIGKILL) ends the run
 finished sample file whole, and the same command resumes it to the single process's files; the
 face's two performances on two ranks give the single process's files; commands that do not
 share their work are refused under 2 ranks; training on 2 ranks writes the single process's model
-and checkpoint bit for bit, and a checkpoint resumes on the other rank count.
+and checkpoint bit for bit, a checkpoint resumes on the other rank count, and a rank killed
+mid-training leaves a whole checkpoint that resumes to the uninterrupted run's model.
 
     /usr/bin/python3 tests/cli/test_cli_mpi.py SIMSR_EXE MPIEXEC WORK_DIR ICT_KIT_DIR
 
@@ -148,6 +149,35 @@ simsr(*train, "--epochs", "1", "--out", T("half1.npz"), "--checkpoint", T("half1
 p = mpirun(*train, "--epochs", "2", "--resume", T("half1_ckpt.npz"), "--out", T("resumed_on_2.npz"))
 check(p.returncode == 0, f"mpirun -np 2 simsr train --resume: exit {p.returncode}; {p.stderr[-300:]}")
 same_arrays(T("resumed_on_2.npz"), T("single.npz"), "train: 1 process's epoch-1 checkpoint resumed on 2 ranks vs uninterrupted")
+# a rank killed mid-training: the checkpoint left is whole (atomic), and --resume from it ends
+# with the uninterrupted run's model
+long_run = [*train, "--epochs", "20"]
+simsr(*long_run, "--out", T("long_single.npz"))
+ckpt = T("killed_ckpt.npz")
+run = subprocess.Popen([*MPIRUN, SIMSR, *long_run, "--out", T("killed.npz"), "--checkpoint", ckpt], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, text=True, env=ENV)
+deadline, epoch = time.time() + 300, 0
+while run.poll() is None and time.time() < deadline and epoch < 3:
+    time.sleep(0.05)
+    try:
+        epoch = int(arrays(ckpt)["train/epoch"]) if os.path.exists(ckpt) else 0
+    except Exception:  # noqa: BLE001  (only the rename makes it appear: never torn)
+        epoch = -1
+        break
+victims = [int(pid) for pid in subprocess.run(["pgrep", "-f", "--", f"--out {T('killed.npz')}"], capture_output=True,
+                                              text=True).stdout.split() if int(pid) != run.pid]
+check(run.poll() is None and epoch >= 3 and victims, f"training still going at checkpoint epoch {epoch} ({len(victims)} rank processes)")
+if victims:
+    os.kill(victims[-1], signal.SIGKILL)
+run.communicate(timeout=300)
+check(run.returncode != 0 and not os.path.exists(T("killed.npz")), f"the killed run ends non-zero (exit {run.returncode}), no model written")
+z = arrays(ckpt)
+left = int(z["train/epoch"])
+check(3 <= left < 20, f"the checkpoint left is whole: epoch {left}")
+p = mpirun(*long_run, "--resume", ckpt, "--out", T("killed_resumed.npz"))
+check(p.returncode == 0, f"mpirun -np 2 simsr train --resume after the kill: exit {p.returncode}; {p.stderr[-300:]}")
+same_arrays(T("killed_resumed.npz"), T("long_single.npz"), f"train: killed at epoch {left}, resumed on 2 ranks vs uninterrupted on 1")
+
 p = mpirun(*train_args(4), "--epochs", "1", "--out", T("x.npz"))
 check(p.returncode != 0 and "end with a batch of 1" in p.stderr and "simsr (rank " in p.stderr,
       f"batches of 4 (the last of 1 frame) refused on 2 ranks, naming it: exit {p.returncode}; {p.stderr[-300:]}")
