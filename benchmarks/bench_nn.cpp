@@ -155,6 +155,16 @@ const Bunny* bunny_or_skip(benchmark::State& state) {
   return b;
 }
 
+/// The first B bunny frames ((B·rows)×3) as displacements from `rest_normalized`, in the network's
+/// units: dataset.py's order (positions parsed to float32, normalized in float32, the rest subtracted).
+Matrix<float> bunny_displacements(const io::NpyArray& frames, const Matrix<float>& rest_normalized, const nn::NetworkConfig& cfg, Index B) {
+  const Index rows = rest_normalized.rows();
+  Matrix<float> d(B * rows, 3);
+  for (Index f = 0; f < B; ++f)
+    nn::normalized_displacements(frames.frame_points(f), rest_normalized, cfg.norm_mean, cfg.norm_std, d.middleRows(f * rows, rows));
+  return d;
+}
+
 void BM_official_train_step_bunny(benchmark::State& state) {
   const Bunny* b = bunny_or_skip(state);
   if (!b) return;
@@ -162,13 +172,7 @@ void BM_official_train_step_bunny(benchmark::State& state) {
   const auto cfg = nn::NetworkConfig::official();
   nn::Rng rng(0);
   nn::SuperResolutionNet<float> net(cfg, b->geo, rng);
-  const Index N = net.lr_points(), M = net.hr_points();
-  // dataset.py: positions parsed to float32, normalized in float32, then the rest subtracted
-  Matrix<float> ldx(B * N, 3), hdx(B * M, 3);
-  for (Index f = 0; f < B; ++f) {
-    nn::normalized_displacements(b->low.frame_points(f), net.lr_rest_normalized(), cfg.norm_mean, cfg.norm_std, ldx.middleRows(f * N, N));
-    nn::normalized_displacements(b->high.frame_points(f), net.hr_rest_normalized(), cfg.norm_mean, cfg.norm_std, hdx.middleRows(f * M, M));
-  }
+  const Matrix<float> ldx = bunny_displacements(b->low, net.lr_rest_normalized(), cfg, B), hdx = bunny_displacements(b->high, net.hr_rest_normalized(), cfg, B);
   nn::SuperResolutionLoss<float> loss(cfg, net.hr_rest_normalized(), b->hr_faces);
   nn::Adam<float> adam(net.store(), {.lr = cfg.lr});
   Matrix<float> pred, d_pred, d_z;
@@ -217,10 +221,8 @@ void BM_upsampling_step_bunny(benchmark::State& state) {
   const auto cfg = nn::NetworkConfig::official();
   nn::Rng rng(0);
   nn::SuperResolutionNet<float> net(cfg, b->geo, rng);
-  const Index N = net.lr_points();
-  Matrix<float> ldx(B * N, 3), pred, zh, d_zh, d_z;
-  for (Index f = 0; f < B; ++f)
-    nn::normalized_displacements(b->low.frame_points(f), net.lr_rest_normalized(), cfg.norm_mean, cfg.norm_std, ldx.middleRows(f * N, N));
+  const Matrix<float> ldx = bunny_displacements(b->low, net.lr_rest_normalized(), cfg, B);
+  Matrix<float> pred, zh, d_zh, d_z;
   net.forward(exec::omp, nn::Mode::train, ldx, pred);  // the code z the upsampling reads
   const Matrix<float> z = net.code();
   auto& up = net.upsampling();

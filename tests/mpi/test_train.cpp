@@ -18,7 +18,7 @@ template <class S>
 test::RunState<S> train(const test::Problem<S>& p, nn::BatchGroup* group, Index epochs, const fs::path& checkpoint = {}) {
   nn::Rng init(5);
   nn::SuperResolutionNet<S> net(p.cfg, p.geo, init);
-  nn::Trainer<S> tr(net, p.faces, p.frames, test::options<S>(epochs, group));
+  nn::Trainer<S> tr(net, p.faces, p.frames, test::options(epochs, group));
   tr.set_holdout(p.holdout);  // 2 frames: one per rank
   tr.run(exec::omp);
   if (!checkpoint.empty()) tr.save_checkpoint(checkpoint, nn::ModelData{p.cfg, p.geo, {}, p.faces});

@@ -96,8 +96,7 @@ void check_same(const RunState<S>& a, const RunState<S>& b, const std::string& w
   CHECK(!a.values.empty());
 }
 
-template <class S>
-nn::TrainerOptions options(Index epochs, nn::BatchGroup* group) {
+inline nn::TrainerOptions options(Index epochs, nn::BatchGroup* group) {
   nn::TrainerOptions o;
   o.epochs = epochs;
   o.seed = 11;

@@ -35,7 +35,7 @@ std::vector<RunState<S>> run_ranks(const Problem<S>& p, int ranks, Index epochs)
   on_ranks(ranks, [&](int r, nn::BatchGroup* g) {
     nn::Rng init(5);
     nn::SuperResolutionNet<S> net(p.cfg, p.geo, init);
-    nn::Trainer<S> tr(net, p.faces, p.frames, options<S>(epochs, g));
+    nn::Trainer<S> tr(net, p.faces, p.frames, options(epochs, g));
     tr.set_holdout(p.holdout);
     tr.run(exec::seq);
     out[std::size_t(r)] = state_of(net, tr);
@@ -76,7 +76,7 @@ TEST_CASE("nn::Trainer with a batch split: a checkpoint of 2 ranks resumes on 1 
   on_ranks(2, [&](int, nn::BatchGroup* g) {
     nn::Rng init(5);
     nn::SuperResolutionNet<double> net(p.cfg, p.geo, init);
-    nn::Trainer<double> tr(net, p.faces, p.frames, options<double>(3, g));
+    nn::Trainer<double> tr(net, p.faces, p.frames, options(3, g));
     tr.set_holdout(p.holdout);
     tr.run_epoch(exec::seq);
     tr.save_checkpoint(ckpt, nn::ModelData{p.cfg, p.geo, {}, p.faces});  // rank 0 writes
@@ -87,7 +87,7 @@ TEST_CASE("nn::Trainer with a batch split: a checkpoint of 2 ranks resumes on 1 
     on_ranks(R, [&](int r, nn::BatchGroup* g) {
       nn::Rng init(99);  // other initial weights: the checkpoint replaces them
       nn::SuperResolutionNet<double> net(p.cfg, p.geo, init);
-      nn::Trainer<double> tr(net, p.faces, p.frames, options<double>(3, g));
+      nn::Trainer<double> tr(net, p.faces, p.frames, options(3, g));
       tr.set_holdout(p.holdout);
       tr.load_checkpoint(ckpt);
       tr.run(exec::seq);
@@ -155,8 +155,12 @@ TEST_CASE("nn::BatchSplit: refusals name what is wrong") {
   const Problem<double> p = make_problem<double>(nn::NetworkConfig::official(), 1, 10, 4);  // batches 4, 4, 2
   nn::Rng init(5);
   nn::SuperResolutionNet<double> net(p.cfg, p.geo, init);
-  CHECK_THROWS_WITH_AS(nn::Trainer<double>(net, p.faces, p.frames, options<double>(1, &groups.member(0))),
+  CHECK_THROWS_WITH_AS(nn::Trainer<double>(net, p.faces, p.frames, options(1, &groups.member(0))),
                        doctest::Contains("end with a batch of 2"), ArgumentError);
+  // f_θ's rows are split in min(32, M) groups: more ranks than groups (M = 24 here) are refused
+  test::ThreadBatchGroups many(25);
+  nn::BatchSplit wide(&many.member(0));
+  CHECK_THROWS_WITH_AS(net.set_batch_split(&wide), doctest::Contains("split in 24 groups of HR vertices, at most 24 ranks; got 25"), ArgumentError);
 }
 
 TEST_CASE("nn::BatchSplit::set_items: unequal items, item-aligned chunks over this rank's rows, rows gathered in item order") {

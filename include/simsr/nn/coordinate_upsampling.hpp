@@ -158,11 +158,13 @@ class CoordinateUpsampling {
   /// gathered, and f_θ's weight gradients and BatchNorm statistics are summed per group in group
   /// order — the same bits on any number of ranks (at most query_groups of them), one process too.
   void set_batch_split(BatchSplit* split) {
-    up_.set_batch_split(split);
-    if (kind_ == UpsamplingKind::table) return;
+    if (kind_ == UpsamplingKind::table) return up_.set_batch_split(split);
     if (split && (!query_split_ || query_split_->group() != split->group())) {
       query_split_ = std::make_unique<BatchSplit>(split->group());
       const Index M = up_.hr_points(), K = up_.neighbors(), groups = std::min(query_groups, M);
+      if (split->size() > groups)
+        throw ArgumentError("nn::CoordinateUpsampling: f_θ's query rows are split in " + std::to_string(groups) + " groups of HR vertices, at most " +
+                            std::to_string(groups) + " ranks; got " + std::to_string(split->size()));
       std::vector<Index> rows(static_cast<std::size_t>(groups));
       for (Index g = 0; g < groups; ++g) {
         const auto [b, e] = WorkShard{g, groups}.range(M);
@@ -170,6 +172,7 @@ class CoordinateUpsampling {
       }
       query_split_->set_items(rows);
     }
+    up_.set_batch_split(split);
     split_queries_ = split != nullptr;
     mlp_->set_batch_split(split ? query_split_.get() : nullptr);
   }

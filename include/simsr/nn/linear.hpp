@@ -20,22 +20,14 @@
 namespace simsr::nn {
 
 namespace detail {
-/// for_chunks with the chunks handed out one at a time to whichever worker is free (the chunks,
-/// and so the arithmetic, are the same fixed ones: only who computes which changes), which keeps
-/// both threads busy when one of them is slowed down (a loaded machine).
+/// for_chunks over `chunks` plain chunks of [0, n), handed out one at a time to whichever worker
+/// is free (for_row_chunks_dynamic, nn/batch_split.hpp).
 template <class Policy, class Body>
 void for_chunks_dynamic(Policy policy, Index n, Index chunks, Index workers, Body&& body) {
-  if (workers <= 1) {
-    exec::for_chunks(policy, n, chunks, workers, body);
-    return;
-  }
-  std::atomic<Index> next{0};
-  exec::parallel_for(policy, workers, [&](Index w) {
-    for (Index c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) {
-      const auto [b, e] = exec::chunk_range(n, chunks, c);
-      body(w, c, b, e);
-    }
-  });
+  RowChunks plain;
+  plain.rows = n;
+  plain.plain = chunks;
+  for_row_chunks_dynamic(policy, plain, workers, body);
 }
 }  // namespace detail
 

@@ -102,7 +102,7 @@ class NeighborUpsample {
     if (w_.size() == 0) throw ArgumentError("nn::NeighborUpsample: backward needs a forward first");
     const bool shared = check_weights("weights (last forward)", w_, B);
     detail::check_shape("nn::NeighborUpsample", "output gradient", d_out, B * M, C);
-    if (d_logits && shared && split_) {
+    if (d_logits && shared && split_ && split_->size() > 1) {  // one process: the loop below, the same bits
       split_logit_gradient(policy, z, d_out, *d_logits);
     } else if (d_logits) {
       const Index R = w_.rows();
@@ -142,7 +142,8 @@ class NeighborUpsample {
   }
 
   /// The batch split of data-parallel training (nullptr: none): the gradient of shared logits, a
-  /// sum over the batch items, is then summed over the global batch's items in order.
+  /// sum over the batch items, is then summed over the global batch's items in order (on one
+  /// process the loop over items already adds them in that order).
   void set_batch_split(BatchSplit* split) { split_ = split; }
 
  private:
@@ -151,7 +152,7 @@ class NeighborUpsample {
   template <class Policy>
   void split_logit_gradient(Policy policy, const ConstView<S>& z, const ConstView<S>& d_out, Matrix<S>& d_logits) {
     const Index M = idx_.rows(), K = idx_.cols(), L = split_->count();
-    split_->rows_per_item(z.rows(), "nn::NeighborUpsample");
+    split_->rows_per_item(z.rows(), "nn::NeighborUpsample");  // checks that z holds this rank's items
     ensure_shape(item_dw_, L, M * K);
     const Index nc = exec::chunk_count(M, product_chunks), workers = exec::worker_count(policy, nc);
     exec::for_chunks(policy, M, nc, workers, [&](Index, Index, Index b, Index e) {

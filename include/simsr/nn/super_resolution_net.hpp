@@ -190,8 +190,8 @@ class SuperResolutionNet {
   /// then give the whole batch's BatchNorm statistics and parameter gradients on every rank, in
   /// bits that do not depend on how many ranks share the batch. Set it for training steps only.
   void set_batch_split(BatchSplit* split) {
+    up_->set_batch_split(split);  // first: it refuses more ranks than f_θ's groups, before anything is set
     if (fe_) fe_->set_batch_split(split);
-    up_->set_batch_split(split);
     decoder_->set_batch_split(split);
   }
 
