@@ -17,8 +17,10 @@
 // remeshes the kit's outer wrap to that edge length first (needs a build with CGAL);
 // --linear-solver cholmod factors with CHOLMOD (needs a build with it).
 // Under `mpirun -np R` (a build with -DSIMSR_WITH_MPI=ON) the samples are shared over the ranks,
-// a contiguous block each (mpi/softdeca_datagen.hpp), and --scenario face's performances
-// (mpi/face_datagen.hpp): the single process's files, bitwise.
+// a contiguous block each (mpi/softdeca_datagen.hpp): the single process's files, bitwise; and
+// --scenario face's performances (mpi/face_datagen.hpp), each in --chunks contiguous chunks of
+// its frames (default: ⌈R / performances⌉) after --chunk-overlap lead-in frames: bitwise with
+// one chunk, to the solver tolerance past a chunk's lead-in otherwise.
 #include <simsr/scenario/scenario.hpp>
 #include <simsr/shell/cloth_datagen.hpp>
 #include <simsr/scenario/softdeca/softdeca_datagen.hpp>
@@ -57,6 +59,7 @@ struct DatagenArgs {
   std::uint64_t seed = 1;
   double lr_cell = 0, skull_lattice = 0, hr_max_volume = 0;
   Index checkpoint_every = 10;
+  Index chunks = 0, chunk_overlap = 2;  ///< face: chunks per performance (0: ⌈ranks / performances⌉), lead-in frames
   bool unseen_forces = true;
   bool stop_on_unconverged = false;
   Index vtk_every = 10;
@@ -179,6 +182,8 @@ inline int datagen(const DatagenArgs& a) {
   o.frames = a.frames;
   o.seed = a.seed;
   o.checkpoint_every = a.checkpoint_every;
+  o.chunks = a.chunks;
+  o.chunk_overlap = a.chunk_overlap;
   o.vtk_every = a.vtk_every;
   o.unseen_forces = a.unseen_forces;
   o.unseen_frames = a.unseen_frames;
@@ -264,6 +269,14 @@ inline void add_datagen(CLI::App& app, std::function<int()>& action) {
       ->check(CLI::Range(0, 100000));
   cmd->add_flag("!--no-unseen-forces", a->unseen_forces, "skip the LR-only unseen-force sequences (paper §5.3)");
   cmd->add_option("--checkpoint-every", a->checkpoint_every, "frames between checkpoints")->capture_default_str()->check(CLI::Range(1, 100000));
+  cmd->add_option("--chunks", a->chunks,
+                  "face: split each performance's frames into this many contiguous chunks, each a unit of work for the ranks of mpirun "
+                  "(0: ceil(ranks / performances), 1 in one process); frames past a chunk's lead-in equal one chunk's to the solver tolerance")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
+  cmd->add_option("--chunk-overlap", a->chunk_overlap, "face: lead-in frames solved, not written, before each chunk but a performance's first")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
   cmd->callback([&action, a] { action = [a] { return datagen(*a); }; });
 }
 

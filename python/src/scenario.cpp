@@ -66,7 +66,8 @@ void bind_scenario(py::module_& m) {
       "generate_face_data",
       [](const fs::path& out, const fs::path& kit, const std::string& preset, double lr_cell, double skull_lattice, double hr_max_volume,
          const std::vector<std::string>& performances, const std::vector<fs::path>& controls, Index frames, std::uint64_t seed, Index checkpoint_every,
-         Index vtk_every, bool unseen_forces, Index unseen_frames, const py::object& on_progress, const std::string& policy) {
+         Index chunks, Index chunk_overlap, Index vtk_every, bool unseen_forces, Index unseen_frames, const py::object& on_progress,
+         const std::string& policy) {
         scenario::FaceDatasetOptions o;
         o.kit = kit;
         o.model = scenario::face_model_preset(preset, lr_cell, skull_lattice, hr_max_volume);
@@ -75,6 +76,8 @@ void bind_scenario(py::module_& m) {
         o.frames = frames;
         o.seed = seed;
         o.checkpoint_every = checkpoint_every;
+        o.chunks = chunks;
+        o.chunk_overlap = chunk_overlap;
         o.vtk_every = vtk_every;
         o.unseen_forces = unseen_forces;
         o.unseen_frames = unseen_frames;
@@ -88,12 +91,13 @@ void bind_scenario(py::module_& m) {
       },
       "out"_a, py::kw_only(), "kit"_a, "preset"_a = "default", "lr_cell"_a = 0.0, "skull_lattice"_a = 0.0, "hr_max_volume"_a = 0.0,
       "performances"_a = std::vector<std::string>{"amazement", "anger", "fear", "pain"}, "controls"_a = std::vector<fs::path>{}, "frames"_a = 120,
-      "seed"_a = 1, "checkpoint_every"_a = 10, "vtk_every"_a = 10, "unseen_forces"_a = true, "unseen_frames"_a = 40, "on_progress"_a = py::none(),
+      "seed"_a = 1, "checkpoint_every"_a = 10, "chunks"_a = 0, "chunk_overlap"_a = 2, "vtk_every"_a = 10, "unseen_forces"_a = true, "unseen_frames"_a = 40, "on_progress"_a = py::none(),
       policy_arg(),
       "The core paper's face data (`simsr datagen --scenario face`): the anatomical model built from the ICT kit (preset 'default', "
       "'paper-ratio' or 'paper-lr'; lr_cell / skull_lattice in cm and hr_max_volume in cm^3 override it when > 0), each built-in "
       "performance (frames each, seed) and each controls file (.npz: names, weights F x C) simulated at both resolutions into out/"
-      "<name>.npz, VTU series every vtk_every frames (0: none), the LR-only unseen-force frames. on_progress(line) receives the "
+      "<name>.npz (each performance's frames in `chunks` contiguous chunks after `chunk_overlap` lead-in frames; 0: one), VTU series every "
+      "vtk_every frames (0: none), the LR-only unseen-force frames. on_progress(line) receives the "
       "progress lines. Resumable: a rerun continues a killed run and reuses finished performances. Returns the summary "
       "(out/face_data.json) as a dict.");
 

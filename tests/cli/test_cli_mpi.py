@@ -4,7 +4,8 @@ build with -DSIMSR_WITH_MPI=ON):
 the 2-rank run writes the single process's files (every array equal, the wall-clock seconds
 aside) and prints its summary once; a rank killed mid-run (SIGKILL) ends the run with every
 finished sample file whole, and the same command resumes it to the single process's files; the
-face's two performances on two ranks give the single process's files; commands that do not
+face's performances on two ranks, one of them in two chunks of its frames, give the single
+process's files; commands that do not
 share their work are refused under 2 ranks; training on 2 ranks writes the single process's model
 and checkpoint bit for bit, a checkpoint resumes on the other rank count, and a rank killed
 mid-training leaves a whole checkpoint that resumes to the uninterrupted run's model.
@@ -182,10 +183,13 @@ p = mpirun(*train_args(4), "--epochs", "1", "--out", T("x.npz"))
 check(p.returncode != 0 and "end with a batch of 1" in p.stderr and "simsr (rank " in p.stderr,
       f"batches of 4 (the last of 1 frame) refused on 2 ranks, naming it: exit {p.returncode}; {p.stderr[-300:]}")
 
-# 5. the face by performance: two controls files (one frame each) on the coarse model
+# 5. the face over 2 ranks on the coarse model: a 1-frame performance whole (fewer frames than
+# chunks) and a 2-frame one in 2 chunks (--chunks 2) after a 1-frame lead-in, which reaches frame 0
+# (so every frame is the single process's, bitwise). Units jaw, smile[0,1) | smile[1,2): rank 0
+# the first two, rank 1 the third, so smile's chunks are simulated on different ranks.
 if not (os.path.exists(os.path.join(KIT, "full_neutral.obj")) and shutil.which("tetgen")):
     missing_peer(f"the ICT kit ({KIT}) or the tetgen program")
-for name, weights in (("smile", [[0.6, 0.6]]), ("jaw", [[0.3]])):  # one frame each: the HR solves are the cost
+for name, weights in (("smile", [[0.3, 0.3], [0.6, 0.6]]), ("jaw", [[0.3]])):  # few frames: the HR solves are the cost
     names = ["mouthSmile_L", "mouthSmile_R"] if name == "smile" else ["jawOpen"]
     np.savez(os.path.join(WORK, f"{name}_controls.npz"), names=np.array(names), weights=np.array(weights))
 def face_args(*performances):
@@ -194,21 +198,35 @@ def face_args(*performances):
             "--hr-max-volume", "1", "--vtk-every", "0", "--no-unseen-forces"]
 
 
-face = face_args("smile", "jaw")
-p = mpirun(*face, "--out", os.path.join(WORK, "face_ranks"))
-check(p.returncode == 0, f"mpirun -np 2 simsr datagen --scenario face: exit {p.returncode}; stderr: {p.stderr[-600:]}")
+face = face_args("jaw", "smile")
+p = mpirun(*face, "--chunks", "2", "--chunk-overlap", "1", "--out", os.path.join(WORK, "face_ranks"))
+check(p.returncode == 0, f"mpirun -np 2 simsr datagen --scenario face --chunks 2: exit {p.returncode}; stderr: {p.stderr[-600:]}")
 lines = [l for l in p.stdout.splitlines() if l.strip()]
-check(len(lines) == 1 and json.loads(lines[0]).get("ranks") == 2, "the face summary printed once, with its ranks")
-check("(rank 1 of 2)" in p.stderr and "datagen: jaw" in p.stderr, "rank 1's progress lines: the second performance")
-# the single process, for rank 1's performance alone (a performance's file depends on the model,
-# the settled neutral and its controls only), from the ranks' settled neutral (its fingerprint
-# matches: read, not solved again; each HR solve is ~20 s here)
+summary = json.loads(lines[0]) if len(lines) == 1 else {}
+check(summary.get("ranks") == 2 and summary.get("chunks_per_performance") == 2 and summary.get("chunk_overlap") == 1,
+      f"the face summary printed once, with its ranks and chunks: {lines[:1]}")
+perf = {q["name"]: q for q in summary.get("performances", [])}
+check(perf.get("smile", {}).get("chunks") == 2 and perf["smile"].get("lead_in_frames_solved") == 1 and perf["smile"].get("simulated") == 2,
+      f"smile: 2 chunks, 1 lead-in frame, 2 frames simulated, added over the ranks: {perf.get('smile')}")
+check(perf.get("jaw", {}).get("simulated") == 1 and "chunks" not in perf["jaw"], f"jaw: one frame, whole: {perf.get('jaw')}")
+rank1 = [l for l in p.stderr.splitlines() if l.endswith("(rank 1 of 2)")]
+check(any(l.startswith("datagen: smile      lead-in    1/2") for l in rank1) and any(l.startswith("datagen: smile      frame    2/2") for l in rank1)
+      and not any(l.startswith("datagen: jaw") for l in rank1), "rank 1's progress lines: smile's lead-in and its second frame, no jaw")
+check(not glob.glob(os.path.join(WORK, "face_ranks", ".state", "smile.chunk*")), "the chunk parts removed once assembled")
+# the single process, smile whole, from the ranks' settled neutral (its fingerprint matches: read,
+# not solved again; each HR solve is ~20 s here)
 alone = os.path.join(WORK, "face_single")
 os.makedirs(os.path.join(alone, ".state"))
 shutil.copy(os.path.join(WORK, "face_ranks", ".state", "neutral.npz"), os.path.join(alone, ".state", "neutral.npz"))
-simsr(*face_args("jaw"), "--out", alone)
-for name in ("jaw.npz", "jaw_controls.npz", "hr_lips.npz"):
+simsr(*face_args("smile"), "--out", alone)
+x, y = arrays(os.path.join(WORK, "face_ranks", "smile.npz")), arrays(os.path.join(alone, "smile.npz"))
+check(x.keys() - y.keys() == {"chunk_first_frames", "chunk_overlap"} and not y.keys() - x.keys(), f"smile: the chunked file's arrays: {sorted(x.keys())}")
+check(list(x.get("chunk_first_frames", [])) == [0, 1] and int(x.get("chunk_overlap", -1)) == 1, "smile: its chunks recorded")
+check(all(np.array_equal(x[k], y[k]) for k in y), "face: smile.npz of 2 ranks in 2 chunks = the single process's, every array bitwise")
+for name in ("smile_controls.npz", "hr_lips.npz"):
     x, y = arrays(os.path.join(WORK, "face_ranks", name)), arrays(os.path.join(alone, name))
     check(x.keys() == y.keys() and all(np.array_equal(x[k], y[k]) for k in x), f"face: {name} of 2 ranks = the single process's")
+p = mpirun(*face, "--chunks", "-1", "--out", os.path.join(WORK, "face_bad"))
+check(p.returncode != 0 and "--chunks" in p.stderr, f"--chunks -1 refused, naming it: {p.stderr[-300:]}")
 
 finish()

@@ -471,5 +471,128 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
     CHECK(e.find("gentle.npz") != std::string::npos);
     CHECK(e.find("hr_lip_pairs") != std::string::npos);
   }
+
+  // In chunks (what `mpirun` uses when ranks outnumber performances): 2 chunks after 1 lead-in
+  // frame, [0, 2) and [2, 4) from frame 1, each its own shard, then the whole list assembles.
+  // Against the uninterrupted whole run above: chunk 0 bitwise; chunk 1 the same equilibria to
+  // the solver tolerance.
+  {
+    ScratchDir chunked("simsr_test_datagen_chunked");
+    std::filesystem::create_directories(chunked.path / ".state");
+    std::filesystem::copy_file(whole.path / ".state" / "neutral.npz", chunked.path / ".state" / "neutral.npz");
+    scenario::FaceDatagenOptions c;
+    c.chunks = 2;
+    c.chunk_overlap = 1;
+    c.checkpoint_every = 1;
+    const auto units = scenario::face_chunks(perfs, c.chunks, c.chunk_overlap);
+    REQUIRE(units.size() == 2);
+    CHECK((units[0].first == 0 && units[0].last == 2 && units[0].lead_in == 0 && units[0].count == 2));
+    CHECK((units[1].first == 2 && units[1].last == 4 && units[1].lead_in == 1 && units[1].index == 1));
+    CHECK(scenario::face_chunks(perfs, 9, 2).size() == std::size_t(frames));  // at most one chunk per frame
+    CHECK(scenario::face_chunks(perfs, 2, 5)[1].lead_in == 0);               // an overlap past the start: from frame 0
+    CHECK_THROWS_AS(scenario::face_chunks(perfs, 0, 1), ArgumentError);
+    CHECK_THROWS_AS(scenario::face_chunks(perfs, 2, -1), ArgumentError);
+    CHECK(scenario::chunks_for_shards(2, 1) == 2);
+    CHECK(scenario::chunks_for_shards(3, 2) == 2);
+    CHECK(scenario::chunks_for_shards(2, 4) == 1);
+
+    std::vector<Index> written, lead_ins;
+    Index kill = 1;
+    c.on_frame = [&](const std::string&, Index f, Index, const physics::NewtonReport&, const physics::NewtonReport&, double, double) {
+      written.push_back(f);
+      if (f == kill) throw std::runtime_error("killed");
+    };
+    c.on_lead_in = [&](const std::string&, Index f, Index first, const physics::NewtonReport&, const physics::NewtonReport&, double, double) {
+      CHECK(first == 2);
+      lead_ins.push_back(f);
+    };
+    // shard 0 (chunk 0) killed at frame 1: its checkpoint after frame 0 is there, nothing else
+    c.shard = {0, 2};
+    CHECK_THROWS_AS(scenario::generate_face_data(exec::omp, face, perfs, chunked.path, c), std::runtime_error);
+    CHECK(std::filesystem::exists(chunked.path / ".state" / "gentle.chunk0of2.partial.npz"));
+    CHECK_FALSE(std::filesystem::exists(chunked.path / ".state" / "gentle.chunk0of2.npz"));
+    kill = -1;
+    const auto s0 = scenario::generate_face_data(exec::omp, face, perfs, chunked.path, c);  // resumed: frame 1 only
+    REQUIRE(s0.size() == 1);
+    CHECK(s0[0].simulated == 1);
+    CHECK(s0[0].chunks == 2);
+    CHECK(s0[0].lr_hr_mean_distance == 0);  // a part of the performance: no figures of the whole
+    CHECK(std::filesystem::exists(chunked.path / ".state" / "gentle.chunk0of2.npz"));
+    CHECK_FALSE(std::filesystem::exists(chunked.path / ".state" / "gentle.chunk0of2.partial.npz"));
+    CHECK_FALSE(std::filesystem::exists(chunked.path / "gentle.npz"));  // only the whole list assembles
+    // another chunking's checkpoint under this chunk's name is refused
+    c.shard = {1, 2};
+    {
+      const auto stray = chunked.path / ".state" / "gentle.chunk1of2.partial.npz";
+      std::filesystem::copy_file(chunked.path / ".state" / "gentle.chunk0of2.npz", stray);
+      CHECK(test::error_of([&] { scenario::generate_face_data(exec::omp, face, perfs, chunked.path, c); }).find("another run") != std::string::npos);
+      std::filesystem::remove(stray);
+    }
+    // shard 1 (chunk 1): frame 1 solved as its lead-in, not written; frames 2 and 3 written
+    const auto s1 = scenario::generate_face_data(exec::omp, face, perfs, chunked.path, c);
+    CHECK(lead_ins == std::vector<Index>{1});
+    CHECK(written == std::vector<Index>{0, 1, 1, 2, 3});  // frame 1 lost to the kill once
+    REQUIRE(s1.size() == 1);
+    CHECK(s1[0].simulated == 2);
+    CHECK(s1[0].lead_in_frames == 1);
+    CHECK(s1[0].lead_in_seconds > 0);
+    // the whole list: nothing simulated, the two parts assembled into the performance's file and removed
+    c.shard = {};
+    const auto s = scenario::generate_face_data(exec::omp, face, perfs, chunked.path, c);
+    REQUIRE(s.size() == 1);
+    CHECK(s[0].simulated == 0);
+    CHECK_FALSE(s[0].reused);
+    CHECK(s[0].lip_intersecting_frames == 0);
+    CHECK(s[0].lr_hr_mean_distance == doctest::Approx(stats[0].lr_hr_mean_distance).epsilon(1e-3));
+    CHECK(written.size() == 5);
+    for (const char* part : {"gentle.chunk0of2.npz", "gentle.chunk1of2.npz"}) CHECK_FALSE(std::filesystem::exists(chunked.path / ".state" / part));
+    const auto z = io::read_npz(chunked.path / "gentle.npz");
+    CHECK(z.at("chunk_first_frames").to_vector<std::int64_t>() == std::vector<std::int64_t>{0, 2});
+    CHECK(z.at("chunk_overlap").item<std::int64_t>() == 1);
+    CHECK(io::fingerprint_of(z) == io::fingerprint_of(io::read_npz(whole.path / "gentle.npz")));  // the same run: any chunking reuses it
+    const auto C = data::read_paired_frames(chunked.path / "gentle.npz");
+    CHECK(C.controls == frames_read.controls);
+    CHECK(C.lowres.topRows(2) == frames_read.lowres.topRows(2));  // chunk 0: the whole run's solves, bitwise
+    CHECK(C.highres.topRows(2) == frames_read.highres.topRows(2));
+    // chunk 1: another warm start (frame 1 reached from the neutral in one solve), the same
+    // equilibria. At LR, where the file holds every vertex, both runs' frames polished by tight
+    // Newton solves land on one point (within 10 nm, and a hundredth of how far apart the frames
+    // were: the difference is the default tolerance's); each default-tolerance frame lies within the 20 µm
+    // of its tight solve that the tolerance case above proves, so the two within 40 µm. At HR
+    // (the surface only in the file), the same 40 µm.
+    scenario::FaceSimulationOptions tight;
+    tight.newton.relative_tolerance = 1e-10;
+    tight.newton.absolute_tolerance = 1e-5;
+    tight.newton.max_iterations = 60;
+    tight.linear.tolerance = 1e-8;
+    scenario::FaceSimulator<> polish(exec::omp, face, scenario::FaceResolution::low, tight);
+    double lr_apart = 0, hr_apart = 0, polished_apart = 0, motion = 0;
+    for (Index f = 2; f < frames; ++f) {
+      polish.set_controls(scenario::face_controls(perfs[0], f, face));
+      polish.set_positions(frames_read.lr(f));
+      polish.step(exec::omp);
+      const Points<> a = polish.positions();
+      polish.set_positions(C.lr(f));
+      polish.step(exec::omp);
+      polished_apart = std::max(polished_apart, (polish.positions() - a).rowwise().norm().maxCoeff());
+      lr_apart = std::max(lr_apart, (C.lr(f) - frames_read.lr(f)).rowwise().norm().maxCoeff());
+      hr_apart = std::max(hr_apart, (C.hr(f) - frames_read.hr(f)).rowwise().norm().maxCoeff());
+      motion = std::max(motion, (frames_read.hr(f) - face.surface.V).rowwise().norm().maxCoeff());
+    }
+    MESSAGE("chunk 1 of 2 after a 1-frame lead-in vs the whole run: LR at most " << lr_apart * 1e6 << " µm apart (polished: " << polished_apart * 1e9
+                                                                                 << " nm), HR skin " << hr_apart * 1e6 << " µm; largest skin motion "
+                                                                                 << motion * 1e3 << " mm");
+    CHECK(motion > 1e-3);
+    CHECK(lr_apart > 0);  // not the same solves: the test would not see the tolerance otherwise
+    CHECK(polished_apart < 1e-8);
+    CHECK(polished_apart < 1e-2 * lr_apart);
+    CHECK(lr_apart < 4e-5);
+    CHECK(hr_apart < 4e-5);
+    // a run of one chunk reuses the chunked file (the same run); one of 3 chunks too
+    c.chunks = 1;
+    CHECK(scenario::generate_face_data(exec::omp, face, perfs, chunked.path, c)[0].reused);
+    c.chunks = 3;
+    CHECK(scenario::generate_face_data(exec::omp, face, perfs, chunked.path, c)[0].reused);
+  }
 }
 #endif

@@ -28,6 +28,24 @@
 /// built-in performances (the contact holds the lips apart where the kit's own neutral has them
 /// crossing, see face_simulator.hpp); a count, not an error, so that a user's performance that
 /// presses the lips harder than the penalty holds is still written and reported.
+///
+/// Chunks (FaceDatagenOptions::chunks, so that more processes than performances share a run):
+/// each performance's frames split into K contiguous chunks, each a unit of work. A chunk [a, b)
+/// starts from the settled neutral at frame a − w (w = chunk_overlap, 2 by default; at frame 0 if
+/// a ≤ w) and solves the w lead-in frames a − w … a − 1 without writing them: the first lead-in
+/// frame is reached from the neutral in one solve (by continuation where Newton alone fails), and
+/// the next w − 1 give frame a the warm start a whole run gives it, the extrapolation of two solved
+/// frames. The lead-in frames are the chunk's extra cost (w frames per chunk after the first).
+/// Frames of a chunk whose lead-in starts at frame 0 equal the whole run's bitwise (the same
+/// solves from the same state); the others are the same equilibria to the solver tolerance, not
+/// bitwise: a quasistatic frame is the equilibrium of its own controls, which Newton reaches from
+/// either warm start to its tolerance (tests/scenario/test_face_datagen.cpp measures how far
+/// apart). A finished chunk is written atomically to DIR/.state/<performance>.chunk<c>of<K>.npz
+/// (its checkpoints to ….partial.npz); the process that runs the whole list (shard 0 of 1)
+/// assembles a performance's chunks into DIR/<performance>.npz, which then records the chunks'
+/// first frames (`chunk_first_frames`) and the overlap. A performance file keeps its
+/// performance's fingerprint whatever the chunks (any chunking is the same run to the solver
+/// tolerance), so a rerun with other chunks reuses a finished file.
 
 #include <algorithm>
 #include <chrono>
@@ -65,12 +83,58 @@ struct FaceDatagenOptions {
   /// Called after every frame: performance, frame, frames of it, the two reports, seconds of the
   /// frame (LR, HR). Progress lines and ETA live in the caller.
   std::function<void(const std::string&, Index, Index, const physics::NewtonReport&, const physics::NewtonReport&, double, double)> on_frame;
-  /// The performances this process simulates: shard `index` of `count`, a contiguous block of the
-  /// list (WorkShard::range); the others are neither simulated nor checked. Each performance
-  /// starts from the settled neutral, so a shard's files equal the whole run's bitwise
-  /// (simsr::mpi::generate_face_dataset gives each rank one). Not part of any fingerprint.
+  /// Contiguous chunks per performance (file comment; fewer where a performance has fewer
+  /// frames). 1: every performance is one unit, solved from its first frame on.
+  Index chunks = 1;
+  /// Lead-in frames solved before a chunk's first frame and not written (file comment).
+  Index chunk_overlap = 2;
+  /// Called after every lead-in frame: performance, frame, the chunk's first frame, the two
+  /// reports, seconds of the frame (LR, HR).
+  std::function<void(const std::string&, Index, Index, const physics::NewtonReport&, const physics::NewtonReport&, double, double)> on_lead_in;
+  /// The units this process simulates: shard `index` of `count`, a contiguous block of the list of
+  /// (performance, chunk) units (face_chunks; with one chunk each, of the performances); the
+  /// others are neither simulated nor checked. Every unit starts from the settled neutral, so a
+  /// shard's files are those of the whole run with the same chunks, bitwise
+  /// (simsr::mpi::generate_face_dataset gives each rank one). Not part of any fingerprint. Only
+  /// the whole list (one shard) assembles chunks into performance files.
   WorkShard shard;
 };
+
+/// One unit of a face run's work: frames [first, last) of performance `performance`, its chunk
+/// `index` of `count`, solved from the settled neutral at frame `lead_in` ≤ first (the frames
+/// before `first` are the unwritten warm-start overlap).
+struct FaceChunk {
+  Index performance = 0, index = 0, count = 1, first = 0, last = 0, lead_in = 0;
+  bool whole() const { return count == 1; }
+  Index frames() const { return last - first; }
+};
+
+/// The units of a run, in order: each performance's frames in min(chunks, F) contiguous chunks
+/// (WorkShard::range over its F frames), each chunk after `overlap` lead-in frames (from frame 0
+/// where its first frame is ≤ overlap). ArgumentError for chunks < 1, overlap < 0 or a performance
+/// without frames.
+inline std::vector<FaceChunk> face_chunks(const std::vector<Performance>& performances, Index chunks, Index overlap) {
+  if (chunks < 1) throw ArgumentError("face datagen: chunks per performance = " + std::to_string(chunks) + " (need >= 1)");
+  if (overlap < 0) throw ArgumentError("face datagen: chunk overlap = " + std::to_string(overlap) + " frames (need >= 0)");
+  std::vector<FaceChunk> units;
+  for (std::size_t p = 0; p < performances.size(); ++p) {
+    const Index F = performances[p].num_frames();
+    if (F < 1) throw ArgumentError("face datagen: performance '" + performances[p].name + "' has no frames");
+    const Index K = std::min(chunks, F);
+    for (Index c = 0; c < K; ++c) {
+      const auto [a, b] = WorkShard{c, K}.range(F);
+      units.push_back({Index(p), c, K, a, b, std::max<Index>(0, a - overlap)});
+    }
+  }
+  return units;
+}
+
+/// The chunks per performance that give each of `shards` processes at least one unit:
+/// ⌈shards / performances⌉ (1 for one shard).
+inline Index chunks_for_shards(Index shards, Index performances) {
+  if (shards < 1 || performances < 1) return 1;
+  return (shards + performances - 1) / performances;
+}
 
 /// Per-performance figures of a run.
 struct PerformanceStats {
@@ -80,6 +144,9 @@ struct PerformanceStats {
   Index lr_iterations = 0, hr_iterations = 0;
   Index simulated = 0;                     ///< frames simulated in this run (the rest were resumed or reused)
   bool reused = false;                     ///< the finished file was there already
+  Index chunks = 1;                        ///< the units its frames were split into
+  Index lead_in_frames = 0;                ///< lead-in frames solved in this run (chunks after the first; not written)
+  double lead_in_seconds = 0;              ///< their LR + HR seconds
   Index lip_intersecting_frames = 0;       ///< HR frames whose upper and lower lip triangles intersect (all frames: the files keep the counts)
   Index lip_max_pairs = 0;                 ///< the most intersecting triangle pairs in one frame
   /// Fig. 4's discrepancy over all the performance's frames (resumed and reused ones included), m:
@@ -217,33 +284,151 @@ inline void write_face_rest_shapes(const FaceModel& face, const std::filesystem:
   data::write_contact_patches(dir / "hr_lips.npz", face_lip_patches(face), face.surface.num_vertices());
 }
 
-/// Simulates `performances` on `face` into `dir` (see the file comment), or the block of them
-/// `opt.shard` names. Returns the figures of this run, one per performance simulated or reused.
+namespace detail {
+
+/// The fingerprint of chunk `u` of a performance whose own fingerprint is `print` (a chunk's
+/// frames depend on where its lead-in starts as well).
+inline std::string face_chunk_fingerprint(const std::string& print, const FaceChunk& u) {
+  if (u.whole()) return print;
+  Fingerprint f;
+  f.add_bytes(print.data(), print.size()).add(u.first).add(u.last).add(u.lead_in).add(u.count);
+  return f.hex();
+}
+
+/// DIR/.state/<performance>.chunk<c>of<K>.npz (`partial`: its checkpoint, ….partial.npz); a whole
+/// performance's checkpoint is DIR/.state/<performance>.npz and it has no part file.
+inline std::filesystem::path face_chunk_file(const std::filesystem::path& state, const std::string& name, const FaceChunk& u, bool partial) {
+  if (u.whole()) return state / (name + ".npz");
+  return state / (name + ".chunk" + std::to_string(u.index) + "of" + std::to_string(u.count) + (partial ? ".partial.npz" : ".npz"));
+}
+
+/// Solves unit `u` of `perf` (file comment): from the settled neutral (lr_neutral, hr_neutral,
+/// under zero controls) at frame u.lead_in, or from `checkpoint` (read from `partial`, of
+/// fingerprint `print`), into `out` (u.frames() frames) and `lip_pairs` (one per frame of `out`),
+/// checkpointing to `partial` every opt.checkpoint_every written frames; figures added to `st`.
+template <class Linear, class P>
+void simulate_face_chunk(P policy, const FaceModel& face, const Performance& perf, const FaceChunk& u, FaceSimulator<Linear>& lr, FaceSimulator<Linear>& hr,
+                         const Points<>& lr_neutral, const Points<>& hr_neutral, const io::NpzArrays* checkpoint, const std::filesystem::path& partial,
+                         const std::string& print, const FaceDatagenOptions& opt, PerformanceStats& st, data::PairedFrames<>& out,
+                         std::vector<std::int64_t>& lip_pairs) {
+  const Index F = perf.num_frames(), N = face.lr.num_vertices(), n = u.frames();
+  const FaceControls zero = neutral_controls(face);
+  Index start = u.lead_in;  // the first frame solved here
+  // positions are taken as solved under the controls set before them (continuation walks from
+  // those): the neutral under zero controls, a checkpoint under its last frame's
+  lr.set_controls(zero);
+  hr.set_controls(zero);
+  lr.set_positions(lr_neutral);
+  hr.set_positions(hr_neutral);
+  if (checkpoint) {
+    const io::NpzArrays& z = *checkpoint;
+    start = u.first + data::resume_frames(z, partial.string(), out);
+    const auto lips = lip_pairs_of(z, start - u.first, partial.string());
+    std::copy(lips.begin(), lips.end(), lip_pairs.begin());
+    const Points<> lx = io::points_of(z, "lr_state", N, partial.string()), hx = io::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
+    const FaceControls last = face_controls(perf, start - 1, face);
+    lr.set_controls(last);
+    hr.set_controls(last);
+    // the frame before the last: as the uninterrupted run had it (the neutral before the first
+    // frame solved)
+    const bool neutral_before = start - 1 == u.lead_in;
+    const FaceControls before = neutral_before ? zero : face_controls(perf, start - 2, face);
+    lr.set_positions(neutral_before ? lr_neutral : io::points_of(z, "lr_before", N, partial.string()), before, lx);
+    hr.set_positions(neutral_before ? hr_neutral : io::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()), before, hx);
+  }
+  Points<> lr_before = lr.positions(), hr_before = hr.positions();
+  for (Index f = start; f < u.last; ++f) {
+    const FaceControls c = face_controls(perf, f, face);
+    lr.set_controls(c);
+    hr.set_controls(c);
+    lr_before = lr.positions();
+    hr_before = hr.positions();
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto rl = solve_frame(policy, lr, perf.name, f);
+    const auto t1 = std::chrono::steady_clock::now();
+    const auto rh = solve_frame(policy, hr, perf.name, f);
+    const auto t2 = std::chrono::steady_clock::now();
+    const double sl = std::chrono::duration<double>(t1 - t0).count(), sh = std::chrono::duration<double>(t2 - t1).count();
+    if (f < u.first) {  // the lead-in: solved, not written
+      ++st.lead_in_frames;
+      st.lead_in_seconds += sl + sh;
+      if (opt.on_lead_in) opt.on_lead_in(perf.name, f, u.first, rl, rh, sl, sh);
+      continue;
+    }
+    const Index row = f - u.first;
+    lip_pairs[std::size_t(row)] = std::int64_t(intersecting_lip_pairs(face, hr.positions()).size());
+    out.lr(row) = lr.positions();
+    out.hr(row) = hr.surface(policy);
+    st.lr_seconds += sl;
+    st.hr_seconds += sh;
+    st.lr_iterations += rl.iterations;
+    st.hr_iterations += rh.iterations;
+    ++st.simulated;
+    if (opt.on_frame) opt.on_frame(perf.name, f, F, rl, rh, sl, sh);
+    const Index done = row + 1;
+    if (done < n && done % opt.checkpoint_every == 0) {
+      io::NpzArrays z = data::frames_checkpoint(out, done, print);
+      z["lr_state"] = io::make_npy(lr.positions());
+      z["hr_state"] = io::make_npy(hr.positions());
+      z["lr_before"] = io::make_npy(lr_before);
+      z["hr_before"] = io::make_npy(hr_before);
+      z["hr_lip_pairs"] = io::make_npy<std::int64_t>({done}, lip_pairs.data());
+      io::write_npz(partial, z);
+    }
+  }
+}
+
+/// Writes a performance's file (atomically) and its controls file.
+inline void write_performance_file(const std::filesystem::path& dir, const Performance& perf, const data::PairedFrames<>& frames,
+                                   const std::vector<std::int64_t>& lip_pairs, const std::string& print, const io::NpzArrays& extra = {}) {
+  const Index F = perf.num_frames();
+  auto arrays = data::paired_frame_arrays(frames);
+  io::set_fingerprint(arrays, print);
+  arrays["hr_lip_pairs"] = io::make_npy<std::int64_t>({F}, lip_pairs.data());
+  arrays["control_names"] = io::make_npy(perf.names);
+  for (const auto& [name, a] : extra) arrays[name] = a;
+  io::write_npz(dir / (perf.name + ".npz"), arrays);
+  io::NpzArrays ctl;
+  ctl["names"] = io::make_npy(perf.names);
+  ctl["weights"] = io::make_npy(perf.weights);
+  io::write_npz(dir / (perf.name + "_controls.npz"), ctl);
+}
+
+}  // namespace detail
+
+/// Simulates `performances` on `face` into `dir` (see the file comment), in opt.chunks chunks
+/// each, or the block of those units `opt.shard` names. Returns the figures of this run, one per
+/// performance with a unit in the block (simulated, resumed or reused), in order; a performance
+/// only part of whose chunks are in the block has no discrepancy or lip figures (they need all
+/// its frames: the whole list's pass measures them when it assembles the file).
 template <class Linear = physics::ConjugateGradient<physics::Multigrid<>>, exec::HostPolicy P>
 std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face, const std::vector<Performance>& performances,
                                                  const std::filesystem::path& dir, const FaceDatagenOptions& opt = {}) {
   if (opt.checkpoint_every < 1) throw ArgumentError("generate_face_data: checkpoint_every must be ≥ 1");
   opt.shard.check("generate_face_data");
-  const auto [first_performance, last_performance] = opt.shard.range(Index(performances.size()));
-  const std::vector<Performance> mine(performances.begin() + first_performance, performances.begin() + last_performance);
-  const auto state = dir / ".state";
-  // every performance checked, and another run's checkpoint refused, before anything is written
-  // or solved; the checkpoints read here are the ones resumed below
-  std::vector<std::string> prints;
-  std::vector<std::optional<io::NpzArrays>> checkpoints;
-  for (const auto& p : mine) {
+  for (const auto& p : performances)
     if (p.name.empty() || p.name.find_first_of("/\\. ") != std::string::npos)
       throw ArgumentError("generate_face_data: performance name '" + p.name + "' cannot be a file name");
-    if (p.num_frames() < 1) throw ArgumentError("generate_face_data: performance '" + p.name + "' has no frames");
-    prints.push_back(detail::face_run_fingerprint(face, opt.simulation, &p));
-    const auto partial = state / (p.name + ".npz");
-    checkpoints.emplace_back();
+  const std::vector<FaceChunk> units = face_chunks(performances, opt.chunks, opt.chunk_overlap);
+  const auto [first_unit, last_unit] = opt.shard.range(Index(units.size()));
+  const auto state = dir / ".state";
+  // every unit's performance fingerprinted, and another run's checkpoint refused, before anything
+  // is written or solved; the checkpoints read here are the ones resumed below
+  std::vector<std::string> prints(performances.size());
+  std::vector<std::optional<io::NpzArrays>> checkpoints(std::size_t(last_unit - first_unit));
+  for (Index i = first_unit; i < last_unit; ++i) {
+    const FaceChunk& u = units[std::size_t(i)];
+    const Performance& p = performances[std::size_t(u.performance)];
+    std::string& print = prints[std::size_t(u.performance)];
+    if (print.empty()) print = detail::face_run_fingerprint(face, opt.simulation, &p);
+    const auto partial = detail::face_chunk_file(state, p.name, u, true);
     if (!std::filesystem::exists(partial)) continue;
-    checkpoints.back() = io::read_npz(partial);
-    if (io::fingerprint_of(*checkpoints.back()) != prints.back())
-      throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options or controls): remove it or use another directory");
+    auto& z = checkpoints[std::size_t(i - first_unit)];
+    z = io::read_npz(partial);
+    if (io::fingerprint_of(*z) != detail::face_chunk_fingerprint(print, u))
+      throw ArgumentError(partial.string() + " is a checkpoint of another run (other meshes, options, controls or chunks): remove it or use another directory");
   }
-  if (mine.empty()) return {};  // a shard with no performance (more shards than performances)
+  if (first_unit == last_unit) return {};  // a shard with no unit (more shards than units)
   std::filesystem::create_directories(state);
   write_face_rest_shapes(face, dir);
   const std::string model_print = detail::face_run_fingerprint(face, opt.simulation, nullptr);
@@ -251,7 +436,7 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
   FaceSimulator<Linear> lr(policy, face, FaceResolution::low, opt.simulation);
   FaceSimulator<Linear> hr(policy, face, FaceResolution::high, opt.simulation);
 
-  // the settled neutral, shared by every performance's first frame
+  // the settled neutral, shared by every unit's first frame
   Points<> lr_neutral, hr_neutral;
   const auto neutral_file = state / "neutral.npz";
   bool have_neutral = false;
@@ -278,98 +463,101 @@ std::vector<PerformanceStats> generate_face_data(P policy, const FaceModel& face
     io::write_npz(neutral_file, z);
   }
 
-  std::vector<PerformanceStats> stats;
-  for (std::size_t pi = 0; pi < mine.size(); ++pi) {
-    const Performance& perf = mine[pi];
-    const Index F = perf.num_frames(), N = face.lr.num_vertices(), M = face.surface.num_vertices();
-    PerformanceStats st;
-    st.name = perf.name;
-    st.frames = F;
-    const std::string& print = prints[pi];
-    const auto final_file = dir / (perf.name + ".npz");
-    const auto partial = state / (perf.name + ".npz");
-    // a finished file of this very run: reuse
-    if (std::filesystem::exists(final_file)) {
-      const auto z = io::read_npz(final_file);
-      if (io::fingerprint_of(z) == print) {
-        st.reused = true;
-        detail::count_lip_frames(detail::lip_pairs_of(z, F, final_file.string()), st);
-        measure_discrepancy(policy, face, data::read_paired_frames(final_file, N, M), st);
-        stats.push_back(st);
-        continue;
-      }
-    }
-    data::PairedFrames<> out = data::PairedFrames<>::one_sequence(F, N, M, perf.name);
-    out.controls = perf.weights;
-    Index start = 0;
-    std::vector<std::int64_t> lip_pairs(std::size_t(F), 0);  // per frame: intersecting lip triangle pairs at HR
-    // positions are taken as solved under the controls set before them (continuation walks from
-    // those): the neutral under zero controls, a checkpoint under its last frame's
-    lr.set_controls(zero);
-    hr.set_controls(zero);
-    lr.set_positions(lr_neutral);
-    hr.set_positions(hr_neutral);
-    if (checkpoints[pi]) {
-      const io::NpzArrays& z = *checkpoints[pi];
-      start = data::resume_frames(z, partial.string(), out);
-      const auto lips = detail::lip_pairs_of(z, start, partial.string());
-      std::copy(lips.begin(), lips.end(), lip_pairs.begin());
-      const Points<> lx = io::points_of(z, "lr_state", N, partial.string()), hx = io::points_of(z, "hr_state", face.hr.num_vertices(), partial.string());
-      const FaceControls last = face_controls(perf, start - 1, face);
-      lr.set_controls(last);
-      hr.set_controls(last);
-      // the frame before the last: as the uninterrupted run had it (the neutral before frame 0)
-      const FaceControls before = start >= 2 ? face_controls(perf, start - 2, face) : zero;
-      lr.set_positions(start >= 2 ? io::points_of(z, "lr_before", N, partial.string()) : lr_neutral, before, lx);
-      hr.set_positions(start >= 2 ? io::points_of(z, "hr_before", face.hr.num_vertices(), partial.string()) : hr_neutral, before, hx);
-    }
-    Points<> lr_before = lr.positions(), hr_before = hr.positions();
-    for (Index f = start; f < F; ++f) {
-      const FaceControls c = face_controls(perf, f, face);
-      lr.set_controls(c);
-      hr.set_controls(c);
-      lr_before = lr.positions();
-      hr_before = hr.positions();
-      const auto t0 = std::chrono::steady_clock::now();
-      const auto rl = detail::solve_frame(policy, lr, perf.name, f);
-      const auto t1 = std::chrono::steady_clock::now();
-      const auto rh = detail::solve_frame(policy, hr, perf.name, f);
-      const auto t2 = std::chrono::steady_clock::now();
-      const double sl = std::chrono::duration<double>(t1 - t0).count(), sh = std::chrono::duration<double>(t2 - t1).count();
-      lip_pairs[std::size_t(f)] = std::int64_t(intersecting_lip_pairs(face, hr.positions()).size());
-      out.lr(f) = lr.positions();
-      out.hr(f) = hr.surface(policy);
-      st.lr_seconds += sl;
-      st.hr_seconds += sh;
-      st.lr_iterations += rl.iterations;
-      st.hr_iterations += rh.iterations;
-      ++st.simulated;
-      if (opt.on_frame) opt.on_frame(perf.name, f, F, rl, rh, sl, sh);
-      const Index done = f + 1;
-      if (done < F && done % opt.checkpoint_every == 0) {
-        io::NpzArrays z = data::frames_checkpoint(out, done, print);
-        z["lr_state"] = io::make_npy(lr.positions());
-        z["hr_state"] = io::make_npy(hr.positions());
-        z["lr_before"] = io::make_npy(lr_before);
-        z["hr_before"] = io::make_npy(hr_before);
-        z["hr_lip_pairs"] = io::make_npy<std::int64_t>({done}, lip_pairs.data());
-        io::write_npz(partial, z);
-      }
-    }
-    measure_discrepancy(policy, face, out, st);
+  const Index N = face.lr.num_vertices(), M = face.surface.num_vertices();
+  // a performance's file, whole: its lip and discrepancy figures
+  auto measure_file = [&](const data::PairedFrames<>& frames, const std::vector<std::int64_t>& lip_pairs, PerformanceStats& st) {
+    measure_discrepancy(policy, face, frames, st);
     detail::count_lip_frames(lip_pairs, st);
-    auto arrays = data::paired_frame_arrays(out);
-    io::set_fingerprint(arrays, print);
-    arrays["hr_lip_pairs"] = io::make_npy<std::int64_t>({F}, lip_pairs.data());
-    arrays["control_names"] = io::make_npy(perf.names);
-    io::write_npz(final_file, arrays);
-    io::NpzArrays ctl;
-    ctl["names"] = io::make_npy(perf.names);
-    ctl["weights"] = io::make_npy(perf.weights);
-    io::write_npz(dir / (perf.name + "_controls.npz"), ctl);
+  };
+  std::vector<PerformanceStats> stats;
+  std::vector<std::size_t> stats_of;                     // the performance of each entry of stats
+  std::vector<char> finished(performances.size(), 0);  // its file is there (reused or written)
+  for (Index i = first_unit; i < last_unit; ++i) {
+    const FaceChunk& u = units[std::size_t(i)];
+    const Performance& perf = performances[std::size_t(u.performance)];
+    const Index F = perf.num_frames();
+    const std::string& print = prints[std::size_t(u.performance)];
+    const auto final_file = dir / (perf.name + ".npz");
+    if (stats.empty() || stats_of.back() != std::size_t(u.performance)) {  // the first of its units here
+      PerformanceStats st;
+      st.name = perf.name;
+      st.frames = F;
+      st.chunks = u.count;
+      // a finished file of this very run (any chunks): reuse
+      if (std::filesystem::exists(final_file)) {
+        const auto z = io::read_npz(final_file);
+        if (io::fingerprint_of(z) == print) {
+          st.reused = true;
+          finished[std::size_t(u.performance)] = 1;
+          measure_file(data::read_paired_frames(final_file, N, M), detail::lip_pairs_of(z, F, final_file.string()), st);
+        }
+      }
+      stats.push_back(st);
+      stats_of.push_back(std::size_t(u.performance));
+    }
+    if (finished[std::size_t(u.performance)]) continue;
+    PerformanceStats& st = stats.back();
+    const auto partial = detail::face_chunk_file(state, perf.name, u, true);
+    const auto part = detail::face_chunk_file(state, perf.name, u, false);
+    const std::string chunk_print = detail::face_chunk_fingerprint(print, u);
+    if (!u.whole() && std::filesystem::exists(part)) {  // a finished chunk of this run: kept
+      io::NpzReader r(part);
+      if (io::fingerprint_of(r) == chunk_print) continue;
+    }
+    data::PairedFrames<> out = data::PairedFrames<>::one_sequence(u.frames(), N, M, perf.name);
+    std::vector<std::int64_t> lip_pairs(std::size_t(u.frames()), 0);  // per frame: intersecting lip triangle pairs at HR
+    const auto& checkpoint = checkpoints[std::size_t(i - first_unit)];
+    detail::simulate_face_chunk(policy, face, perf, u, lr, hr, lr_neutral, hr_neutral, checkpoint ? &*checkpoint : nullptr, partial, chunk_print, opt, st, out,
+                                lip_pairs);
+    if (u.whole()) {
+      out.controls = perf.weights;
+      measure_file(out, lip_pairs, st);
+      detail::write_performance_file(dir, perf, out, lip_pairs, print);
+      finished[std::size_t(u.performance)] = 1;
+    } else {
+      io::NpzArrays z = data::frames_checkpoint(out, u.frames(), chunk_print);
+      z["hr_lip_pairs"] = io::make_npy<std::int64_t>({u.frames()}, lip_pairs.data());
+      io::write_npz(part, z);
+    }
     std::filesystem::remove(partial);
-    stats.push_back(st);
   }
+
+  // the whole list: every performance's chunks are there; assembled into its file
+  if (opt.shard.whole())
+    for (std::size_t s = 0; s < stats.size(); ++s) {
+      const std::size_t p = stats_of[s];
+      if (finished[p]) continue;
+      PerformanceStats& st = stats[s];
+      const Performance& perf = performances[p];
+      const Index F = perf.num_frames();
+      data::PairedFrames<> out = data::PairedFrames<>::one_sequence(F, N, M, perf.name);
+      out.controls = perf.weights;
+      std::vector<std::int64_t> lip_pairs(std::size_t(F), 0), firsts;
+      std::vector<std::filesystem::path> parts;
+      for (const FaceChunk& u : units) {
+        if (u.performance != Index(p)) continue;
+        const auto part = detail::face_chunk_file(state, perf.name, u, false);
+        const auto z = io::read_npz(part);
+        if (io::fingerprint_of(z) != detail::face_chunk_fingerprint(prints[p], u))
+          throw ArgumentError(part.string() + " is a chunk of another run (other meshes, options, controls or chunks)");
+        data::PairedFrames<> chunk = data::PairedFrames<>::one_sequence(u.frames(), N, M, perf.name);
+        if (data::resume_frames(z, part.string(), chunk) != u.frames())
+          throw ArgumentError(part.string() + ": holds fewer frames than its chunk [" + std::to_string(u.first) + ", " + std::to_string(u.last) + ")");
+        out.lowres.middleRows(u.first, u.frames()) = chunk.lowres;
+        out.highres.middleRows(u.first, u.frames()) = chunk.highres;
+        const auto lips = detail::lip_pairs_of(z, u.frames(), part.string());
+        std::copy(lips.begin(), lips.end(), lip_pairs.begin() + u.first);
+        firsts.push_back(u.first);
+        parts.push_back(part);
+      }
+      measure_file(out, lip_pairs, st);
+      io::NpzArrays extra;
+      extra["chunk_first_frames"] = io::make_npy<std::int64_t>({Index(firsts.size())}, firsts.data());
+      const std::int64_t overlap = opt.chunk_overlap;
+      extra["chunk_overlap"] = io::make_npy<std::int64_t>({}, &overlap);
+      detail::write_performance_file(dir, perf, out, lip_pairs, prints[p], extra);
+      for (const auto& part : parts) std::filesystem::remove(part);
+    }
   return stats;
 }
 
@@ -413,6 +601,11 @@ inline nlohmann::ordered_json face_data_report(const FaceModel& face, const std:
       p["hr_newton_iterations_per_frame"] = double(s.hr_iterations) / n;
       p["hr_frames_with_intersecting_lips"] = s.lip_intersecting_frames;
       p["hr_most_intersecting_lip_triangle_pairs"] = s.lip_max_pairs;
+    }
+    if (s.chunks > 1) {  // its frames in chunks: what the lead-ins cost
+      p["chunks"] = s.chunks;
+      p["lead_in_frames_solved"] = s.lead_in_frames;
+      p["lead_in_seconds"] = s.lead_in_seconds;
     }
     perf.push_back(p);
   }

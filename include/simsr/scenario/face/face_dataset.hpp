@@ -38,6 +38,11 @@ struct FaceDatasetOptions {
   Index frames = 120;                           ///< per built-in performance
   std::uint64_t seed = 1;                       ///< of the built-in performances
   Index checkpoint_every = 10;
+  /// Contiguous chunks per performance (FaceDatagenOptions::chunks; face_datagen.hpp's file
+  /// comment): 0 chooses ⌈shards / performances⌉, so that every process of a shared run has work
+  /// (1 in one process).
+  Index chunks = 0;
+  Index chunk_overlap = 2;                      ///< lead-in frames before each later chunk
   Index vtk_every = 10;                         ///< VTU series of every n-th frame (0: none)
   bool unseen_forces = true;                    ///< the LR-only §5.3 sequences in DIR/unseen/
   Index unseen_frames = 40;
@@ -81,31 +86,49 @@ FaceDatasetParts prepare_face_dataset(P policy, const FaceDatasetOptions& o, con
   return parts;
 }
 
-/// Step 2: simulates the performances (the block `shard` names, or all) into `out`, a progress
-/// line per frame to `log` (frames/s over this call's frames, ETA over its block).
+/// The chunks per performance a run of `o` over `shards` processes uses: o.chunks, or when it is 0
+/// as many as give every process a unit (chunks_for_shards).
+inline Index face_dataset_chunks(const FaceDatasetOptions& o, const FaceDatasetParts& parts, Index shards) {
+  if (o.chunks < 0) throw ArgumentError("face datagen: chunks = " + std::to_string(o.chunks) + " (need >= 1, or 0 to choose)");
+  return o.chunks > 0 ? o.chunks : chunks_for_shards(shards, Index(parts.performances.size()));
+}
+
+/// Step 2: simulates the performances (the block of units `shard` names, or all) into `out`, in
+/// face_dataset_chunks(o, parts, shard.count) chunks each, a progress line per frame to `log`
+/// (frames/s over this call's frames, ETA over its block).
 template <exec::HostPolicy P>
 std::vector<PerformanceStats> simulate_face_dataset(P policy, const FaceDatasetParts& parts, const FaceDatasetOptions& o, const std::filesystem::path& out,
                                                     const std::function<void(const std::string&)>& log = {}, WorkShard shard = {}) {
   using clock = std::chrono::steady_clock;
-  const auto [first, last] = shard.range(Index(parts.performances.size()));
-  Index total = 0;
-  for (Index p = first; p < last; ++p) total += parts.performances[std::size_t(p)].num_frames();
-  Index done = 0;
-  const auto start = clock::now();
   FaceDatagenOptions opt;
   opt.checkpoint_every = o.checkpoint_every;
+  opt.chunks = face_dataset_chunks(o, parts, shard.count);
+  opt.chunk_overlap = o.chunk_overlap;
   opt.shard = shard;
-  opt.on_frame = [&](const std::string& perf, Index f, Index F, const physics::NewtonReport& rl, const physics::NewtonReport& rh, double sl, double sh) {
+  const auto units = face_chunks(parts.performances, opt.chunks, opt.chunk_overlap);
+  const auto [first, last] = shard.range(Index(units.size()));
+  Index total = 0;
+  for (Index u = first; u < last; ++u) total += units[std::size_t(u)].last - units[std::size_t(u)].lead_in;
+  Index done = 0;
+  const auto start = clock::now();
+  auto progress = [&](const char* what, const std::string& perf, Index f, Index F, const physics::NewtonReport& rl, const physics::NewtonReport& rh, double sl,
+                      double sh) {
     ++done;
     if (!log) return;
     const double el = std::chrono::duration<double>(clock::now() - start).count();
     const double fps = double(done) / el;
     const double eta = double(total - done) / fps;  // an upper bound: resumed frames are not simulated
     char buf[512];
-    std::snprintf(buf, sizeof buf, "datagen: %-10s frame %4lld/%lld | %.2f frames/s | LR %lld it %.2f s | HR %lld it %.2f s | ETA %d:%02d", perf.c_str(),
+    std::snprintf(buf, sizeof buf, "datagen: %-10s %s %4lld/%lld | %.2f frames/s | LR %lld it %.2f s | HR %lld it %.2f s | ETA %d:%02d", perf.c_str(), what,
                   (long long)f + 1, (long long)F, fps, (long long)rl.iterations, sl, (long long)rh.iterations, sh, int(eta) / 60, int(eta) % 60);
     log(buf);
   };
+  opt.on_frame = [&](const std::string& perf, Index f, Index F, const physics::NewtonReport& rl, const physics::NewtonReport& rh, double sl, double sh) {
+    progress("frame", perf, f, F, rl, rh, sl, sh);
+  };
+  // "lead-in 3/5": frame 3 solved before the chunk that starts at frame 5 (index 4)
+  opt.on_lead_in = [&](const std::string& perf, Index f, Index first_frame, const physics::NewtonReport& rl, const physics::NewtonReport& rh, double sl,
+                       double sh) { progress("lead-in", perf, f, first_frame + 1, rl, rh, sl, sh); };
   return generate_face_data(policy, parts.face, parts.performances, out, opt);
 }
 
@@ -121,6 +144,8 @@ nlohmann::ordered_json finish_face_dataset(P policy, const FaceDatasetParts& par
   };
   const FaceModel& face = parts.face;
   auto j = face_data_report(face, stats);
+  j["chunks_per_performance"] = face_dataset_chunks(o, parts, 1);
+  j["chunk_overlap"] = o.chunk_overlap;
   char buf[512];
   for (const auto& s : stats)
     if (s.lip_intersecting_frames) {
