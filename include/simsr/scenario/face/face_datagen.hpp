@@ -33,7 +33,8 @@
 /// each performance's frames split into K contiguous chunks, each a unit of work. A chunk [a, b)
 /// starts from the settled neutral at frame a − w (w = chunk_overlap, 2 by default; at frame 0 if
 /// a ≤ w) and solves the w lead-in frames a − w … a − 1 without writing them: the first lead-in
-/// frame is reached from the neutral in one solve (by continuation where Newton alone fails), and
+/// frame is reached from the neutral by the simulator's continuation (its controls walked in 2,
+/// 4, … substeps; FaceSimulator::step_from_afar), and
 /// the next w − 1 give frame a the warm start a whole run gives it, the extrapolation of two solved
 /// frames. The lead-in frames are the chunk's extra cost (w frames per chunk after the first).
 /// Frames of a chunk whose lead-in starts at frame 0 equal the whole run's bitwise (the same
@@ -250,12 +251,13 @@ inline void count_lip_frames(const std::vector<std::int64_t>& pairs, Performance
   st.lip_max_pairs = pairs.empty() ? 0 : Index(*std::max_element(pairs.begin(), pairs.end()));
 }
 
-/// One resolution's Newton solve with the failure made specific.
+/// One resolution's Newton solve with the failure made specific; `from_afar`: by continuation at
+/// once (FaceSimulator::step_from_afar).
 template <class P, class Sim>
-physics::NewtonReport solve_frame(P policy, Sim& sim, const std::string& perf, Index frame) {
+physics::NewtonReport solve_frame(P policy, Sim& sim, const std::string& perf, Index frame, bool from_afar = false) {
   physics::NewtonReport r;
   try {
-    r = sim.step(policy);
+    r = from_afar ? sim.step_from_afar(policy) : sim.step(policy);
   } catch (const ConvergenceError& e) {
     throw Error("face datagen: performance '" + perf + "', frame " + std::to_string(frame) + ", " + resolution_name(sim.resolution()) +
                 " solve failed: " + e.what());
@@ -343,10 +345,13 @@ void simulate_face_chunk(P policy, const FaceModel& face, const Performance& per
     hr.set_controls(c);
     lr_before = lr.positions();
     hr_before = hr.positions();
+    // a chunk's first frame solved away from frame 0 is a jump from the neutral: walked in substeps
+    // at once (a frame-0 start is the whole run's own first solve, kept as it is: bitwise)
+    const bool from_afar = f == u.lead_in && f > 0;
     const auto t0 = std::chrono::steady_clock::now();
-    const auto rl = solve_frame(policy, lr, perf.name, f);
+    const auto rl = solve_frame(policy, lr, perf.name, f, from_afar);
     const auto t1 = std::chrono::steady_clock::now();
-    const auto rh = solve_frame(policy, hr, perf.name, f);
+    const auto rh = solve_frame(policy, hr, perf.name, f, from_afar);
     const auto t2 = std::chrono::steady_clock::now();
     const double sl = std::chrono::duration<double>(t1 - t0).count(), sh = std::chrono::duration<double>(t2 - t1).count();
     if (f < u.first) {  // the lead-in: solved, not written
