@@ -250,11 +250,31 @@ void scene_counters(benchmark::State& state) {
 }
 
 /// The case's linear solver, built for the scene's mesh (PCG + multigrid builds its lattice
-/// levels here, once per mesh like the gather lists: not timed).
+/// levels here, once per mesh like the gather lists: not timed). `coarse_refresh_every`: the
+/// multigrid's MultigridOptions (ignored by the other solvers).
 template <class Linear>
-Linear make_linear() {
-  return make_linear_solver<Linear>(exec::omp, scene().mesh, {.tolerance = kCgTolerance});
+Linear make_linear(int coarse_refresh_every = 1) {
+  if constexpr (is_multigrid_pcg<Linear>)
+    return Linear({.tolerance = kCgTolerance},
+                  Multigrid<>(lattice_hierarchy(exec::omp, scene().mesh).prolongations, {.coarse_refresh_every = coarse_refresh_every}));
+  else
+    return make_linear_solver<Linear>(exec::omp, scene().mesh, {.tolerance = kCgTolerance});
 }
+
+/// The baseline of the element Hessians: M without its own element_stiffness, so ElasticEnergy
+/// takes the 9×9 route (stress_derivative, then tet_elements.hpp's element_stiffness), as every
+/// material did before issue #17.
+template <class M>
+struct NineByNine {
+  using scalar_type = typename M::scalar_type;
+  using Element = typename M::Element;
+  M m;
+  static void check(const Element& e) { M::check(e); }
+  scalar_type energy(const Mat3<>& F, const Element& e) const { return m.energy(F, e); }
+  Mat3<> stress(const Mat3<>& F, const Element& e) const { return m.stress(F, e); }
+  Mat9<> stress_derivative(const Mat3<>& F, const Element& e, Definiteness d) const { return m.stress_derivative(F, e, d); }
+};
+static_assert(!physics::detail::HasElementStiffness<NineByNine<TeranMuscle<>>> && physics::detail::HasElementStiffness<TeranMuscle<>>);
 
 /// The multigrid levels' sizes as counters (vertices of level 1 and of the coarsest level).
 template <class Linear>
@@ -270,12 +290,12 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 // ---------------------------------------------------------------------------------------------
 // One frame.
 
-template <class Linear, class Policy>
+template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
-  ElasticEnergy<TeranMuscle<>> elastic(s.mesh, TeranMuscle<>(), s.elements_a);
+  ElasticEnergy<Material> elastic(s.mesh, Material{}, s.elements_a);
   EmbeddedSprings<> springs = *s.springs;
-  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, NewtonOptions{}, make_linear<Linear>());
+  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, NewtonOptions{}, make_linear<Linear>(CoarseRefreshEvery));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
   const auto frame = [&] {
@@ -321,6 +341,10 @@ BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky, exec::seq_t)->Name("BM_frame
 BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky, exec::omp_t)->Name("BM_frame_73k/pcg_ichol/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::seq_t)->Name("BM_frame_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t)->Name("BM_frame_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+// issue #17's baseline beside it: element Hessians through the 9×9 ∂P/∂F, coarse levels rebuilt every Newton iteration
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, NineByNine<TeranMuscle<>>, 1)->Name("BM_frame_73k/pcg_multigrid_9x9/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 2)->Name("BM_frame_73k/pcg_multigrid_coarse_every_2/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4)->Name("BM_frame_73k/pcg_multigrid_coarse_every_4/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 // ---------------------------------------------------------------------------------------------
 // Kernels, at frame A's solution with frame B's controls (the start of a timed frame).
@@ -364,10 +388,10 @@ void BM_energy_gradient(benchmark::State& state) {
 BENCHMARK_TEMPLATE(BM_energy_gradient, exec::seq_t)->Name("BM_kernel_73k/energy+gradient/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_energy_gradient, exec::omp_t)->Name("BM_kernel_73k/energy+gradient/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 
-template <class Policy>
+template <class Policy, class Material = TeranMuscle<>>
 void BM_hessian(benchmark::State& state) {
   const Scene& s = scene();
-  ElasticEnergy<TeranMuscle<>> elastic(s.mesh, TeranMuscle<>(), s.elements_b);
+  ElasticEnergy<Material> elastic(s.mesh, Material{}, s.elements_b);
   std::vector<char> fixed;
   const Points<> x = frame_start(fixed);
   BlockHessian<> H(s.mesh.num_vertices(), s.mesh.T);
@@ -388,6 +412,8 @@ void BM_hessian(benchmark::State& state) {
 }
 BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t)->Name("BM_kernel_73k/hessian/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t)->Name("BM_kernel_73k/hessian/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t, NineByNine<TeranMuscle<>>)->Name("BM_kernel_73k/hessian_9x9/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t, NineByNine<TeranMuscle<>>)->Name("BM_kernel_73k/hessian_9x9/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 
 /// The first Newton system of the frame: A (projected Hessian of all terms, Dirichlet rows
 /// eliminated) and b = −g over the free DOFs. Built once (omp).

@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <simsr/physics/materials/materials.hpp>
+#include <simsr/physics/tet_elements.hpp>
 
 #include <Eigen/Eigenvalues>
 
@@ -140,6 +141,38 @@ FdReport check_derivatives(const M& m, const std::vector<Sample>& samples, const
   }
   MESSAGE("worst FD error: stress " << worst.stress << ", derivative " << worst.derivative
                                     << " (stencil across J0: " << worst.at_threshold << ")");
+  return worst;
+}
+
+/// A material's own element_stiffness (the eigen-mode route) equals vol·(D⊗I)ᵀ ∂P/∂F (D⊗I)
+/// through its 9×9 stress_derivative, exact and projected, on every sample with random shape
+/// gradients; exactly symmetric. Returns the worst relative difference.
+template <class M>
+double check_element_stiffness(const M& m, const std::vector<Sample>& samples, const typename M::Element& e, double scale,
+                               unsigned seed = 5) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), v(0.1, 3.0);
+  double worst = 0;
+  for (const Sample& s : samples) {
+    const std::string kind = s.kind;
+    CAPTURE(kind);
+    CAPTURE(s.F);
+    Mat3d Dm;
+    do {
+      for (int k = 0; k < 9; ++k) Dm(k % 3, k / 3) = u(rng);
+    } while (std::abs(Dm.determinant()) < 0.05);
+    const ShapeGradients<double> D = shape_gradients(Mat3d(Dm.inverse()));
+    const double vol = v(rng);
+    for (const Definiteness d : {Definiteness::exact, Definiteness::project}) {
+      const Mat12<double> K = m.element_stiffness(s.F, e, d, D, vol);
+      const Mat12<double> reference = element_stiffness(m.stress_derivative(s.F, e, d), D, vol);
+      const double err = relative_error(K, reference, scale * vol * D.squaredNorm());
+      CHECK(err < 1e-12);
+      CHECK(K == K.transpose());
+      worst = std::max(worst, err);
+    }
+  }
+  MESSAGE("element stiffness from the eigen-modes against the 9x9 route: worst relative difference " << worst);
   return worst;
 }
 

@@ -29,6 +29,8 @@ TEST_CASE("MooneyRivlin: rest state, small strain, derivatives, projection, inve
   const MooneyRivlin<> only10(1e4, 0.0, 1e5), only01(0.0, 1e4, 1e5);
   check_derivatives(only10, deformation_samples(104), {}, 2e4);
   check_derivatives(only01, deformation_samples(105), {}, 2e4);
+  check_element_stiffness(m, deformation_samples(103), {}, mu);
+  check_element_stiffness(only01, deformation_samples(105), {}, 2e4);
   std::mt19937 rng(5);
   check_projection_keeps_psd(m, Mat3d::Identity(), {}, mu);
   for (int i = 0; i < 5; ++i) check_projection_keeps_psd(m, with_singular_values(rng, 1.05, 1.02, 1.01), {}, mu);

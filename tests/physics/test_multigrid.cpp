@@ -113,6 +113,83 @@ TEST_CASE("Multigrid: a second compute starts its eigenvalue estimate warm; forg
   CHECK(zu == zf);
 }
 
+TEST_CASE("Multigrid: coarse levels lagged (coarse_refresh_every): SPD and symmetric, PCG converges to the new matrix's solution; rebuilt on schedule, after forget_estimates and when the Dirichlet rows change") {
+  auto s = stiffness_system(16, 4, 3);
+  const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
+  const SparseMatrix<> A = s.A();
+  // a nearby matrix of the same pattern and Dirichlet rows (the next Newton iteration's): free
+  // entries scaled by a smooth random factor, kept symmetric and positive definite
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0.7, 1.3);
+  VecX<> scale(A.rows());
+  for (Index i = 0; i < scale.size(); ++i) scale[i] = s.fixed[std::size_t(i)] ? 1.0 : u(rng);
+  SparseMatrix<> B = A;
+  for (Index r = 0; r < B.outerSize(); ++r)
+    for (SparseMatrix<>::InnerIterator it(B, r); it; ++it)
+      if (!s.fixed[std::size_t(it.row())] && !s.fixed[std::size_t(it.col())]) it.valueRef() *= std::sqrt(scale[it.row()] * scale[it.col()]);
+  const Eigen::SimplicialLDLT<SparseMatrix<>> ldlt(B);
+  REQUIRE(ldlt.info() == Eigen::Success);
+  const VecX<> reference = ldlt.solve(s.b);
+
+  using Pcg = ConjugateGradient<Multigrid<>>;
+  Pcg lagged({.tolerance = 1e-10}, Multigrid<>(prolongations, {.coarse_refresh_every = 3})), fresh({.tolerance = 1e-10}, Multigrid<>(prolongations));
+  lagged.compute(exec::seq, A);
+  CHECK(lagged.preconditioner().refreshed());
+  lagged.compute(exec::seq, B);  // B's residuals, A's coarse levels
+  CHECK_FALSE(lagged.preconditioner().refreshed());
+  fresh.compute(exec::seq, B);
+  VecX<> x_lagged, x_fresh;
+  const auto i_lagged = lagged.solve(exec::seq, s.b, x_lagged);
+  const auto i_fresh = fresh.solve(exec::seq, s.b, x_fresh);
+  CHECK(i_lagged.converged);
+  CHECK((x_lagged - reference).norm() <= 1e-8 * reference.norm());
+  CHECK((x_fresh - reference).norm() <= 1e-8 * reference.norm());
+  MESSAGE("PCG iterations with B's coarse levels ", i_fresh.iterations, ", with A's (lagged) ", i_lagged.iterations);
+  CHECK(i_lagged.iterations <= 2 * i_fresh.iterations);
+  for (Index i = 0; i < x_lagged.size(); ++i)
+    if (s.fixed[std::size_t(i)]) CHECK(x_lagged[i] == 0.0);
+  // the lagged V-cycle is still a symmetric positive definite operator
+  std::normal_distribution<double> N;
+  for (int trial = 0; trial < 10; ++trial) {
+    VecX<> a(B.rows()), b(B.rows()), Ma, Mb;
+    for (Index i = 0; i < a.size(); ++i) a[i] = N(rng), b[i] = N(rng);
+    lagged.preconditioner().apply(exec::seq, a, Ma);
+    lagged.preconditioner().apply(exec::seq, b, Mb);
+    CHECK(std::abs(a.dot(Mb) - b.dot(Ma)) <= 1e-10 * a.norm() * Mb.norm());
+    CHECK(a.dot(Ma) > 0);
+  }
+  lagged.compute(exec::seq, B);  // the 3rd compute with these coarse levels
+  CHECK_FALSE(lagged.preconditioner().refreshed());
+  lagged.compute(exec::seq, B);  // the 4th: a rebuild
+  CHECK(lagged.preconditioner().refreshed());
+  lagged.compute(exec::seq, B);
+  CHECK_FALSE(lagged.preconditioner().refreshed());
+  lagged.preconditioner().forget_estimates();
+  lagged.compute(exec::seq, B);
+  CHECK(lagged.preconditioner().refreshed());
+  VecX<> z_lagged, z_fresh;
+  lagged.preconditioner().apply(exec::seq, s.b, z_lagged);
+  fresh.preconditioner().apply(exec::seq, s.b, z_fresh);
+  CHECK(z_lagged == z_fresh);  // after forget_estimates: a fresh build on B, bitwise
+  // another Dirichlet set: the coarse levels are rebuilt at once (they must not move a fixed DOF)
+  lagged.compute(exec::seq, A);
+  REQUIRE_FALSE(lagged.preconditioner().refreshed());
+  std::vector<char> more_fixed = s.fixed;
+  for (Index v = 0; v < s.mesh.num_vertices(); ++v)
+    if (s.mesh.V(v, 0) == 4.0)
+      for (int c = 0; c < 3; ++c) more_fixed[std::size_t(3 * v + c)] = 1;
+  const SparseMatrix<> C = s.H.assemble(exec::seq, more_fixed);
+  lagged.compute(exec::seq, C);
+  CHECK(lagged.preconditioner().refreshed());
+  VecX<> rhs = s.b, x_c;
+  for (Index i = 0; i < rhs.size(); ++i)
+    if (more_fixed[std::size_t(i)]) rhs[i] = 0;
+  CHECK(lagged.solve(exec::seq, rhs, x_c).converged);
+  for (Index i = 0; i < x_c.size(); ++i)
+    if (more_fixed[std::size_t(i)]) CHECK(x_c[i] == 0.0);
+  CHECK_THROWS_AS(Multigrid<>(prolongations, {.coarse_refresh_every = 0}), ArgumentError);
+}
+
 TEST_CASE("PCG + multigrid solves stiffness systems like a direct LDLT, in far fewer iterations than block-Jacobi") {
   for (unsigned seed = 1; seed <= 3; ++seed) {
     auto s = stiffness_system(24, 4, seed);

@@ -33,6 +33,7 @@ TEST_CASE("NeoHookean: rest state, small strain, derivatives, projection, invers
   check_rest_state(m, {}, m.mu());
   check_linear_elasticity(m, m.mu(), m.lambda(), 1);
   check_derivatives(m, deformation_samples(101), {}, m.mu());
+  check_element_stiffness(m, deformation_samples(101), {}, m.mu());
   std::mt19937 rng(3);
   check_projection_keeps_psd(m, Mat3d::Identity(), {}, m.mu());
   for (int i = 0; i < 5; ++i) check_projection_keeps_psd(m, with_singular_values(rng, 1.05, 1.02, 1.01), {}, m.mu());

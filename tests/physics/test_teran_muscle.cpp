@@ -59,6 +59,7 @@ TEST_CASE("TeranMuscle: derivatives, projection and inversion") {
       for (const Sample& s : samples)
         if (std::abs((s.F * e.fibre).norm() - 1) > 1e-4) away.push_back(s);
       check_derivatives(m, away, e, 1e5);
+      check_element_stiffness(m, samples, e, 1e5, unsigned(7 * t + 1));
     }
   SUBCASE("fibre collapsed to zero length: the fibre term is flat") {
     const auto e = TeranMuscle<>::element(Eigen::Vector3d(1, 0, 0), 1.0);

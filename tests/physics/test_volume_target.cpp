@@ -22,6 +22,7 @@ TEST_CASE("VolumeTarget: psi = w (det F - v)^2, P = 2w (J - v) cof F, and dP/dF 
     }
     const FdReport r = check_derivatives(m, samples, {}, 3.0, 1e-6);
     CHECK(r.derivative < 1e-6);
+    check_element_stiffness(m, samples, {}, 3.0);
   }
   // v scaling: a uniform stretch s^{1/3} I with s = v costs nothing
   const VolumeTarget<> m(1.0, 0.8);

@@ -158,8 +158,11 @@ class QuasistaticSolver {
     detail::GradientTest test(options_.relative_tolerance, options_.absolute_tolerance, options_.reference_force);
     const double size = double((x.colwise().maxCoeff() - x.colwise().minCoeff()).norm());
     last_shift_ = 0;
+    double accepted = std::numeric_limits<double>::quiet_NaN();  // the energy of the last accepted step's x
     for (Index it = 0;; ++it) {
-      const double E = total_energy(policy, x, terms...);
+      // the line search evaluated the energy at this x already (the same sum of the same terms:
+      // the same bits), so an iteration after the first does not evaluate it again
+      const double E = it == 0 ? total_energy(policy, x, terms...) : accepted;
       if (!std::isfinite(E)) throw ConvergenceError("quasistatic Newton (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
       const double balance = compute_gradient(policy, x, terms...);
       const double gnorm = double(g_.norm());
@@ -219,12 +222,13 @@ class QuasistaticSolver {
       // Backtracking on the total energy; differences below round-off of the terms' magnitudes
       // count as no increase, so the last steps of a converged solve are not rejected by noise.
       const double noise = 64 * std::numeric_limits<double>::epsilon() * magnitude_;
-      double alpha = 1;
+      double alpha = 1, trial_energy = 0;
       Index backtracks = 0;
       for (;; ++backtracks) {
         trial_ = x;
         Eigen::Map<VecX<S>>(trial_.data(), 3 * n_) += S(alpha) * d_;
         const double Et = total_energy(policy, trial_, terms...);
+        trial_energy = Et;
         if (std::isfinite(Et) && Et <= E + options_.armijo * alpha * slope + noise) break;
         if (backtracks >= options_.max_backtracks)
           throw ConvergenceError("quasistatic Newton (line search: no decrease along the Newton direction at iteration " + std::to_string(it) + ")",
@@ -232,6 +236,7 @@ class QuasistaticSolver {
         alpha *= 0.5;
       }
       x.swap(trial_);
+      accepted = trial_energy;
       report.linear_iterations += info.iterations;
       NewtonIteration record{it, E, gnorm, alpha, backtracks, info.iterations, info.relative_residual, projected, shift};
       report.history.push_back(record);

@@ -24,9 +24,6 @@
 
 namespace simsr::physics {
 
-template <class S = Scalar>
-using Mat12 = Eigen::Matrix<S, 12, 12>;
-
 /// Rest data of #T tets.
 template <class S = Scalar>
 struct TetRestData {

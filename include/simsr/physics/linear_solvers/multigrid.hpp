@@ -141,6 +141,15 @@ struct MultigridOptions {
   double damping = 0;          ///< ω; 0: 4 / (3 λ_max(B⁻¹A)) estimated per level at compute()
   int power_iterations = 12;   ///< for that estimate, at the first compute()
   int warm_power_iterations = 2;  ///< at later ones, started from the last estimate's vector
+  /// The coarse levels (Galerkin products, their smoothers, the coarsest factorization) are
+  /// built by one compute() and kept for the next n − 1 (and rebuilt by the first after
+  /// forget_estimates() or a change of the Dirichlet rows); between, a
+  /// compute() refreshes only the finest level's smoother and ω, and the V-cycle corrects the
+  /// new matrix's residual with the coarse levels of an earlier one. PCG only needs the
+  /// preconditioner to be symmetric positive definite, not A's own: a lagged V-cycle costs some
+  /// iterations and saves the setup (most of it the products PᵀAP) in Newton iterations and
+  /// frames whose Hessians differ little. 1: rebuilt every time.
+  int coarse_refresh_every = 1;
 };
 
 /// The V-cycle preconditioner (see the file comment). Movable; keeps its buffers between calls.
@@ -155,6 +164,7 @@ class Multigrid {
     if (options.power_iterations < 1 || options.warm_power_iterations < 1)
       throw ArgumentError("Multigrid: power_iterations and warm_power_iterations must be at least 1");
     if (options.damping < 0 || !(options.damping < 2)) throw ArgumentError("Multigrid: damping must be in [0, 2) (0: automatic)");
+    if (options.coarse_refresh_every < 1) throw ArgumentError("Multigrid: coarse_refresh_every must be at least 1");
     for (std::size_t l = 0; l < prolongations.size(); ++l) {
       if (prolongations[l].rows() % 3 || prolongations[l].cols() % 3)
         throw ShapeError("Multigrid: prolongation " + std::to_string(l) + " (3 DOFs per vertex)", {-1, -1},
@@ -176,7 +186,10 @@ class Multigrid {
   /// run that must not depend on its history (a resumed frame sequence, bitwise) calls it per frame.
   void forget_estimates() {
     for (Level& L : levels_) L.v.resize(0);
+    computes_since_refresh_ = -1;
   }
+  /// Whether the last compute() rebuilt the coarse levels (MultigridOptions::coarse_refresh_every).
+  bool refreshed() const { return refreshed_; }
 
   /// Galerkin coarse operators, smoothers and the coarsest factorization for A. The structures
   /// of the products and the coarsest symbolic factorization are kept while A's pattern stays.
@@ -190,6 +203,22 @@ class Multigrid {
       throw ShapeError("Multigrid: matrix (rows of the first prolongation)", {levels_[0].P_geometric.rows(), levels_[0].P_geometric.rows()},
                        {A.rows(), A.cols()});
     levels_[0].A_ref = &A;
+    // lagged coarse levels: only level 0's smoother and ω (its residuals use A itself)
+    bool stale = computes_since_refresh_ < 0 || levels_.size() == 1 || levels_[0].b.size() != A.rows() ||
+                 levels_[0].P.rows() != A.rows() || computes_since_refresh_ + 1 >= options_.coarse_refresh_every;
+    if (!stale) {  // the coarse levels must not move a DOF that is fixed now: the same Dirichlet rows, or a rebuild
+      decoupled_rows(policy, A, decoupled_now_);
+      stale = decoupled_now_ != levels_[0].decoupled;
+    }
+    refreshed_ = stale;
+    if (!stale) {
+      ++computes_since_refresh_;
+      Level& L = levels_[0];
+      L.smoother.compute(policy, A);
+      L.omega = options_.damping > 0 ? options_.damping : 4.0 / (3.0 * lambda_max(policy, L));
+      return;
+    }
+    computes_since_refresh_ = 0;
     for (std::size_t l = 0; l < levels_.size(); ++l) {
       Level& L = levels_[l];
       const SparseMatrix<S>& Al = L.matrix();
@@ -376,6 +405,9 @@ class Multigrid {
   MultigridOptions options_;
   std::vector<Level> levels_;
   std::uint64_t direct_version_ = 0;  ///< without coarse levels A's pattern is unknown here: analyze every time
+  int computes_since_refresh_ = -1;   ///< computes since the coarse levels were built (-1: never, or forgotten)
+  bool refreshed_ = false;
+  std::vector<char> decoupled_now_;  ///< a lagged compute()'s Dirichlet rows, checked against level 0's
   std::optional<SparseCholesky<S>> coarse_solver_;
 };
 

@@ -87,6 +87,17 @@ Mat3<S> isotropic_stress(const SignedSvd<S>& svd, const Vec3<S>& g) {
   return svd.U * g.asDiagonal() * svd.V.transpose();
 }
 
+/// The positive semi-definite part of a symmetric 3×3 matrix (its negative eigenvalues set to 0).
+/// A positive definite H (Sylvester: its leading minors positive; most elements' principal
+/// Hessian away from compression) is returned as it is, without an eigen-decomposition.
+template <class S>
+Mat3<S> psd_part(const Mat3<S>& H) {
+  const S minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
+  if (H(0, 0) > S(0) && minor2 > S(0) && H.determinant() > S(0)) return H;
+  const Eigen::SelfAdjointEigenSolver<Mat3<S>> eig(H);
+  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(S(0)).asDiagonal() * eig.eigenvectors().transpose();
+}
+
 /// ∂vec(P)/∂vec(F) = Σ_m e_m q_m q_mᵀ over the 9 orthonormal modes q_m = vec(U M_m Vᵀ): the 3
 /// modes of the diagonal block (eigenvectors of H) and the 3 flip + 3 twist modes. `project`
 /// clamps every e_m at 0 (Teran et al. 2005's definiteness fix), `exact` keeps them.
@@ -99,11 +110,7 @@ Mat9<S> isotropic_stress_derivative(const SignedSvd<S>& svd, const PrincipalDeri
     return r;
   };
   const bool project = definiteness == Definiteness::project;
-  Mat3<S> H = d.H;
-  if (project) {
-    const Eigen::SelfAdjointEigenSolver<Mat3<S>> eig(H);
-    H = eig.eigenvectors() * eig.eigenvalues().cwiseMax(S(0)).asDiagonal() * eig.eigenvectors().transpose();
-  }
+  const Mat3<S> H = project ? psd_part(d.H) : d.H;
   Eigen::Matrix<S, 9, 3> Q;
   for (int i = 0; i < 3; ++i) Q.col(i) = q(i, i);
   Mat9<S> D = Q * H * Q.transpose();
@@ -118,6 +125,49 @@ Mat9<S> isotropic_stress_derivative(const SignedSvd<S>& svd, const PrincipalDeri
     D.noalias() += ep * twist * twist.transpose();
   }
   return D;
+}
+
+/// The element stiffness vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) of the ∂P/∂F above, without forming it: each
+/// mode q = vec(u_i v_jᵀ) maps to the 12-vector w(a) = B(a,j) u_i with B = D V, so block (a,b) is
+/// vol · U M_ab Uᵀ with (k the pair's third index, α_k = (flip_k + twist_k)/2, β_k = (flip_k − twist_k)/2)
+///   M_ab(i,i) = H(i,i) B(a,i) B(b,i) + Σ_{j≠i} α_k B(a,j) B(b,j),
+///   M_ab(i,j) = H(i,j) B(a,i) B(b,j) + β_k B(a,j) B(b,i)   (i ≠ j).
+/// Why: the 9×9 route (isotropic_stress_derivative, then tet_elements.hpp's element_stiffness)
+/// spends ~2,000 multiply-adds per tet on matrices this formula never forms (~750 here, only the
+/// ten blocks a ≤ b, the others their transposes): the Newton Hessian of the 73k-tet LR face is
+/// assembled four times a frame (issue #17).
+template <class S>
+Mat12<S> isotropic_element_stiffness(const SignedSvd<S>& svd, const PrincipalDerivatives<S>& d, Definiteness definiteness,
+                                     const ShapeGradients<S>& D, S vol) {
+  const bool project = definiteness == Definiteness::project;
+  const Mat3<S> H = project ? psd_part(d.H) : d.H;
+  Vec3<S> alpha, beta;
+  for (int k = 0; k < 3; ++k) {
+    const S flip = project ? std::max(d.minus(k), S(0)) : d.minus(k);
+    const S twist = project ? std::max(d.plus(k), S(0)) : d.plus(k);
+    alpha(k) = S(0.5) * (flip + twist);
+    beta(k) = S(0.5) * (flip - twist);
+  }
+  const ShapeGradients<S> B = D * svd.V;
+  Mat12<S> K;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a; b < 4; ++b) {
+      Mat3<S> M;
+      for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3, l = (i + 2) % 3;  // the other two indices; pair (i, j) has third index l, (i, l) has j
+        M(i, i) = H(i, i) * B(a, i) * B(b, i) + alpha(l) * B(a, j) * B(b, j) + alpha(j) * B(a, l) * B(b, l);
+        M(i, j) = H(i, j) * B(a, i) * B(b, j) + beta(l) * B(a, j) * B(b, i);
+        M(i, l) = H(i, l) * B(a, i) * B(b, l) + beta(j) * B(a, l) * B(b, i);
+      }
+      const Mat3<S> block = vol * (svd.U * M * svd.U.transpose());
+      if (b == a) {  // symmetric in exact arithmetic; made so in floating point
+        K.template block<3, 3>(3 * a, 3 * a) = S(0.5) * (block + block.transpose());
+      } else {
+        K.template block<3, 3>(3 * a, 3 * b) = block;
+        K.template block<3, 3>(3 * b, 3 * a) = block.transpose();
+      }
+    }
+  return K;
 }
 
 /// The invariants of C = FᵀF used by Ψ(I1, I2, J): I1 = Σσ², I2 = Σ_{i<j} σ_i²σ_j², J = det F.
@@ -217,6 +267,13 @@ class InvariantMaterial {
     const SignedSvd<S> svd = signed_svd(F);
     return isotropic_stress_derivative(svd, principal_from_invariants(svd.sigma, self().partials(invariants(svd.sigma))),
                                        definiteness);
+  }
+
+  /// vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) straight from the eigen-modes (isotropic_element_stiffness).
+  Mat12<S> element_stiffness(const Mat3<S>& F, const Element&, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
+    const SignedSvd<S> svd = signed_svd(F);
+    return isotropic_element_stiffness(svd, principal_from_invariants(svd.sigma, self().partials(invariants(svd.sigma))),
+                                       definiteness, D, vol);
   }
 
  private:

@@ -25,6 +25,14 @@ using Mat9 = Eigen::Matrix<S, 9, 9>;
 template <class S = Scalar>
 using Vec9 = Eigen::Matrix<S, 9, 1>;
 
+/// A tet's element stiffness (12×12, vertex-major: rows 3a..3a+2 are vertex a's).
+template <class S = Scalar>
+using Mat12 = Eigen::Matrix<S, 12, 12>;
+
+/// A tet's shape-function gradients D (4×3): F(i,j) = Σ_a x_a[i] D(a,j) (tet_elements.hpp).
+template <class S = Scalar>
+using ShapeGradients = Eigen::Matrix<S, 4, 3>;
+
 /// What stress_derivative returns.
 enum class Definiteness {
   exact,    ///< the true ∂P/∂F (indefinite under compression or inversion)

@@ -84,22 +84,29 @@ class TeranMuscle {
 
   Mat9<S> stress_derivative(const Mat3<S>& F, const Element& e, Definiteness definiteness) const {
     Mat9<S> D = iso_.stress_derivative(F, {}, definiteness);
-    const Vec3<S> Fa = F * e.fibre;
-    const S lambda = Fa.norm();
-    if (lambda < flat_below()) return D;
-    const Vec3<S> n = Fa / lambda;
-    S d2 = max_stress_ * (passive_.derivative(lambda) + e.activation * active_.derivative(lambda));
-    S d1 = fibre_stress(lambda, e.activation) / lambda;
-    if (definiteness == Definiteness::project) {
-      d2 = std::max(d2, S(0));
-      d1 = std::max(d1, S(0));
-    }
+    const FibreStiffness f = fibre_stiffness(F, e, definiteness);
+    if (!f.active) return D;
     Vec9<S> v;
-    for (int c = 0; c < 3; ++c) v.template segment<3>(3 * c) = e.fibre(c) * n;
+    for (int c = 0; c < 3; ++c) v.template segment<3>(3 * c) = e.fibre(c) * f.n;
     for (int c = 0; c < 3; ++c)
-      for (int l = 0; l < 3; ++l) D.template block<3, 3>(3 * c, 3 * l).diagonal().array() += d1 * e.fibre(c) * e.fibre(l);
-    D.noalias() += (d2 - d1) * v * v.transpose();
+      for (int l = 0; l < 3; ++l) D.template block<3, 3>(3 * c, 3 * l).diagonal().array() += f.d1 * e.fibre(c) * e.fibre(l);
+    D.noalias() += (f.d2 - f.d1) * v * v.transpose();
     return D;
+  }
+
+  /// vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) without the 9×9 matrix: the Mooney–Rivlin part from its eigen-modes
+  /// (isotropic_element_stiffness), the fibre part as vol g_a g_b (ψ_f'/λ I + (ψ_f'' − ψ_f'/λ) n nᵀ)
+  /// for block (a,b) with g = D a (both terms of stress_derivative's fibre part pushed through D⊗I).
+  Mat12<S> element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
+    Mat12<S> K = iso_.element_stiffness(F, {}, definiteness, D, vol);
+    const FibreStiffness f = fibre_stiffness(F, e, definiteness);
+    if (!f.active) return K;
+    const Eigen::Matrix<S, 4, 1> g = D * e.fibre;
+    const Mat3<S> nn = f.n * f.n.transpose();  // formed before scaling: exactly symmetric
+    const Mat3<S> N = vol * (f.d1 * Mat3<S>::Identity() + (f.d2 - f.d1) * nn);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) K.template block<3, 3>(3 * a, 3 * b) += (g(a) * g(b)) * N;
+    return K;
   }
 
   /// ψ_f'(λ) = σ_max (f_p(λ) + α f_a(λ)), the fibre's first Piola stress magnitude [Pa].
@@ -108,6 +115,26 @@ class TeranMuscle {
   }
 
  private:
+  /// The fibre term's ∂P/∂F = d2 v vᵀ + d1 (a aᵀ ⊗ I − v vᵀ), v = vec(n aᵀ): its direction and two
+  /// coefficients (clamped at 0 for `project`); not `active` where the fibre term is flat.
+  struct FibreStiffness {
+    bool active = false;
+    Vec3<S> n;
+    S d1 = 0, d2 = 0;
+  };
+  FibreStiffness fibre_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness) const {
+    const Vec3<S> Fa = F * e.fibre;
+    const S lambda = Fa.norm();
+    if (lambda < flat_below()) return {};
+    FibreStiffness f{true, Fa / lambda, fibre_stress(lambda, e.activation) / lambda,
+                     max_stress_ * (passive_.derivative(lambda) + e.activation * active_.derivative(lambda))};
+    if (definiteness == Definiteness::project) {
+      f.d2 = std::max(f.d2, S(0));
+      f.d1 = std::max(f.d1, S(0));
+    }
+    return f;
+  }
+
   /// Below this stretch both fibre curves vanish identically.
   S flat_below() const { return std::min(S(1), ActiveFibreCurve<S>::lower * active_.optimal_length); }
 
