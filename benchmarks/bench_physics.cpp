@@ -76,6 +76,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <typeinfo>
 #include <filesystem>
 #include <memory>
 #include <random>
@@ -290,12 +292,15 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 // ---------------------------------------------------------------------------------------------
 // One frame.
 
-template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1>
+template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
+          NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
-  ElasticEnergy<Material> elastic(s.mesh, Material{}, s.elements_a);
+  ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
   EmbeddedSprings<> springs = *s.springs;
-  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, NewtonOptions{}, make_linear<Linear>(CoarseRefreshEvery));
+  NewtonOptions options;
+  options.forcing = Forcing;
+  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
   const auto frame = [&] {
@@ -323,6 +328,11 @@ void BM_frame(benchmark::State& state) {
   state.counters["projected"] = double(std::count_if(report.history.begin(), report.history.end(), [](const NewtonIteration& it) { return it.projected; }));
   state.counters["fps"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
   multigrid_counters(state, newton.linear_solver());
+  if (std::getenv("SIMSR_BENCH_NEWTON_HISTORY"))  // the last frame's Newton iterations, on stderr
+    for (const NewtonIteration& it : report.history)
+      std::fprintf(stderr, "BM_frame (%s, coarse levels every %d, forcing %s): iteration %lld |g| %.3e step %.3g backtracks %lld PCG %lld\n",
+                   typeid(Linear).name(), CoarseRefreshEvery, Forcing == NewtonOptions::Forcing::adaptive ? "adaptive" : "fixed", (long long)it.iteration,
+                   it.gradient_norm, it.step_length, (long long)it.backtracks, (long long)it.linear_iterations);
 }
 
 using Cholesky = SparseCholesky<>;
@@ -345,6 +355,8 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t)->Name("BM_frame_73k/pcg_
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, NineByNine<TeranMuscle<>>, 1)->Name("BM_frame_73k/pcg_multigrid_9x9/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 2)->Name("BM_frame_73k/pcg_multigrid_coarse_every_2/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4)->Name("BM_frame_73k/pcg_multigrid_coarse_every_4/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::adaptive)->Name("BM_frame_73k/pcg_multigrid_inexact/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 2, NewtonOptions::Forcing::adaptive)->Name("BM_frame_73k/pcg_multigrid_inexact_coarse_every_2/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 // ---------------------------------------------------------------------------------------------
 // Kernels, at frame A's solution with frame B's controls (the start of a timed frame).
@@ -391,7 +403,7 @@ BENCHMARK_TEMPLATE(BM_energy_gradient, exec::omp_t)->Name("BM_kernel_73k/energy+
 template <class Policy, class Material = TeranMuscle<>>
 void BM_hessian(benchmark::State& state) {
   const Scene& s = scene();
-  ElasticEnergy<Material> elastic(s.mesh, Material{}, s.elements_b);
+  ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_b);
   std::vector<char> fixed;
   const Points<> x = frame_start(fixed);
   BlockHessian<> H(s.mesh.num_vertices(), s.mesh.T);

@@ -206,6 +206,52 @@ TEST_CASE("Newton: warm start at the solution converges at once; seq and omp sol
   CHECK_THROWS_AS(seq.solve(exec::seq, x, bad, elastic), MeshError);
 }
 
+TEST_CASE("Forcing::adaptive (inexact Newton): the same equilibrium to the tolerance in fewer PCG iterations; loose solves first, the solver's own tolerance back after the solve") {
+  // a hanging muscle block on a BCC lattice (the LR face's kind of mesh), pulled sideways at its free end
+  const auto box = box_tet_mesh<double>(2, 2, 6, Vec3<>(0, 0, 0), Vec3<>(0.1, 0.1, 0.3));
+  const TetMesh<double> mesh = discretize::bcc_lattice(box, 0.025).mesh;
+  ElasticEnergy<NeoHookean<>> flesh(mesh, NeoHookean<>::from_young_poisson(3e4, 0.45));
+  Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
+  BoneAttachments<> ends(mesh.V);
+  ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
+  ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
+  ends.set_transform("bottom", RigidTransform<>{Eigen::AngleAxisd(0.3, Vec3<>::UnitZ()).toRotationMatrix(), Vec3<>(0.04, 0.0, 0.02)});
+  using Pcg = ConjugateGradient<BlockJacobi<>>;
+  const auto solve = [&](NewtonOptions::Forcing forcing, std::vector<double>* tolerances) {
+    NewtonOptions o;
+    o.relative_tolerance = 1e-9;
+    o.forcing = forcing;
+    QuasistaticSolver<Pcg> newton(mesh.num_vertices(), mesh.T, o, Pcg({.tolerance = 1e-8}));
+    if (tolerances) newton.options().progress = [&](const NewtonIteration&) { tolerances->push_back(newton.linear_solver().options().tolerance); };
+    Points<> x = mesh.V;
+    const NewtonReport r = newton.solve(exec::omp, x, ends.boundary(), flesh, gravity);
+    CHECK(r.converged);
+    CHECK(newton.linear_solver().options().tolerance == 1e-8);  // given back
+    return std::make_pair(x, r);
+  };
+  std::vector<double> tolerances;
+  const auto [x_fixed, r_fixed] = solve(NewtonOptions::Forcing::fixed, nullptr);
+  const auto [x_inexact, r_inexact] = solve(NewtonOptions::Forcing::adaptive, &tolerances);
+  const double moved = (x_fixed - mesh.V).cwiseAbs().maxCoeff();
+  REQUIRE(moved > 0.01);
+  CHECK((x_inexact - x_fixed).cwiseAbs().maxCoeff() <= 1e-6 * moved);
+  MESSAGE("Newton / PCG iterations: solves to 1e-8 ", r_fixed.iterations, " / ", r_fixed.linear_iterations, ", adaptive forcing ",
+          r_inexact.iterations, " / ", r_inexact.linear_iterations);
+  CHECK(r_inexact.linear_iterations < r_fixed.linear_iterations);
+  REQUIRE(tolerances.size() >= 2);
+  CHECK(tolerances.front() == 0.1);  // forcing_max first
+  CHECK(tolerances.back() < tolerances.front());
+  for (const double t : tolerances) CHECK((t >= 1e-8 && t <= 0.1));
+  // a solver without a tolerance (a direct one) ignores the option
+  NewtonOptions o;
+  o.relative_tolerance = 1e-9;
+  o.forcing = NewtonOptions::Forcing::adaptive;
+  QuasistaticSolver<SparseCholesky<>> direct(mesh.num_vertices(), mesh.T, o);
+  Points<> x = mesh.V;
+  CHECK(direct.solve(exec::seq, x, ends.boundary(), flesh, gravity).converged);
+  CHECK((x - x_fixed).cwiseAbs().maxCoeff() <= 1e-6 * moved);
+}
+
 TEST_CASE("Newton progress: every iteration is reported, with the Hessian it used") {
   const auto mesh = box_tet_mesh<double>(4, 1, 1, Vec3<>(0, 0, 0), Vec3<>(0.4, 0.1, 0.1));
   ElasticEnergy<NeoHookean<>> elastic(mesh, NeoHookean<>::from_young_poisson(1e5, 0.3));

@@ -89,6 +89,15 @@ struct NewtonOptions {
   /// (README, "Thin shells"). Not better everywhere: a crumpled membrane solved back to rest from
   /// far away took 119 iterations against adaptive's 41 (bench_physics, BM_newton_crumpled_1089).
   enum class Hessian { projected, adaptive, regularized } hessian = Hessian::adaptive;
+  /// The linear solves' relative tolerance, for iterative solvers (ConjugateGradient: its
+  /// options().tolerance). `fixed`: the solver's own in every iteration. `adaptive`: an inexact
+  /// Newton (Eisenstat & Walker 1996, choice 2): η_0 = forcing_max, then η_k = 0.9 (‖g_k‖ /
+  /// ‖g_{k−1}‖)², kept at least 0.9 η_{k−1}² while that is above 0.1 (their safeguard), at most
+  /// forcing_max and at least the solver's own tolerance. Far from the solution a loose solve
+  /// gives nearly the same step for a fraction of the iterations; near it the ratio is small and
+  /// the solves tighten to the solver's own tolerance, keeping Newton's fast local convergence.
+  enum class Forcing { fixed, adaptive } forcing = Forcing::fixed;
+  double forcing_max = 0.1;
   /// Called after every iteration (progress lines for long runs).
   std::function<void(const NewtonIteration&)> progress;
 };
@@ -156,6 +165,7 @@ class QuasistaticSolver {
     apply_boundary(x, boundary);
     NewtonReport report;
     detail::GradientTest test(options_.relative_tolerance, options_.absolute_tolerance, options_.reference_force);
+    ForcingTerm forcing(*this);
     const double size = double((x.colwise().maxCoeff() - x.colwise().minCoeff()).norm());
     last_shift_ = 0;
     double accepted = std::numeric_limits<double>::quiet_NaN();  // the energy of the last accepted step's x
@@ -180,6 +190,7 @@ class QuasistaticSolver {
       }
 
       // Newton direction: H d = −g (fixed DOFs: identity rows, zero right-hand side).
+      forcing.set(it, gnorm);
       rhs_ = -g_;
       bool projected = options_.hessian == NewtonOptions::Hessian::projected;
       LinearSolveInfo info;
@@ -243,6 +254,43 @@ class QuasistaticSolver {
       if (options_.progress) options_.progress(record);
     }
   }
+
+  /// NewtonOptions::forcing for the solve it lives in: sets the linear solver's tolerance per
+  /// iteration and gives it back its own at the end (also when the solve throws).
+  class ForcingTerm {
+   public:
+    explicit ForcingTerm(QuasistaticSolver& s) : s_(s) {
+      if constexpr (kTunable) own_ = s_.linear_.options().tolerance;
+    }
+    ~ForcingTerm() {
+      if constexpr (kTunable) s_.linear_.options().tolerance = own_;
+    }
+    ForcingTerm(const ForcingTerm&) = delete;
+    ForcingTerm& operator=(const ForcingTerm&) = delete;
+    /// The tolerance of iteration `it`, whose gradient norm is `gnorm`.
+    void set(Index it, double gnorm) {
+      if constexpr (kTunable) {
+        if (s_.options_.forcing != NewtonOptions::Forcing::adaptive) return;
+        const double cap = std::max(own_, s_.options_.forcing_max);
+        double eta = cap;
+        if (it > 0 && last_norm_ > 0) {
+          const double ratio = gnorm / last_norm_;
+          eta = 0.9 * ratio * ratio;
+          const double safeguard = 0.9 * last_eta_ * last_eta_;
+          if (safeguard > 0.1) eta = std::max(eta, safeguard);
+        }
+        eta = std::clamp(eta, own_, cap);
+        s_.linear_.options().tolerance = eta;
+        last_eta_ = eta;
+        last_norm_ = gnorm;
+      }
+    }
+
+   private:
+    static constexpr bool kTunable = requires(Linear& l) { l.options().tolerance = 0.1; };
+    QuasistaticSolver& s_;
+    double own_ = 0, last_eta_ = 0, last_norm_ = 0;
+  };
 
   /// Σ terms' energies at x (J).
   template <class P, class... Terms>
