@@ -256,11 +256,7 @@ void scene_counters(benchmark::State& state) {
 /// multigrid's MultigridOptions (ignored by the other solvers).
 template <class Linear>
 Linear make_linear(int coarse_refresh_every = 1) {
-  if constexpr (is_multigrid_pcg<Linear>)
-    return Linear({.tolerance = kCgTolerance},
-                  Multigrid<>(lattice_hierarchy(exec::omp, scene().mesh).prolongations, {.coarse_refresh_every = coarse_refresh_every}));
-  else
-    return make_linear_solver<Linear>(exec::omp, scene().mesh, {.tolerance = kCgTolerance});
+  return make_linear_solver<Linear>(exec::omp, scene().mesh, {.tolerance = kCgTolerance}, {}, {.coarse_refresh_every = coarse_refresh_every});
 }
 
 /// The baseline of the element Hessians: M without its own element_stiffness, so ElasticEnergy

@@ -420,13 +420,13 @@ inline constexpr bool is_multigrid_pcg<ConjugateGradient<Multigrid<S>, S>> = tru
 
 /// A linear solver for Newton on `mesh`: Linear{} (with `options` where Linear is a
 /// ConjugateGradient), or, for PCG with Multigrid, one with the mesh's lattice hierarchy (built
-/// under `policy`: lattice_hierarchy).
+/// under `policy`: lattice_hierarchy) and the `multigrid` options.
 template <class Linear, exec::HostPolicy P, class S>
 Linear make_linear_solver(P policy, const TetMesh<S>& mesh, const ConjugateGradientOptions& options = {},
-                          const LatticeHierarchyOptions& levels = {}) {
+                          const LatticeHierarchyOptions& levels = {}, const MultigridOptions& multigrid = {}) {
   static_assert(assert_linear_solver<Linear>());
   if constexpr (is_multigrid_pcg<Linear>)
-    return Linear(options, Multigrid<typename Linear::scalar_type>(lattice_hierarchy(policy, mesh, levels).prolongations));
+    return Linear(options, Multigrid<typename Linear::scalar_type>(lattice_hierarchy(policy, mesh, levels).prolongations, multigrid));
   else if constexpr (requires { Linear(options); })
     return Linear(options);
   else

@@ -98,6 +98,12 @@ Mat3<S> psd_part(const Mat3<S>& H) {
   return eig.eigenvectors() * eig.eigenvalues().cwiseMax(S(0)).asDiagonal() * eig.eigenvectors().transpose();
 }
 
+/// A flip or twist eigenvalue as `definiteness` takes it (clamped at 0 for `project`).
+template <class S>
+S mode_eigenvalue(S e, Definiteness definiteness) {
+  return definiteness == Definiteness::project ? std::max(e, S(0)) : e;
+}
+
 /// ∂vec(P)/∂vec(F) = Σ_m e_m q_m q_mᵀ over the 9 orthonormal modes q_m = vec(U M_m Vᵀ): the 3
 /// modes of the diagonal block (eigenvectors of H) and the 3 flip + 3 twist modes. `project`
 /// clamps every e_m at 0 (Teran et al. 2005's definiteness fix), `exact` keeps them.
@@ -119,8 +125,8 @@ Mat9<S> isotropic_stress_derivative(const SignedSvd<S>& svd, const PrincipalDeri
   for (const auto& p : pairs) {
     const Vec9<S> a = q(p[0], p[1]), b = q(p[1], p[0]);
     const Vec9<S> flip = r * (a + b), twist = r * (a - b);
-    const S em = project ? std::max(d.minus(p[2]), S(0)) : d.minus(p[2]);
-    const S ep = project ? std::max(d.plus(p[2]), S(0)) : d.plus(p[2]);
+    const S em = mode_eigenvalue(d.minus(p[2]), definiteness);
+    const S ep = mode_eigenvalue(d.plus(p[2]), definiteness);
     D.noalias() += em * flip * flip.transpose();
     D.noalias() += ep * twist * twist.transpose();
   }
@@ -143,8 +149,8 @@ Mat12<S> isotropic_element_stiffness(const SignedSvd<S>& svd, const PrincipalDer
   const Mat3<S> H = project ? psd_part(d.H) : d.H;
   Vec3<S> alpha, beta;
   for (int k = 0; k < 3; ++k) {
-    const S flip = project ? std::max(d.minus(k), S(0)) : d.minus(k);
-    const S twist = project ? std::max(d.plus(k), S(0)) : d.plus(k);
+    const S flip = mode_eigenvalue(d.minus(k), definiteness);
+    const S twist = mode_eigenvalue(d.plus(k), definiteness);
     alpha(k) = S(0.5) * (flip + twist);
     beta(k) = S(0.5) * (flip - twist);
   }
