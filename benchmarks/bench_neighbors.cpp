@@ -1,6 +1,9 @@
 // Neighbour gathering at the paper's sizes (LR 15,872 vertices, HR surface 35,637 vertices):
-//   3-D kNN k=20 of the HR vertices among the LR ones (kd-tree build and query),
-//   EdgeConv's feature kNN N=15,872, D=64, k=5 (brute force, self included as in DGCNN),
+//   3-D kNN k=20 of the HR vertices among the LR ones: the uniform grid (GridKnn, build and
+//     query) beside the kd-tree (KdTree, the baseline; the grid's setup checks that both give the
+//     same indices and distances, bitwise),
+//   EdgeConv's feature kNN N=15,872, D=64, k=5 (brute force, self included as in DGCNN): the
+//     fused kernel (default) beside the blocked-GEMM one (SelfKernel::blocked_gemm, the baseline),
 //   geodesic kNN k=5 on a BCC lattice graph of ~15.6k vertices (the first EdgeConv graph).
 // Uniform random points in [-1,1]^3 and standard-normal features, as scripts/peers/knn_peer.py
 // --bench uses for the scipy and torch peers. Buffers are built once and reused across iterations.
@@ -101,9 +104,36 @@ void BM_KdTreeQuery_HR35637_in_LR15872_k20(benchmark::State& state) {
 BENCHMARK(BM_KdTreeQuery_HR35637_in_LR15872_k20<exec::seq_t>)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
 BENCHMARK(BM_KdTreeQuery_HR35637_in_LR15872_k20<exec::omp_t>)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
 
+void BM_GridBuild_LR15872(benchmark::State& state) {
+  const auto& P = lr_points();
+  GridKnn<double> grid;
+  for (auto _ : state) {
+    grid.build(P);
+    benchmark::DoNotOptimize(grid);
+  }
+  state.SetItemsProcessed(state.iterations() * kLR);
+}
+BENCHMARK(BM_GridBuild_LR15872)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+
 template <class Policy>
+void BM_GridQuery_HR35637_in_LR15872_k20(benchmark::State& state) {
+  GridKnn<double> grid(lr_points());
+  KnnResult<double> r, tree;
+  grid.query_into(Policy{}, hr_points(), 20, r);
+  KdTree<double>(lr_points()).query_into(exec::omp, hr_points(), 20, tree);
+  if (r.indices != tree.indices || r.distances != tree.distances) state.SkipWithError("GridKnn and KdTree differ");
+  for (auto _ : state) {
+    grid.query_into(Policy{}, hr_points(), 20, r);
+    benchmark::DoNotOptimize(r.indices.data());
+  }
+  state.SetItemsProcessed(state.iterations() * kHR);
+}
+BENCHMARK(BM_GridQuery_HR35637_in_LR15872_k20<exec::seq_t>)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+BENCHMARK(BM_GridQuery_HR35637_in_LR15872_k20<exec::omp_t>)->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.2);
+
+template <class Policy, SelfKernel Kernel = SelfKernel::fused>
 void BM_FeatureKnn_N15872_D64_k5(benchmark::State& state) {
-  BruteForceKnn<float> knn(features(), {state.range(0), state.range(1), 8});
+  BruteForceKnn<float, Kernel> knn(features(), {state.range(0), state.range(1), 8});
   KnnResult<float> r;
   knn.query_self_into(Policy{}, 5, r, false);
   for (auto _ : state) {
@@ -112,7 +142,7 @@ void BM_FeatureKnn_N15872_D64_k5(benchmark::State& state) {
   }
   state.counters["GFLOP/s"] = benchmark::Counter(2.0 * kLR * kLR * kFeatureDim * 1e-9 * double(state.iterations()), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_FeatureKnn_N15872_D64_k5<exec::seq_t>)->Args({128, 1024})->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.5);
+BENCHMARK(BM_FeatureKnn_N15872_D64_k5<exec::seq_t>)->Args({256, 2048})->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.5);
 BENCHMARK(BM_FeatureKnn_N15872_D64_k5<exec::omp_t>)
     ->ArgNames({"qblock", "pblock"})
     ->Args({128, 1024})
@@ -121,6 +151,9 @@ BENCHMARK(BM_FeatureKnn_N15872_D64_k5<exec::omp_t>)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinWarmUpTime(0.5);
+// the baseline: the blocked-GEMM kernel at its default tile (256)
+BENCHMARK(BM_FeatureKnn_N15872_D64_k5<exec::seq_t, SelfKernel::blocked_gemm>)->Name("BM_FeatureKnn_N15872_D64_k5_baseline/seq")->Args({256, 2048})->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.5);
+BENCHMARK(BM_FeatureKnn_N15872_D64_k5<exec::omp_t, SelfKernel::blocked_gemm>)->Name("BM_FeatureKnn_N15872_D64_k5_baseline/omp")->Args({256, 2048})->Unit(benchmark::kMillisecond)->UseRealTime()->MinWarmUpTime(0.5);
 
 template <class Policy>
 void BM_GeodesicKnn_BCC15579_k5(benchmark::State& state) {

@@ -3,6 +3,13 @@
 ///    precomputed once by prepare_inference(policy) outside the loop, then infer(policy, …) per frame) with
 ///    up_k = 20 at N = 15,872 LR and M = 35,637 HR vertices, B = 1 (issue #4's "about a second
 ///    per frame on 2 cores").
+///  - BM_official_forward_paper_size/{seq,omp}/baseline_blocked_gemm_knn: the same with the dynamic
+///    feature graph's earlier kernel (neighbors::SelfKernel::blocked_gemm; issue #17 item 4's
+///    baseline, run beside the default fused kernel).
+///  - BM_official_dynamic_knn_paper_size/{fused,blocked_gemm}/{seq,omp}: that graph alone (k = 5
+///    nearest other points of the N = 15,872 rows of h¹, 64 features, as block 1's EdgeConv builds
+///    it) on the features of one inference; the setup checks that both kernels give the same graph
+///    (it reports an error otherwise).
 ///  - BM_official_forward_train_mode_paper_size/omp: forward(Mode::train), B = 1, same sizes
 ///    (f_θ over the M·upK = 712,740 queries at every call, BatchNorm on batch statistics).
 ///  - BM_official_train_step_bunny/omp/B:{32,8}: one training step on the bunny (zero_grad,
@@ -24,6 +31,7 @@
 #include <simsr/io/npz.hpp>
 #include <simsr/io/npy.hpp>
 #include <simsr/io/obj.hpp>
+#include <simsr/neighbors/brute_force_knn.hpp>
 #include <simsr/neighbors/kd_tree.hpp>
 #include <simsr/nn/adam.hpp>
 #include <simsr/nn/super_resolution_loss.hpp>
@@ -35,6 +43,7 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <type_traits>
 
 using namespace simsr;
 using nn::Matrix;
@@ -93,10 +102,10 @@ Matrix<float> paper_ldx(Index B) {
   return x;
 }
 
-template <exec::HostPolicy Policy>
+template <class Search, exec::HostPolicy Policy>
 void BM_official_forward_paper_size(Policy policy, benchmark::State& state) {
   nn::Rng rng(0);
-  nn::SuperResolutionNet<float> net(paper_config(), paper_geo(), rng);
+  nn::SuperResolutionNet<float, Search> net(paper_config(), paper_geo(), rng);
   const Matrix<float> ldx = paper_ldx(1);
   Matrix<float> pred;
   net.prepare_inference(policy);
@@ -236,13 +245,66 @@ void BM_upsampling_step_bunny(benchmark::State& state) {
   state.counters["query_rows"] = double(net.hr_points() * cfg.up_k);
 }
 
-void BM_official_forward_paper_size_seq(benchmark::State& s) { BM_official_forward_paper_size(exec::seq, s); }
-void BM_official_forward_paper_size_omp(benchmark::State& s) { BM_official_forward_paper_size(exec::omp, s); }
+using FusedKnn = neighbors::BruteForceKnn<float>;
+using BaselineKnn = neighbors::BruteForceKnn<float, neighbors::SelfKernel::blocked_gemm>;
+void BM_official_forward_paper_size_seq(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::seq, s); }
+void BM_official_forward_paper_size_omp(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::omp, s); }
+void BM_official_forward_paper_size_seq_baseline(benchmark::State& s) { BM_official_forward_paper_size<BaselineKnn>(exec::seq, s); }
+void BM_official_forward_paper_size_omp_baseline(benchmark::State& s) { BM_official_forward_paper_size<BaselineKnn>(exec::omp, s); }
+
+/// h¹ of one inference at the paper's size: the rows block 1's dynamic graph is built on.
+const FusedKnn::point_matrix& paper_block1_features() {
+  static const FusedKnn::point_matrix h1 = [] {
+    nn::Rng rng(0);
+    nn::SuperResolutionNet<float> net(paper_config(), paper_geo(), rng);
+    Matrix<float> pred;
+    net.prepare_inference(exec::omp);
+    net.infer(exec::omp, paper_ldx(1), pred);
+    return FusedKnn::point_matrix(net.feature_embedding().block_output(0));
+  }();
+  return h1;
+}
+
+template <class Knn, exec::HostPolicy Policy>
+void BM_official_dynamic_knn_paper_size(Policy policy, benchmark::State& state) {
+  const auto& h1 = paper_block1_features();
+  const Index k = paper_config().knn;
+  Knn knn(h1);
+  neighbors::KnnResult<float> r, other;
+  knn.query_self_into(policy, k, r, true);
+  // the other kernel's graph, once: the rows must agree (exact ties aside; the features have none)
+  using Other = std::conditional_t<std::is_same_v<Knn, FusedKnn>, BaselineKnn, FusedKnn>;
+  Other(h1).query_self_into(exec::omp, k, other, true);
+  if (r.indices != other.indices || r.distances != other.distances) state.SkipWithError("the fused and blocked-GEMM kernels' graphs differ");
+  for (auto _ : state) {
+    knn.query_self_into(policy, k, r, true);
+    benchmark::DoNotOptimize(r.indices.data());
+  }
+  state.counters["features"] = double(h1.cols());
+}
+void BM_dynamic_knn_fused_seq(benchmark::State& s) { BM_official_dynamic_knn_paper_size<FusedKnn>(exec::seq, s); }
+void BM_dynamic_knn_fused_omp(benchmark::State& s) { BM_official_dynamic_knn_paper_size<FusedKnn>(exec::omp, s); }
+void BM_dynamic_knn_gemm_seq(benchmark::State& s) { BM_official_dynamic_knn_paper_size<BaselineKnn>(exec::seq, s); }
+void BM_dynamic_knn_gemm_omp(benchmark::State& s) { BM_official_dynamic_knn_paper_size<BaselineKnn>(exec::omp, s); }
 
 }  // namespace
 
 BENCHMARK(BM_official_forward_paper_size_seq)->Name("BM_official_forward_paper_size/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 BENCHMARK(BM_official_forward_paper_size_omp)->Name("BM_official_forward_paper_size/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK(BM_official_forward_paper_size_seq_baseline)
+    ->Name("BM_official_forward_paper_size/seq/baseline_blocked_gemm_knn")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK(BM_official_forward_paper_size_omp_baseline)
+    ->Name("BM_official_forward_paper_size/omp/baseline_blocked_gemm_knn")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK(BM_dynamic_knn_fused_seq)->Name("BM_official_dynamic_knn_paper_size/fused/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_dynamic_knn_fused_omp)->Name("BM_official_dynamic_knn_paper_size/fused/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_dynamic_knn_gemm_seq)->Name("BM_official_dynamic_knn_paper_size/blocked_gemm/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_dynamic_knn_gemm_omp)->Name("BM_official_dynamic_knn_paper_size/blocked_gemm/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_official_forward_train_mode_paper_size)->Name("BM_official_forward_train_mode_paper_size/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_official_train_step_bunny)->Name("BM_official_train_step_bunny/omp")->Arg(32)->Arg(8)->ArgName("B")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 BENCHMARK(BM_trainer_step_bunny)->Name("BM_trainer_step_bunny/omp")->Arg(8)->ArgName("B")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);

@@ -4,6 +4,7 @@
 
 #include <doctest/doctest.h>
 
+#include <array>
 #include <random>
 #include <string>
 
@@ -153,4 +154,97 @@ TEST_CASE("BruteForceKnn rejects bad input with messages that say what and where
   CHECK_THROWS_WITH_AS(BruteForceKnn<float>{P}, doctest::Contains("points row 2 holds a non-finite"), ArgumentError);
   const Features<float> Z = Features<float>::Zero(3, 2);
   CHECK_THROWS_WITH_AS(BruteForceKnn<float>(Z, {0, 10, 1}), doctest::Contains("query_block and point_block must be >= 1"), ArgumentError);
+}
+
+namespace {
+
+/// Rows of a and b agree up to the order of exact ties: the same distances bitwise, and wherever
+/// the indices differ, the distance is tied with another entry of the row or with the k-th (a
+/// tie group cut at k may keep different members).
+template <class S>
+void check_same_up_to_ties(const KnnResult<S>& a, const KnnResult<S>& b, const std::string& what) {
+  INFO(what);
+  REQUIRE(a.indices.rows() == b.indices.rows());
+  REQUIRE(a.indices.cols() == b.indices.cols());
+  CHECK(a.distances == b.distances);
+  const Index k = a.k();
+  int untied = 0;
+  for (Index i = 0; i < a.queries(); ++i)
+    for (Index j = 0; j < k; ++j) {
+      if (a.indices(i, j) == b.indices(i, j)) continue;
+      const S d = a.distances(i, j);
+      const bool tied = (j > 0 && a.distances(i, j - 1) == d) || (j + 1 < k && a.distances(i, j + 1) == d) || a.distances(i, k - 1) == d;
+      untied += !tied;
+    }
+  CHECK(untied == 0);
+}
+
+/// The fused self-query kernel against the blocked-GEMM one and the long-double reference, over
+/// one random set; seq == omp bitwise.
+template <class S>
+void fused_case(std::mt19937& rng, Index n, Index d, Index k, int kind, typename BruteForceKnn<S>::Params params, bool exclude_self) {
+  const auto P = test::random_points<Features<S>>(n, d, kind, rng);
+  BruteForceKnn<S> fused(P, params);
+  BruteForceKnn<S, neighbors::SelfKernel::blocked_gemm> gemm(P, params);
+  const std::string what = name<S>(n, d, k, kind, exclude_self ? "fused, self excluded" : "fused, self included") +
+                           " tile=" + std::to_string(params.query_block);
+  const auto seq = fused.query_self(exec::seq, k, exclude_self);
+  const auto omp = fused.query_self(exec::omp, k, exclude_self);
+  CHECK_MESSAGE(omp.indices == seq.indices, what);
+  CHECK_MESSAGE(omp.distances == seq.distances, what);
+  check_same_up_to_ties(seq, gemm.query_self(exec::omp, k, exclude_self), what + " vs blocked_gemm");
+  const int diff = test::check_against_reference(seq, test::reference_knn(P, P, k + 1, exclude_self), tolerance<S>(d), what);
+  if (kind >= 2 && params.extra_candidates > 0) CHECK_MESSAGE(diff == 0, (what + ": exact ties by index"));
+  if (exclude_self)
+    for (Index i = 0; i < n; ++i)
+      for (Index j = 0; j < k; ++j) REQUIRE(seq.indices(i, j) != i);
+}
+
+}  // namespace
+
+TEST_CASE("BruteForceKnn's fused self-query kernel: feature widths 1..130, sizes off the tile and panel sizes, ties, k = N-1") {
+  std::mt19937 rng(17);
+  int cases = 0;
+  for (Index d : {1, 2, 3, 5, 8, 15, 16, 17, 31, 33, 63, 64, 65, 100, 130})
+    for (int kind = 0; kind < 4; ++kind) {
+      // N below, at and past a panel (8 to 32 columns by target) and a tile; tiles of one panel and of several
+      const Index n = std::array<Index, 5>{2, 9, 37, 100, 263}[static_cast<std::size_t>(rng() % 5)];
+      const Index tile = std::array<Index, 3>{1, 40, 256}[static_cast<std::size_t>(rng() % 3)];
+      const Index k = std::min<Index>(n - 1, std::array<Index, 3>{1, 5, 20}[static_cast<std::size_t>(rng() % 3)]);
+      fused_case<float>(rng, n, d, k, kind, {tile, 64, 8}, true);
+      fused_case<float>(rng, n, d, n - 1, kind, {tile, 64, 8}, true);  // every other point
+      fused_case<float>(rng, n, d, std::min<Index>(n, 4), kind, {tile, 64, 8}, false);
+      fused_case<double>(rng, n, d, k, kind, {tile, 64, 8}, true);
+      cases += 4;
+    }
+  CHECK(cases == 15 * 4 * 4);
+}
+
+TEST_CASE("BruteForceKnn's fused kernel: many tiles, seq == omp bitwise and the blocked-GEMM kernel's graph") {
+  std::mt19937 rng(23);
+  for (int kind : {0, 1, 3}) {
+    const auto P = test::random_points<Features<float>>(1500, 64, kind, rng);
+    BruteForceKnn<float> fused(P, {64, 1024, 8});
+    BruteForceKnn<float, neighbors::SelfKernel::blocked_gemm> gemm(P, {64, 1024, 8});
+    KnnResult<float> seq, omp, ref;
+    fused.query_self_into(exec::seq, 5, seq);
+    fused.query_self_into(exec::omp, 5, omp);
+    gemm.query_self_into(exec::seq, 5, ref);
+    CHECK(omp.indices == seq.indices);
+    CHECK(omp.distances == seq.distances);
+    check_same_up_to_ties(seq, ref, "1500×64 kind " + std::to_string(kind));
+  }
+}
+
+TEST_CASE("BruteForceKnn rejects features whose squared norm overflows (the distances would select nothing)") {
+  Features<float> P = Features<float>::Random(40, 8);
+  P(17, 3) = 3e19f;  // finite, but its square is not
+  CHECK_THROWS_WITH_AS(BruteForceKnn<float>{P}, doctest::Contains("points row 17 has a squared norm that overflows float"), ArgumentError);
+  CHECK_THROWS_AS((BruteForceKnn<float, neighbors::SelfKernel::blocked_gemm>{P}), ArgumentError);
+  BruteForceKnn<float> knn;
+  CHECK_THROWS_AS(knn.build(P), ArgumentError);
+  CHECK(knn.size() == 0);  // nothing half-built
+  P(17, 3) = 3e9f;
+  CHECK_NOTHROW(knn.build(P));
+  CHECK(knn.query_self(exec::seq, 3).indices.rows() == 40);
 }

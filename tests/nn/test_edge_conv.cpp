@@ -205,3 +205,19 @@ TEST_CASE("nn::EdgeConv: dynamic graph equals the explicit kNN graph; seq == omp
   test::check_warm_no_allocation(exec::omp, ec, h, nn::Mode::train);
   test::check_warm_no_allocation(exec::seq, fixed, h, nn::Mode::train);
 }
+
+TEST_CASE("nn::DynamicKnnGraph: the fused kNN kernel gives the blocked-GEMM kernel's graph; seq == omp") {
+  std::mt19937_64 rng(77);
+  for (const Index C : {3, 35, 64, 128}) {  // the embedding's feature widths (h⁰ 35, h¹ 64, h² 128) and a narrow one
+    const Index B = 2, N = 333, k = 5;
+    const Matrix<float> h = random_matrix(rng, B * N, C).cast<float>();
+    nn::DynamicKnnGraph<float> fused;
+    nn::DynamicKnnGraph<float, neighbors::BruteForceKnn<float, neighbors::SelfKernel::blocked_gemm>> gemm;
+    GraphIndices gs, go, gb;
+    fused.build(exec::seq, h, N, k, gs);
+    fused.build(exec::omp, h, N, k, go);
+    gemm.build(exec::omp, h, N, k, gb);
+    CHECK(go == gs);
+    CHECK(gb == gs);  // random features: no exact ties
+  }
+}

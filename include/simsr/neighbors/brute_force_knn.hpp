@@ -1,12 +1,15 @@
 #pragma once
 /// \file
 /// Exhaustive k-nearest neighbours for high-dimensional features (EdgeConv's dynamic graph in
-/// DGCNN, §3.1): squared distances ‖a‖² + ‖b‖² − 2a·b from Eigen GEMMs on blocks of queries ×
-/// blocks of points, a bounded sorted buffer per query row, never an N×N matrix.
+/// DGCNN, §3.1): squared distances ‖a‖² + ‖b‖² − 2a·b on blocks of queries × blocks of points, a
+/// bounded sorted buffer per query row, never an N×N matrix. Self queries (the dynamic graph's)
+/// run a fused distance-and-select kernel over symmetric tile pairs (detail/distance_tile.hpp);
+/// other queries run Eigen GEMM blocks.
 ///
 ///     simsr::neighbors::BruteForceKnn<float> knn(F);            // F: N×D row-major, borrowed
 ///     knn.query_self_into(simsr::exec::omp, 5, r);              // 5 nearest other points per row
 ///     knn.query_self_into(simsr::exec::omp, 5, r, false);       // self included (first, distance 0)
+///     simsr::neighbors::BruteForceKnn<float, simsr::neighbors::SelfKernel::blocked_gemm> old(F);  // the earlier kernel
 
 #include <algorithm>
 #include <atomic>
@@ -19,9 +22,28 @@
 
 #include "../core/parallel.hpp"
 #include "../core/serial_gemm.hpp"
+#include "detail/distance_tile.hpp"
 #include "knn_result.hpp"
 
 namespace simsr::neighbors {
+
+/// How BruteForceKnn's self queries form and select the tile distances. Both give the same
+/// result (the exact kNN, ties by index: see BruteForceKnn), computed with different roundings
+/// of the candidate filter.
+enum class SelfKernel {
+  /// Distances formed and filtered in registers, never stored (detail::DistanceTile): the default.
+  fused,
+  /// Each tile product G_IJ written by a single-threaded Eigen GEMM, then read back row by row:
+  /// the kernel before issue #17, kept as the benchmarks' baseline.
+  blocked_gemm
+};
+
+/// Block sizes of BruteForceKnn (any scalar, any SelfKernel).
+struct BruteForceKnnParams {
+  Index query_block = 256;     ///< queries per GEMM block (rows of the block product; self queries: the tile size)
+  Index point_block = 1024;    ///< points per GEMM block (columns)
+  Index extra_candidates = 8;  ///< candidates kept beyond k for the exact re-ranking
+};
 
 /// Exact brute-force kNN over N points of dimension D (row-major N×D, float by default).
 ///
@@ -36,8 +58,9 @@ namespace simsr::neighbors {
 /// the same kernel, so the results are bitwise identical for any thread count.
 ///
 /// Self queries (query_self_into) use the symmetry of the distance: the points are cut into tiles
-/// of `query_block` rows and only the tile products G_IJ with I ≤ J are computed (half the
-/// flops); each entry is offered to both of its rows. A row keeps the `cap` smallest (approximate
+/// of `query_block` rows (SelfKernel::fused rounds it up to a whole number of its register panels)
+/// and only the tile pairs (I, J) with I ≤ J are computed (half the flops); each entry is offered
+/// to both of its rows. A row keeps the `cap` smallest (approximate
 /// squared distance, index) pairs in lexicographic order, a set that does not depend on the order
 /// in which the pairs arrive: each worker keeps its own lists over the tiles it took, and the
 /// lists are merged per row before the re-ranking, so the result is the same for any thread
@@ -47,26 +70,24 @@ namespace simsr::neighbors {
 /// its scratch buffers (sized on the first query, reused after), so a query allocates nothing once
 /// `out` has its shape; the price is that one object must not run two queries at once (use one
 /// object per thread, or exec::omp inside one query).
-template <class S = float>
+template <class S = float, SelfKernel Kernel = SelfKernel::fused>
 class BruteForceKnn {
   static_assert(std::is_same_v<S, float> || std::is_same_v<S, double>, "simsr::neighbors::BruteForceKnn works on float or double features");
 
  public:
   using scalar_type = S;
   using point_matrix = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;  ///< N×D
+  static constexpr SelfKernel self_kernel = Kernel;
 
-  struct Params {
-    Index query_block = 256;     ///< queries per GEMM block (rows of the block product; self queries: the tile size)
-    Index point_block = 1024;    ///< points per GEMM block (columns)
-    Index extra_candidates = 8;  ///< candidates kept beyond k for the exact re-ranking
-  };
+  using Params = BruteForceKnnParams;  ///< one type for every kernel
 
   BruteForceKnn() = default;
   explicit BruteForceKnn(const point_matrix& P, Params params = {}) { build(P, params); }
   explicit BruteForceKnn(Eigen::Map<const point_matrix> P, Params params = {}) { build(P, params); }
   BruteForceKnn(point_matrix&&, Params = {}) = delete;  // would dangle
 
-  /// Borrows P (N×D) and precomputes its squared norms. ArgumentError for non-finite values or
+  /// Borrows P (N×D) and precomputes its squared norms. ArgumentError for non-finite values, a
+  /// squared norm that overflows S (the distances would be NaN and select nothing) or
   /// non-positive block sizes.
   void build(const point_matrix& P, Params params = {}) { build_view(P.data(), P.rows(), P.cols(), params); }
   void build(Eigen::Map<const point_matrix> P, Params params = {}) { build_view(P.data(), P.rows(), P.cols(), params); }
@@ -135,8 +156,12 @@ class BruteForceKnn {
       const auto c = static_cast<std::size_t>(qb * cap);
       if (cand_d2.size() < c) cand_d2.resize(c), cand_i.resize(c);
       if (count.size() < static_cast<std::size_t>(qb)) count.resize(static_cast<std::size_t>(qb));
-      if (exact.size() < static_cast<std::size_t>(cap)) exact.resize(static_cast<std::size_t>(cap)), order.resize(static_cast<std::size_t>(cap));
       if (d2.size() < static_cast<std::size_t>(pb)) d2.resize(static_cast<std::size_t>(pb));
+      reserve_rerank(cap);
+    }
+    /// The re-ranking's scratch for `cap` candidates.
+    void reserve_rerank(Index cap) {
+      if (exact.size() < static_cast<std::size_t>(cap)) exact.resize(static_cast<std::size_t>(cap)), order.resize(static_cast<std::size_t>(cap));
     }
     /// Empty candidate lists for n points.
     void reserve_lists(Index n, Index cap) {
@@ -158,8 +183,14 @@ class BruteForceKnn {
       throw ArgumentError(std::string(where) + ": " + std::to_string(n) + " points exceed the 32-bit index range");
     if (d < 1) throw ShapeError(std::string(where) + ": points", {n, -1}, {n, d});
     detail::check_finite_rows(where, "points", PointMap(data, n, d));
-    data_ = data, n_ = n, d_ = d, params_ = params;
     norms_ = PointMap(data, n, d).rowwise().squaredNorm();
+    for (Index i = 0; i < n; ++i)
+      if (!std::isfinite(norms_[i])) {
+        data_ = nullptr, n_ = 0;
+        throw ArgumentError(std::string(where) + ": points row " + std::to_string(i) + " has a squared norm that overflows " +
+                            (std::is_same_v<S, float> ? "float" : "double") + " (scale the features down)");
+      }
+    data_ = data, n_ = n, d_ = d, params_ = params;
   }
 
   template <class Policy, class DQ>
@@ -192,16 +223,23 @@ class BruteForceKnn {
     const Index n = n_;
     out.resize(n, k);
     if (n == 0) return;
-    const Index T = std::min(params_.query_block, n);
+    constexpr bool fused = Kernel == SelfKernel::fused;
+    constexpr Index NR = Tile::NR;
+    // fused: tiles start on panel boundaries of the packed points
+    const Index T = fused ? (std::min(params_.query_block, n) + NR - 1) / NR * NR : std::min(params_.query_block, n);
     const Index cap = std::min(k + params_.extra_candidates, exclude_self ? n - 1 : n);
     const Index nb = (n + T - 1) / T, pairs = nb * (nb + 1) / 2;
     const Index max_workers = std::is_same_v<Policy, exec::omp_t> ? Index(exec::omp_max_threads()) : Index(1);
     const Index workers = std::max<Index>(1, std::min(pairs, max_workers));
     if (static_cast<Index>(ws_.size()) < workers) ws_.resize(static_cast<std::size_t>(workers));
+    if constexpr (fused) Tile::pack(data_, n, d_, norms_.data(), packed_, packed_norms_);
     for (Index w = 0; w < workers; ++w) {
       Workspace& ws = ws_[static_cast<std::size_t>(w)];
-      ws.reserve(T, T, d_, cap);
-      ws.reserve_lists(n, cap);
+      if constexpr (fused)
+        ws.reserve_rerank(cap);  // no tile is stored
+      else
+        ws.reserve(T, T, d_, cap);
+      ws.reserve_lists(fused ? n + NR : n, cap);  // fused: the column thresholds are read a whole panel at a time
     }
     std::atomic<Index> next{0};
     exec::parallel_for(policy, workers, [&](Index w) {
@@ -211,7 +249,10 @@ class BruteForceKnn {
       for (Index p; (p = next.fetch_add(1, std::memory_order_relaxed)) < pairs;) {
         while (p >= first + (nb - d)) first += nb - d, ++d;
         const Index I = p - first, J = I + d;
-        tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
+        if constexpr (fused)
+          fused_tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
+        else
+          tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
       }
     });
     // merge the workers' lists into worker 0's, then re-rank (chunks of T rows)
@@ -287,6 +328,31 @@ class BruteForceKnn {
     }
   }
 
+  /// SelfKernel::fused's tile of rows [q0, q0 + m) × columns [p0, p0 + pn) (q0 ≤ p0, p0 on a panel
+  /// boundary): micro-tiles of MR rows × one panel, each entry offered as in tile(), the same
+  /// entries offered whenever the approximate distances agree (the thresholds are the same
+  /// lists' worst; the filter only skips what offer would reject).
+  void fused_tile(Index q0, Index m, Index p0, Index pn, Index cap, bool exclude_self, Workspace& ws) const {
+    const bool diagonal = q0 == p0;
+    S* worst = ws.self_worst.data();
+    for (Index r0 = 0; r0 < m; r0 += Tile::MR) {
+      const int mr = static_cast<int>(std::min<Index>(Tile::MR, m - r0));
+      const Index q = q0 + r0;  // its panel: rows past n are the panel's zero padding
+      const S* rows = packed_.data() + (q / Tile::NR) * Tile::NR * d_ + q % Tile::NR;
+      for (Index c0 = 0; c0 < pn; c0 += Tile::NR) {
+        const Index cols = std::min<Index>(Tile::NR, pn - c0);
+        Tile::run(rows, packed_.data() + (p0 + c0) * d_, d_, norms_.data() + q0 + r0, packed_norms_.data() + p0 + c0, worst + q0 + r0,
+                  worst + p0 + c0, mr, !diagonal, [&](int r, int l, S d2) {
+                    if (l >= cols) return;
+                    const Index q = q0 + r0 + r, p = p0 + c0 + l;
+                    if (diagonal && p == q && exclude_self) return;
+                    if (d2 <= worst[q]) offer(ws, q, d2, static_cast<VIndex>(p), cap);
+                    if (!diagonal && d2 <= worst[p]) offer(ws, p, d2, static_cast<VIndex>(q), cap);
+                  });
+      }
+    }
+  }
+
   /// One block of m queries starting at q0: candidates from all point blocks, then re-ranking.
   template <class DQ>
   void block(const Eigen::MatrixBase<DQ>& Q, Index q0, Index m, Index k, Index cap, bool exclude_self, Workspace& ws,
@@ -329,15 +395,25 @@ class BruteForceKnn {
   /// index) go to row `row`.
   template <class Row>
   void rerank(const Row& q, const VIndex* ci, Index cap, Index k, Workspace& ws, KnnResult<S>& out, Index row) const {
-    for (Index c = 0; c < cap; ++c) {
-      const S* p = data_ + static_cast<Index>(ci[c]) * d_;
-      double acc = 0;
+    // W candidates at a time: each sum keeps its order (the same distances as one at a time), the
+    // W independent additions overlap instead of waiting on one chain's latency.
+    constexpr Index W = 4;
+    for (Index c0 = 0; c0 < cap; c0 += W) {
+      const Index w = std::min(W, cap - c0);
+      const S* p[W];
+      double acc[W] = {};
+      for (Index t = 0; t < W; ++t) p[t] = data_ + static_cast<Index>(ci[c0 + std::min(t, w - 1)]) * d_;
       for (Index j = 0; j < d_; ++j) {
-        const double diff = static_cast<double>(q[j]) - static_cast<double>(p[j]);
-        acc += diff * diff;
+        const double qj = static_cast<double>(q[j]);
+        for (Index t = 0; t < W; ++t) {
+          const double diff = qj - static_cast<double>(p[t][j]);
+          acc[t] += diff * diff;
+        }
       }
-      ws.exact[static_cast<std::size_t>(c)] = static_cast<S>(std::sqrt(acc));
-      ws.order[static_cast<std::size_t>(c)] = static_cast<VIndex>(c);
+      for (Index t = 0; t < w; ++t) {
+        ws.exact[static_cast<std::size_t>(c0 + t)] = static_cast<S>(std::sqrt(acc[t]));
+        ws.order[static_cast<std::size_t>(c0 + t)] = static_cast<VIndex>(c0 + t);
+      }
     }
     auto first = ws.order.begin(), last = ws.order.begin() + cap;
     std::partial_sort(first, first + k, last, [&](VIndex a, VIndex b) {
@@ -350,10 +426,13 @@ class BruteForceKnn {
     }
   }
 
+  using Tile = detail::DistanceTile<S>;
+
   const S* data_ = nullptr;
   Index n_ = 0, d_ = 0;
   Params params_{};
   VecX<S> norms_;
+  std::vector<S> packed_, packed_norms_;  ///< SelfKernel::fused: the points in register panels (Tile::pack)
   std::vector<Workspace> ws_;
 };
 

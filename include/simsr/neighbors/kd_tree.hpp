@@ -78,6 +78,16 @@ class SortedKnnSet {
   std::size_t count_ = 0;
 };
 
+/// A result row of k squared distances in (distance, index) order → Euclidean distances; distinct
+/// squared distances may share a square root, and then the smaller index comes first.
+template <class S>
+void finish_knn_row(VIndex* idx, S* dist, Index k) {
+  for (Index j = 0; j < k; ++j) {
+    dist[j] = std::sqrt(dist[j]);
+    for (Index t = j; t > 0 && dist[t] == dist[t - 1] && idx[t] < idx[t - 1]; --t) std::swap(idx[t], idx[t - 1]);
+  }
+}
+
 }  // namespace detail
 
 /// Exact Euclidean kNN in 3-D over a point set indexed once (S = float or double).
@@ -141,11 +151,7 @@ class KdTree {
       S* dist = out.distances.row(i).data();
       detail::SortedKnnSet<S> set(out.indices.row(i).data(), dist, static_cast<std::size_t>(k));
       tree.findNeighbors(set, q, params);
-      VIndex* idx = out.indices.row(i).data();
-      for (Index j = 0; j < k; ++j) {  // distinct squared distances may share a square root: keep ties by index
-        dist[j] = std::sqrt(dist[j]);
-        for (Index t = j; t > 0 && dist[t] == dist[t - 1] && idx[t] < idx[t - 1]; --t) std::swap(idx[t], idx[t - 1]);
-      }
+      detail::finish_knn_row(out.indices.row(i).data(), dist, k);
     });
   }
 
