@@ -3,6 +3,9 @@
 //   BM_face_frame/lr_default      the LR split lattice of the default model (~10.8k tets)
 //   BM_face_frame/lr_paper_size   the LR lattice at the paper's size (preset paper-lr: BCC cell
 //                                 0.565 cm, ~73k tets; Park et al. 2023 §4)
+//   BM_face_frame/lr_paper_size_csr     the same with every product on the scalar CSR (the
+//                                       baseline of the 3×3-block products, issue #17 item 1)
+//   BM_face_frame/lr_paper_size_single  … with the multigrid's level matrices in single precision
 //   BM_face_frame/hr_default      the HR tetgen mesh of the default model (~135k tets, lip contact)
 //
 // Scene: the ICT face from the bundled kit (data_dir()/ict_face), the model built once per
@@ -47,14 +50,20 @@ const scenario::FaceModel& face_model(const std::string& preset) {
   return *slot;
 }
 
-void BM_face_frame(benchmark::State& state, const std::string& preset, scenario::FaceResolution res) {
+/// `storage`: the multigrid's level storage (MultigridOptions::Storage); csr also runs PCG's own
+/// products on the scalar CSR (the baseline of the 3×3-block products).
+void BM_face_frame(benchmark::State& state, const std::string& preset, scenario::FaceResolution res,
+                   physics::MultigridOptions::Storage storage = physics::MultigridOptions::Storage::block) {
   if (!std::filesystem::exists(data_dir() / "ict_face" / "full_neutral.obj")) {
     state.SkipWithError("the ICT kit is not in data_dir()/ict_face");
     return;
   }
   const auto& face = face_model(preset);
   const auto perf = scenario::builtin_performance("amazement", face.expression_names, 1);
-  scenario::FaceSimulator<> sim(exec::omp, face, res);
+  scenario::FaceSimulationOptions options;
+  options.multigrid.storage = storage;
+  options.linear.block_products = storage != physics::MultigridOptions::Storage::csr;
+  scenario::FaceSimulator<> sim(exec::omp, face, res, options);
   sim.set_controls(scenario::neutral_controls(face));
   sim.step(exec::omp);
   const auto c59 = scenario::face_controls(perf, 59, face), c60 = scenario::face_controls(perf, 60, face), c61 = scenario::face_controls(perf, 61, face);
@@ -89,6 +98,16 @@ BENCHMARK_CAPTURE(BM_face_frame, lr_default, std::string("default"), scenario::F
     ->MinTime(1.0);
 BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size, std::string("paper-lr"), scenario::FaceResolution::low)
     ->Name("BM_face_frame/lr_paper_size")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(5);
+BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_csr, std::string("paper-lr"), scenario::FaceResolution::low, physics::MultigridOptions::Storage::csr)
+    ->Name("BM_face_frame/lr_paper_size_csr")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(5);
+BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single, std::string("paper-lr"), scenario::FaceResolution::low, physics::MultigridOptions::Storage::block_single)
+    ->Name("BM_face_frame/lr_paper_size_single")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);

@@ -32,7 +32,11 @@
 //       (Eigen SimplicialLDLT, AMD; sequential itself — /omp runs the energy, Hessian assembly
 //       and gradient under exec::omp), pcg_jacobi, pcg_block_jacobi, pcg_ichol (ConjugateGradient
 //       with relative tolerance kCgTolerance, products/dots under the policy; incomplete Cholesky
-//       is Eigen's, sequential setup and triangular solves). Counters:
+//       is Eigen's, sequential setup and triangular solves), pcg_multigrid (the lattice V-cycle;
+//       its products and PCG's on 3×3-block copies, BlockCsr, the Galerkin levels in blocks),
+//       pcg_multigrid_csr (the same on the scalar CSR: the baseline of the block products),
+//       pcg_multigrid_single (the V-cycle's level matrices in single precision), cholmod
+//       (CHOLMOD's supernodal LLᵀ; built with -DSIMSR_WITH_CHOLMOD=ON). Counters:
 //       newton_iterations, linear_iterations (PCG iterations summed over the frame), projected
 //       (Newton iterations whose exact Hessian was not positive definite: assembled twice), fps.
 //   BM_kernel_73k/energy+gradient/<policy>   E(x) and ∂E/∂x of the elastic energy
@@ -43,7 +47,8 @@
 //   BM_linear_73k/<solver>[/<policy>]        one linear solve of the first Newton system of the
 //       frame (projected Hessian at frame A's solution with frame B's boundary applied, rhs = −g):
 //       cholesky = numeric LDLᵀ + solve (symbolic analysis done once before), cholesky_symbolic =
-//       analysis + factorization + solve, pcg_* = preconditioner setup + PCG solve.
+//       analysis + factorization + solve, pcg_* = preconditioner setup + PCG solve; cholmod and
+//       cholmod_symbolic the same with CHOLMOD (issue #17 item 2: beside the simplicial LDLᵀ).
 //
 // Run:   build/benchmarks/bench_physics
 //        OMP_NUM_THREADS=1 build/benchmarks/bench_physics --benchmark_filter=omp
@@ -69,6 +74,9 @@
 #include <simsr/physics/forces/triangle_membrane.hpp>
 #include <simsr/physics/hessian.hpp>
 #include <simsr/physics/linear_solvers/linear_solvers.hpp>
+#if defined(SIMSR_HAVE_CHOLMOD)
+#include <simsr/physics/linear_solvers/cholmod_cholesky.hpp>
+#endif
 #include <simsr/physics/materials/teran_muscle.hpp>
 #include <simsr/physics/quasistatic.hpp>
 
@@ -251,12 +259,17 @@ void scene_counters(benchmark::State& state) {
   state.counters["h_mm"] = 1e3 * s.h;
 }
 
+using Storage = MultigridOptions::Storage;
+
 /// The case's linear solver, built for the scene's mesh (PCG + multigrid builds its lattice
-/// levels here, once per mesh like the gather lists: not timed). `coarse_refresh_every`: the
-/// multigrid's MultigridOptions (ignored by the other solvers).
+/// levels here, once per mesh like the gather lists: not timed). `coarse_refresh_every`,
+/// `storage`: the multigrid's MultigridOptions (ignored by the other solvers); Storage::csr also
+/// runs PCG's own products on the scalar CSR (ConjugateGradientOptions::block_products = false):
+/// the baseline of every 3×3-block product.
 template <class Linear>
-Linear make_linear(int coarse_refresh_every = 1) {
-  return make_linear_solver<Linear>(exec::omp, scene().mesh, {.tolerance = kCgTolerance}, {}, {.coarse_refresh_every = coarse_refresh_every});
+Linear make_linear(int coarse_refresh_every = 1, Storage storage = Storage::block) {
+  return make_linear_solver<Linear>(exec::omp, scene().mesh, {.tolerance = kCgTolerance, .block_products = storage != Storage::csr}, {},
+                                    {.coarse_refresh_every = coarse_refresh_every, .storage = storage});
 }
 
 /// The baseline of the element Hessians: M without its own element_stiffness, so ElasticEnergy
@@ -289,14 +302,14 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 // One frame.
 
 template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
-          NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed>
+          NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
   EmbeddedSprings<> springs = *s.springs;
   NewtonOptions options;
   options.forcing = Forcing;
-  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery));
+  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
   const auto frame = [&] {
@@ -353,6 +366,13 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 2)->Name(
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4)->Name("BM_frame_73k/pcg_multigrid_coarse_every_4/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::adaptive)->Name("BM_frame_73k/pcg_multigrid_inexact/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 2, NewtonOptions::Forcing::adaptive)->Name("BM_frame_73k/pcg_multigrid_inexact_coarse_every_2/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+// the 3×3-block products' baseline (scalar CSR everywhere) and single-precision multigrid levels
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::fixed, Storage::csr)->Name("BM_frame_73k/pcg_multigrid_csr/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::fixed, Storage::block_single)->Name("BM_frame_73k/pcg_multigrid_single/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::fixed, Storage::block_single)->Name("BM_frame_73k/pcg_multigrid_single_coarse_every_4/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+#if defined(SIMSR_HAVE_CHOLMOD)
+BENCHMARK_TEMPLATE(BM_frame, CholmodCholesky<>, exec::omp_t)->Name("BM_frame_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+#endif
 
 // ---------------------------------------------------------------------------------------------
 // Kernels, at frame A's solution with frame B's controls (the start of a timed frame).
@@ -456,10 +476,10 @@ const NewtonSystem& newton_system() {
   return sys;
 }
 
-template <class Linear, class Policy, bool Symbolic>
+template <class Linear, class Policy, bool Symbolic, Storage MultigridStorage = Storage::block>
 void BM_linear(benchmark::State& state) {
   const NewtonSystem& sys = newton_system();
-  Linear linear = make_linear<Linear>();
+  Linear linear = make_linear<Linear>(1, MultigridStorage);
   VecX<> d(sys.b.size());
   LinearSolveInfo info;
   std::uint64_t version = 1;
@@ -490,6 +510,15 @@ BENCHMARK_TEMPLATE(BM_linear, PcgBlockJacobi, exec::omp_t, false)->Name("BM_line
 BENCHMARK_TEMPLATE(BM_linear, PcgIncompleteCholesky, exec::seq_t, false)->Name("BM_linear_73k/pcg_ichol/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid, exec::seq_t, false)->Name("BM_linear_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid, exec::omp_t, false)->Name("BM_linear_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid, exec::omp_t, false, Storage::csr)->Name("BM_linear_73k/pcg_multigrid_csr/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, PcgMultigrid, exec::omp_t, false, Storage::block_single)->Name("BM_linear_73k/pcg_multigrid_single/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+#if defined(SIMSR_HAVE_CHOLMOD)
+// CHOLMOD's supernodal LLᵀ beside Eigen's simplicial LDLᵀ (issue #17 item 2), numeric only and
+// with the analysis; /omp: CHOLMOD's own OpenMP loops and the BLAS (OpenBLAS: its threads).
+BENCHMARK_TEMPLATE(BM_linear, CholmodCholesky<>, exec::seq_t, false)->Name("BM_linear_73k/cholmod/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, CholmodCholesky<>, exec::omp_t, false)->Name("BM_linear_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_linear, CholmodCholesky<>, exec::omp_t, true)->Name("BM_linear_73k/cholmod_symbolic/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+#endif
 
 // Newton's fallback where the exact Hessian is indefinite (NewtonOptions::Hessian): a 1,089-
 // vertex cloth membrane (k = 50 N/m) crumpled inside its pinned rim (every vertex pulled 15-35 %

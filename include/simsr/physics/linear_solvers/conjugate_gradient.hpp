@@ -21,6 +21,7 @@
 #include "../../core/error.hpp"
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
+#include "block_csr.hpp"
 #include "linear_solver.hpp"
 #include "sparse_ops.hpp"
 
@@ -84,6 +85,9 @@ class BlockJacobi {
 struct ConjugateGradientOptions {
   double tolerance = 1e-6;     ///< stop when ‖b − A x‖ ≤ tolerance·‖b‖
   Index max_iterations = 0;    ///< 0: the system size
+  /// Run the products A·p on a 3×3 block copy of A (BlockCsr) when A's size is a multiple of 3:
+  /// the same iterates to rounding for fewer bytes per product; false: on A's CSR (the baseline).
+  bool block_products = true;
 };
 
 /// PCG from x = 0 (see the file comment). Buffers are kept between solves.
@@ -105,6 +109,8 @@ class ConjugateGradient {
   void compute(P policy, const SparseMatrix<S>& A, std::uint64_t /*pattern_version*/ = 0) {
     if (A.rows() != A.cols()) throw ShapeError("ConjugateGradient: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
     A_ = &A;
+    blocked_ = options_.block_products && A.rows() % 3 == 0;
+    if (blocked_) A_block_.assign(policy, A);
     preconditioner_.compute(policy, A);
   }
 
@@ -128,7 +134,10 @@ class ConjugateGradient {
     S rz = physics::dot(policy, r_, z_);
     S rnorm = bnorm;
     for (Index it = 0; it < max_it; ++it) {
-      sparse_multiply(policy, *A_, p_, q_);
+      if (blocked_)
+        A_block_.multiply(policy, p_, q_);
+      else
+        sparse_multiply(policy, *A_, p_, q_);
       const S pq = physics::dot(policy, p_, q_);
       if (!(pq > S(0))) {  // zero or negative curvature along p: A is not positive definite
         info.converged = false;
@@ -158,6 +167,8 @@ class ConjugateGradient {
   ConjugateGradientOptions options_;
   Preconditioner preconditioner_;
   const SparseMatrix<S>* A_ = nullptr;
+  BlockCsr<S, S> A_block_;  ///< A as 3×3 blocks (ConjugateGradientOptions::block_products)
+  bool blocked_ = false;
   VecX<S> r_, z_, p_, q_;
 };
 

@@ -224,6 +224,9 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
   f.add(o.inversion_threshold).add(o.mu10).add(o.mu01).add(o.kappa).add(o.muscle_max_stress).add(o.track_stiffness).add(o.contact_stiffness).add(o.contact_thickness);
   f.add(o.contact_rest_fraction).add(o.newton.relative_tolerance).add(o.newton.absolute_tolerance).add(o.newton.max_iterations).add(o.linear.tolerance).add(std::int64_t(o.extrapolate));
   f.add(o.substep_levels).add(std::int64_t(o.carry_with_jaw));
+  // the products' storage changes frames to rounding, the lagged levels by PCG's tolerance
+  f.add(std::int64_t(o.linear.block_products)).add(std::int64_t(o.multigrid.storage)).add(std::int64_t(o.multigrid.coarse_refresh_every));
+  f.add(std::int64_t(o.multigrid.smoothing_sweeps)).add(o.multigrid.damping).add(std::int64_t(o.multigrid.power_iterations));
   if (p) {
     f.add(p->weights);
     for (const auto& n : p->names) f.add_bytes(n.data(), n.size());

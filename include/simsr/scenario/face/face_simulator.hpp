@@ -123,6 +123,8 @@ struct FaceSimulationOptions {
   /// A failed frame is retried in 2, 4, … 2^substep_levels steps of its controls (file comment).
   Index substep_levels = 3;
   physics::ConjugateGradientOptions linear{.tolerance = 1e-4};
+  /// The V-cycle's options where Linear is PCG with the lattice multigrid (the default).
+  physics::MultigridOptions multigrid{};
 };
 
 /// A quasistatic face simulator on one mesh of a FaceModel (see the file comment). Linear: the
@@ -139,7 +141,7 @@ class FaceSimulator {
         elastic_(part_of_mesh(face, false), physics::MooneyRivlin<>(opt_.mu10, opt_.mu01, opt_.kappa, opt_.inversion_threshold)),
         muscle_(part_of_mesh(face, true), physics::TeranMuscle<>(physics::MooneyRivlin<>(opt_.mu10, opt_.mu01, opt_.kappa, opt_.inversion_threshold), opt_.muscle_max_stress),
                 fibres_),
-        newton_(mesh_.num_vertices(), mesh_.T, opt_.newton, physics::make_linear_solver<Linear>(policy, mesh_, opt_.linear)),
+        newton_(mesh_.num_vertices(), mesh_.T, opt_.newton, physics::make_linear_solver<Linear>(policy, mesh_, opt_.linear, {}, opt_.multigrid)),
         tracks_(make_tracks()) {
     const bool high = resolution == FaceResolution::high;
     bone_ = high ? face.hr_bone : face.lr_bone;
