@@ -185,3 +185,20 @@ TEST_CASE("bunny: Embedded baseline on the official paired frames") {
   CHECK(frames_beaten == nf);
   CHECK(sum_emb < 0.5 * sum_rest);
 }
+
+TEST_CASE("Embedded::apply's body over MatrixSpan (the accessor DeviceEmbedded gives it on a device) equals apply, bitwise, under seq and omp") {
+  std::mt19937 rng(29);
+  auto p = box_problem(rng, 900);
+  Embedded<> e;
+  e.fit(exec::omp, p);
+  Points<> lr(p.lr.num_vertices(), 3), ref(e.num_hr(), 3), seq(e.num_hr(), 3), omp(e.num_hr(), 3);
+  std::normal_distribution<double> N;
+  for (Index i = 0; i < lr.size(); ++i) lr.data()[i] = N(rng);
+  e.apply(exec::seq, lr, ref);
+  using Body = interp::detail::EmbeddedApply<double, MatrixSpan<const double>, MatrixSpan<double>>;
+  const MatrixSpan<const double> in{lr.data(), lr.rows(), 3, 3};
+  exec::parallel_for(exec::seq, e.num_hr(), Body{e.embedding().weights.data(), e.lr_vertex_ids().data(), in, MatrixSpan<double>{seq.data(), seq.rows(), 3, 3}});
+  exec::parallel_for(exec::omp, e.num_hr(), Body{e.embedding().weights.data(), e.lr_vertex_ids().data(), in, MatrixSpan<double>{omp.data(), omp.rows(), 3, 3}});
+  CHECK(seq == ref);
+  CHECK(omp == ref);
+}

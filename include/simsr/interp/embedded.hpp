@@ -15,6 +15,7 @@
 #include "../core/types.hpp"
 #include "../discretize/embedding.hpp"
 #include "concepts.hpp"
+#include "detail/embedded_apply.hpp"
 #include "problem.hpp"
 
 namespace simsr::interp {
@@ -55,14 +56,10 @@ class Embedded {
       throw ShapeError("Embedded::apply: LR displacement", {num_lr_, 3}, {lr_displacement.rows(), lr_displacement.cols()});
     if (hr_displacement.rows() != num_hr() || hr_displacement.cols() != 3)
       throw ShapeError("Embedded::apply: HR displacement", {num_hr(), 3}, {hr_displacement.rows(), hr_displacement.cols()});
-    const auto& W = embedding_.weights;
-    exec::parallel_for(policy, num_hr(), [&](Index q) {
-      for (int d = 0; d < 3; ++d) {
-        S x = S(0);
-        for (int k = 0; k < 4; ++k) x += W(q, k) * S(lr_displacement(ids_(q, k), d));
-        hr_displacement(q, d) = x;
-      }
-    });
+    using In = detail::EigenAccess<const DI>;
+    using Out = detail::EigenAccess<DO>;
+    exec::parallel_for(policy, num_hr(),
+                       detail::EmbeddedApply<S, In, Out>{embedding_.weights.data(), ids_.data(), In{&lr_displacement.derived()}, Out{&hr_displacement.derived()}});
   }
 
   /// N, the LR vertex count fitted on (0 before fit).

@@ -28,10 +28,45 @@
 #include <Eigen/SparseCore>
 
 #include "../../core/error.hpp"
+#include "../../core/host_device.hpp"
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
 
 namespace simsr::physics {
+
+namespace detail {
+/// y(3b..3b+2) = Σ over block row b's blocks of A_bk · x(3k..3k+2): BlockCsr's product, one
+/// functor for exec::seq, exec::omp (host arrays) and exec::cuda (DeviceBlockCsr's device arrays).
+template <class S, class Value>
+struct BlockCsrProduct {
+  const int* outer;
+  const int* inner;
+  const Value* values;
+  const S* x;
+  S* y;
+  SIMSR_HOST_DEVICE void operator()(Index b) const {
+    S s0 = 0, s1 = 0, s2 = 0;
+    for (int k = outer[b]; k < outer[b + 1]; ++k) {
+      const Value* a = values + 9 * std::size_t(k);
+      const S* xb = x + 3 * std::size_t(inner[k]);
+      const S x0 = xb[0], x1 = xb[1], x2 = xb[2];
+      // one term at a time, in column order (file comment)
+      s0 += S(a[0]) * x0;
+      s0 += S(a[1]) * x1;
+      s0 += S(a[2]) * x2;
+      s1 += S(a[3]) * x0;
+      s1 += S(a[4]) * x1;
+      s1 += S(a[5]) * x2;
+      s2 += S(a[6]) * x0;
+      s2 += S(a[7]) * x1;
+      s2 += S(a[8]) * x2;
+    }
+    y[3 * b] = s0;
+    y[3 * b + 1] = s1;
+    y[3 * b + 2] = s2;
+  }
+};
+}  // namespace detail
 
 /// The 3×3 block copy of a square-blocked CSR matrix (see the file comment). S: the scalar of
 /// the source matrix and of the vectors; Value: how the block values are stored (S or float).
@@ -66,32 +101,7 @@ class BlockCsr {
   void multiply(P policy, const VecX<S>& x, VecX<S>& y) const {
     if (x.size() != 3 * block_cols_) throw ShapeError("BlockCsr::multiply: x", {3 * block_cols_}, {x.size()});
     if (y.size() != 3 * block_rows_) y.resize(3 * block_rows_);
-    const int* outer = outer_.data();
-    const int* inner = inner_.data();
-    const Value* val = values_.data();
-    const S* xv = x.data();
-    S* yv = y.data();
-    exec::parallel_for(policy, block_rows_, [&](Index b) {
-      S s0 = 0, s1 = 0, s2 = 0;
-      for (int k = outer[b]; k < outer[b + 1]; ++k) {
-        const Value* a = val + 9 * std::size_t(k);
-        const S* xb = xv + 3 * std::size_t(inner[k]);
-        const S x0 = xb[0], x1 = xb[1], x2 = xb[2];
-        // one term at a time, in column order (file comment)
-        s0 += S(a[0]) * x0;
-        s0 += S(a[1]) * x1;
-        s0 += S(a[2]) * x2;
-        s1 += S(a[3]) * x0;
-        s1 += S(a[4]) * x1;
-        s1 += S(a[5]) * x2;
-        s2 += S(a[6]) * x0;
-        s2 += S(a[7]) * x1;
-        s2 += S(a[8]) * x2;
-      }
-      yv[3 * b] = s0;
-      yv[3 * b + 1] = s1;
-      yv[3 * b + 2] = s2;
-    });
+    exec::parallel_for(policy, block_rows_, detail::BlockCsrProduct<S, Value>{outer_.data(), inner_.data(), values_.data(), x.data(), y.data()});
   }
 
   /// The blocks: block row b holds blocks block_outer()[b] .. block_outer()[b+1] − 1, block k in
