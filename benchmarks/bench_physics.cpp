@@ -39,6 +39,9 @@
 //       (CHOLMOD's supernodal LLᵀ; built with -DSIMSR_WITH_CHOLMOD=ON). Counters:
 //       newton_iterations, linear_iterations (PCG iterations summed over the frame), projected
 //       (Newton iterations whose exact Hessian was not positive definite: assembled twice), fps.
+//   BM_frame_73k/<linear>_extrapolated/omp   the same frame from the face simulator's warm start:
+//       2 x_A − x_before, with x_before the frame before A (jaw 0.08 rad, activation 0.05, targets
+//       −0.5 mm: the same step back), solved once at setup from x_A
 //   BM_kernel_73k/energy+gradient/<policy>   E(x) and ∂E/∂x of the elastic energy
 //   BM_kernel_73k/hessian/<policy>           projected element Hessians (Newton tries the exact
 //       one first; same cost: both go through the signed SVD) gathered into the
@@ -109,6 +112,8 @@ struct Controls {
 };
 constexpr Controls kFrameA{0.10, 0.10, 0.0};
 constexpr Controls kFrameB{0.12, 0.15, 0.0005};
+/// The frame before A, the same step back (for the extrapolated warm start 2 x_A − x_before).
+constexpr Controls kFrameBeforeA{0.08, 0.05, -0.0005};
 
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -131,6 +136,7 @@ struct Scene {
   Points<> targets_a, targets_b;
   DirichletBoundary<> bc_a, bc_b;
   Points<> x_a;  ///< frame A's converged solution (the warm start of every timed frame)
+  Points<> x_before_a;  ///< the frame before A's (kFrameBeforeA), for the extrapolated warm start
   Index setup_iterations = 0;
 
   std::vector<MuscleFibre<>> elements(const Controls& c) const {
@@ -235,6 +241,14 @@ Scene build_scene() {
   s.x_a = m.V;
   const NewtonReport r = newton.solve(exec::omp, s.x_a, s.bc_a, elastic, *s.gravity, *s.springs);
   s.setup_iterations = r.iterations;
+  {  // the frame before A, from A's solution
+    ElasticEnergy<TeranMuscle<>> before(m, TeranMuscle<>(), s.elements(kFrameBeforeA));
+    EmbeddedSprings<> springs = *s.springs;
+    springs.set_targets(s.targets(kFrameBeforeA));
+    s.x_before_a = s.x_a;
+    newton.solve(exec::omp, s.x_before_a, s.boundary(kFrameBeforeA), before, *s.gravity, springs);
+    s.bones->set_transform("jaw", hinge_rotation(s.hinge_point, s.hinge_axis, kFrameB.jaw_angle));  // boundary() moved it
+  }
   std::fprintf(stderr,
                "bench_physics scene: %s, h = %.5f m -> %lld tets, %lld vertices (bbox %.3f x %.3f x %.3f m); cranium %lld, jaw %lld "
                "vertices; %lld muscle tets; %lld track springs; mass %.3f kg; lattice %.1f s; frame A from rest: %lld Newton "
@@ -301,8 +315,10 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 // ---------------------------------------------------------------------------------------------
 // One frame.
 
+/// `Extrapolate`: the frame starts from 2 x_A − x_before (the last two frames' linear extrapolation,
+/// as the face simulator's warm start), not from x_A.
 template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
-          NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block>
+          NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block, bool Extrapolate = false>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
@@ -313,7 +329,10 @@ void BM_frame(benchmark::State& state) {
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
   const auto frame = [&] {
-    x = s.x_a;                         // previous frame's converged solution
+    if constexpr (Extrapolate)
+      x = 2 * s.x_a - s.x_before_a;    // the last two frames extrapolated
+    else
+      x = s.x_a;                       // previous frame's converged solution
     elastic.set_elements(s.elements_b);  // this frame's activations
     springs.set_targets(s.targets_b);    // this frame's track targets
     report = newton.solve(Policy{}, x, s.bc_b, elastic, *s.gravity, springs);  // jaw at this frame's angle
@@ -370,6 +389,9 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 2, Newton
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::fixed, Storage::csr)->Name("BM_frame_73k/pcg_multigrid_csr/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::fixed, Storage::block_single)->Name("BM_frame_73k/pcg_multigrid_single/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::fixed, Storage::block_single)->Name("BM_frame_73k/pcg_multigrid_single_coarse_every_4/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+// the warm start of the face simulator: the last two frames extrapolated
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::fixed, Storage::block, true)->Name("BM_frame_73k/pcg_multigrid_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::fixed, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)
 BENCHMARK_TEMPLATE(BM_frame, CholmodCholesky<>, exec::omp_t)->Name("BM_frame_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #endif
