@@ -121,5 +121,21 @@ TEST_CASE("Multigrid: block and scalar Galerkin levels give the same V-cycle to 
     CAPTURE(seed);
     CHECK((z_blocks - z_scalar).norm() <= 1e-10 * z_scalar.norm());
     for (Index l = 0; l + 1 < blocks.num_levels(); ++l) CHECK(std::abs(blocks.damping(l) - scalar.damping(l)) <= 1e-10 * scalar.damping(l));
+    // the caller's block copy of A (ConjugateGradient's) in place of the multigrid's own: the same V-cycle, bitwise
+    for (const auto storage : {MultigridOptions::Storage::block, MultigridOptions::Storage::block_single}) {
+      BlockCsr<double> Ab;
+      Ab.assign(exec::omp, s.A());
+      Multigrid<> own(prolongations, {.storage = storage}), given(prolongations, {.storage = storage});
+      own.compute(exec::omp, s.A());
+      given.compute(exec::omp, s.A(), Ab);
+      VecX<> z_own, z_given;
+      own.apply(exec::omp, s.b, z_own);
+      given.apply(exec::omp, s.b, z_given);
+      CHECK(z_given == z_own);
+    }
+    BlockCsr<double> wrong;
+    wrong.assign(exec::seq, SparseMatrix<>(3, 3));
+    Multigrid<> mg(prolongations);
+    CHECK_THROWS_AS(mg.compute(exec::seq, s.A(), wrong), ShapeError);
   }
 }

@@ -31,6 +31,7 @@
 #include "../../core/host_device.hpp"
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
+#include "sparse_ops.hpp"
 
 namespace simsr::physics {
 
@@ -85,7 +86,7 @@ class BlockCsr {
     if (A.rows() % 3 || A.cols() % 3)
       throw ShapeError("BlockCsr: matrix (rows and columns multiples of 3)", {A.rows() / 3 * 3, A.cols() / 3 * 3}, {A.rows(), A.cols()});
     if (!A.isCompressed()) throw ArgumentError("BlockCsr: the matrix must be compressed");
-    if (!same_pattern(A)) analyse(A);
+    if (!source_.matches(A)) analyse(A);
     const S* src = A.valuePtr();
     const int* outer = A.outerIndexPtr();
     Value* dst = values_.data();
@@ -124,12 +125,6 @@ class BlockCsr {
   }
 
  private:
-  bool same_pattern(const Source& A) const {
-    return A.rows() == 3 * block_rows_ && A.cols() == 3 * block_cols_ && Index(src_inner_.size()) == Index(A.nonZeros()) &&
-           std::equal(src_outer_.begin(), src_outer_.end(), A.outerIndexPtr()) &&
-           std::equal(src_inner_.begin(), src_inner_.end(), A.innerIndexPtr());
-  }
-
   /// The block pattern of A (every block holding at least one stored entry) and each CSR
   /// entry's slot in the block values. The slots no entry maps to stay zero.
   void analyse(const Source& A) {
@@ -161,15 +156,14 @@ class BlockCsr {
     if (9 * inner_.size() > std::size_t(UINT32_MAX))
       throw ArgumentError("BlockCsr: " + std::to_string(inner_.size()) + " blocks are more than 32-bit slots can address");
     values_.assign(9 * inner_.size(), Value(0));
-    src_outer_.assign(outer, outer + A.rows() + 1);
-    src_inner_.assign(inner, inner + A.nonZeros());
+    source_.remember(A);
   }
 
   Index block_rows_ = 0, block_cols_ = 0;
   std::vector<int> outer_, inner_;      ///< block rows' starts, block columns
   std::vector<Value> values_;           ///< 9 per block, row-major
   std::vector<std::uint32_t> slot_;     ///< CSR entry k → its index in values_
-  std::vector<int> src_outer_, src_inner_;  ///< the pattern analysed (compared at every assign)
+  detail::CsrPattern<int> source_;      ///< the pattern analysed (compared at every assign)
 };
 
 }  // namespace simsr::physics

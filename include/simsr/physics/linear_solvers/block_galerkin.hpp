@@ -78,7 +78,8 @@ class BlockGalerkin {
     if (A.rows() != 3 * W.rows() || A.cols() != A.rows())
       throw ShapeError("BlockGalerkin: the fine matrix (3 × W's rows, square)", {3 * W.rows(), 3 * W.rows()}, {A.rows(), A.cols()});
     if (Index(dropped.size()) != A.rows()) throw ShapeError("BlockGalerkin: dropped DOFs", {A.rows()}, {Index(dropped.size())});
-    if (!same_pattern(A, W)) symbolic(A, W);
+    if (!a_pattern_.matches(A.rows() / 3, A.cols() / 3, A.block_outer(), A.block_inner(), A.num_blocks()) || !w_pattern_.matches(W))
+      symbolic(A, W);
     const Index nf = W.rows(), nc = W.cols();
     const int* ao = A.block_outer();
     const int* ai = A.block_inner();
@@ -147,13 +148,6 @@ class BlockGalerkin {
  private:
   static constexpr Index kChunks = 16;
 
-  bool same_pattern(const BlockCsr<S, S>& A, const SparseMatrix<S>& W) const {
-    const Index nb = A.num_blocks();
-    return W.rows() == w_rows_ && W.cols() == w_cols_ && Index(a_inner_.size()) == nb && Index(w_inner_.size()) == W.nonZeros() &&
-           std::equal(a_outer_.begin(), a_outer_.end(), A.block_outer()) && std::equal(a_inner_.begin(), a_inner_.end(), A.block_inner()) &&
-           std::equal(w_outer_.begin(), w_outer_.end(), W.outerIndexPtr()) && std::equal(w_inner_.begin(), w_inner_.end(), W.innerIndexPtr());
-  }
-
   /// `row` ← the sorted, distinct columns `each` passes to its callback (mark: all zero on entry and exit).
   template <class Each>
   static void row_union(std::vector<char>& mark, std::vector<int>& row, Each&& each) {
@@ -220,12 +214,8 @@ class BlockGalerkin {
     }
     std::fill(Ac_.valuePtr(), Ac_.valuePtr() + 9 * blocks, S(0));
     scratch_.assign(std::size_t(kChunks), std::vector<S>(9 * std::size_t(nc), S(0)));
-    w_rows_ = W.rows();
-    w_cols_ = W.cols();
-    a_outer_.assign(ao, ao + A.rows() / 3 + 1);
-    a_inner_.assign(ai, ai + A.num_blocks());
-    w_outer_.assign(wo, wo + W.rows() + 1);
-    w_inner_.assign(wi, wi + W.nonZeros());
+    a_pattern_.remember(A.rows() / 3, A.cols() / 3, ao, ai, A.num_blocks());
+    w_pattern_.remember(W);
     ++version_;
   }
 
@@ -236,8 +226,7 @@ class BlockGalerkin {
   std::vector<int> ac_block_outer_, ac_block_inner_;  ///< A_c's block pattern
   SparseMatrix<S> Ac_;
   std::vector<std::vector<S>> scratch_;  ///< one dense row of 3×3 accumulators per chunk
-  Index w_rows_ = -1, w_cols_ = -1;
-  std::vector<int> a_outer_, a_inner_, w_outer_, w_inner_;  ///< the patterns of the last symbolic()
+  detail::CsrPattern<int> a_pattern_, w_pattern_;  ///< A's block pattern and W's at the last symbolic()
   std::uint64_t version_ = 0;
 };
 

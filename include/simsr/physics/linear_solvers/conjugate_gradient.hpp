@@ -111,6 +111,10 @@ class ConjugateGradient {
     A_ = &A;
     blocked_ = options_.block_products && A.rows() % 3 == 0;
     if (blocked_) A_block_.assign(policy, A);
+    // a preconditioner that reads A's blocks too (Multigrid) takes this copy instead of making its own
+    if constexpr (requires { preconditioner_.compute(policy, A, A_block_); }) {
+      if (blocked_) return preconditioner_.compute(policy, A, A_block_);
+    }
     preconditioner_.compute(policy, A);
   }
 

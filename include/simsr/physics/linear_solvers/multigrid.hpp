@@ -188,7 +188,11 @@ class Multigrid {
                          {prolongations[l - 1].cols(), -1}, {prolongations[l].rows(), prolongations[l].cols()});
     }
     levels_.resize(prolongations.size() + 1);
-    for (std::size_t l = 0; l < prolongations.size(); ++l) levels_[l].P_geometric = std::move(prolongations[l]);
+    for (std::size_t l = 0; l < prolongations.size(); ++l) {
+      levels_[l].P_geometric = std::move(prolongations[l]);
+      // the Galerkin product in blocks where P = W ⊗ I₃ (lattice_hierarchy's); any other P, scalar
+      if (options_.storage != MultigridOptions::Storage::csr) levels_[l].W = vertex_weights(levels_[l].P_geometric);
+    }
   }
 
   Index num_levels() const { return Index(levels_.size()); }
@@ -211,7 +215,22 @@ class Multigrid {
   /// signal QuasistaticSolver takes to fall back from the exact to the projected Hessian.
   template <exec::HostPolicy P>
   void compute(P policy, const SparseMatrix<S>& A) {
+    compute_levels(policy, A, nullptr);
+  }
+  /// The same, with A's 3×3 block copy already made (ConjugateGradient's, for its own products):
+  /// the finest level reads it instead of copying A again. It must outlive the apply() calls.
+  template <exec::HostPolicy P>
+  void compute(P policy, const SparseMatrix<S>& A, const BlockCsr<S, S>& blocks) {
+    if (blocks.rows() != A.rows() || blocks.cols() != A.cols())
+      throw ShapeError("Multigrid: the block copy of the matrix", {A.rows(), A.cols()}, {blocks.rows(), blocks.cols()});
+    compute_levels(policy, A, &blocks);
+  }
+
+ private:
+  template <exec::HostPolicy P>
+  void compute_levels(P policy, const SparseMatrix<S>& A, const BlockCsr<S, S>* given_blocks) {
     if (levels_.empty()) levels_.resize(1);
+    levels_[0].given_blocks = given_blocks;
     if (A.rows() != A.cols()) throw ShapeError("Multigrid: matrix", {A.rows(), A.rows()}, {A.rows(), A.cols()});
     if (levels_.size() > 1 && levels_[0].P_geometric.rows() != A.rows())
       throw ShapeError("Multigrid: matrix (rows of the first prolongation)", {levels_[0].P_geometric.rows(), levels_[0].P_geometric.rows()},
@@ -228,7 +247,7 @@ class Multigrid {
     if (!stale) {
       ++computes_since_refresh_;
       Level& L = levels_[0];
-      store_blocks(policy, L);
+      store_blocks(policy, L, false);
       L.smoother.compute(policy, A);
       L.omega = options_.damping > 0 ? options_.damping : 4.0 / (3.0 * lambda_max(policy, L));
       return;
@@ -249,13 +268,15 @@ class Multigrid {
         factorize_coarsest(policy, Al, l > 0 ? coarse_structure_version(levels_[l - 1]) : ++direct_version_);
         break;
       }
-      store_blocks(policy, L, block_galerkin_on(L));
+      store_blocks(policy, L, true);
       L.smoother.compute(policy, Al);
       L.omega = options_.damping > 0 ? options_.damping : 4.0 / (3.0 * lambda_max(policy, L));
       galerkin(policy, l);
     }
   }
 
+
+ public:
   /// z = one V-cycle applied to r (z ≈ A⁻¹ r).
   template <exec::HostPolicy P>
   void apply(P policy, const VecX<S>& r, VecX<S>& z) {
@@ -273,14 +294,15 @@ class Multigrid {
     std::vector<Index> pt_source;  ///< Pt's entry k is P's entry pt_source[k]
     SparseProduct<S> ap, galerkin;  ///< A·P, then Pᵀ·(A·P) = the next level's matrix (Storage::csr)
     std::optional<SparseMatrix<S>> W;  ///< P_geometric's vertex weights, where it is W ⊗ I₃ (block storages)
-    bool weights_checked = false;
     BlockGalerkin<S> block_galerkin;  ///< Pᵀ A P in 3×3 blocks (where W is)
     std::vector<char> decoupled;
     const SparseMatrix<S>* A_ref = nullptr;  ///< the caller's matrix (level 0)
     const SparseMatrix<S>* A_coarse = nullptr;  ///< the previous level's Galerkin product (levels ≥ 1)
     BlockJacobi<S> smoother;
-    BlockCsr<S, S> block;             ///< the matrix as 3×3 blocks (Storage::block)
+    BlockCsr<S, S> block;             ///< the matrix as 3×3 blocks (Storage::block; BlockGalerkin's input)
     BlockCsr<S, float> block_single;  ///< … of single-precision values (Storage::block_single)
+    const BlockCsr<S, S>* given_blocks = nullptr;  ///< level 0: the caller's block copy of A, if it gave one
+    const BlockCsr<S, S>& blocks() const { return given_blocks ? *given_blocks : block; }
     double omega = 1;
     VecX<S> b, x, r, t, v;  ///< v: the power iteration's vector, kept as the next compute's start
     const SparseMatrix<S>& matrix() const { return A_ref ? *A_ref : *A_coarse; }
@@ -310,13 +332,13 @@ class Multigrid {
     });
     S* ptv = L.Pt.valuePtr();
     exec::parallel_for(policy, L.Pt.nonZeros(), [&](Index k) { ptv[k] = pv[L.pt_source[std::size_t(k)]]; });
-    if (block_galerkin_on(L)) {
-      L.block_galerkin.compute(policy, L.block, *L.W, L.decoupled);
+    if (L.W) {
+      L.block_galerkin.compute(policy, L.blocks(), *L.W, L.decoupled);
     } else {
       const SparseMatrix<S>& AP = L.ap.compute(policy, A, L.P);
       L.galerkin.compute(policy, L.Pt, AP);
     }
-    SparseMatrix<S>& Ac = block_galerkin_on(L) ? L.block_galerkin.result() : L.galerkin.result();
+    SparseMatrix<S>& Ac = L.W ? L.block_galerkin.result() : L.galerkin.result();
     // a coarse DOF all of whose fine DOFs are fixed has a zero row: make it an identity row
     for (Index r = 0; r < Ac.rows(); ++r) {
       S* diag = nullptr;
@@ -336,18 +358,8 @@ class Multigrid {
     levels_[l + 1].A_coarse = &Ac;
   }
 
-  /// Whether level l's Galerkin product runs in blocks: a block storage and P = W ⊗ I₃ (checked
-  /// once per level; a prolongation of another form takes the scalar products).
-  bool block_galerkin_on(Level& L) const {
-    if (options_.storage == MultigridOptions::Storage::csr || L.P_geometric.size() == 0) return false;
-    if (!L.weights_checked) {
-      L.W = vertex_weights(L.P_geometric);
-      L.weights_checked = true;
-    }
-    return L.W.has_value();
-  }
   static std::uint64_t coarse_structure_version(const Level& L) {
-    return L.W && L.weights_checked ? L.block_galerkin.structure_version() : L.galerkin.structure_version();
+    return L.W ? L.block_galerkin.structure_version() : L.galerkin.structure_version();
   }
 
   /// Sparse LDLᵀ of the coarsest matrix (SparseCholesky: the symbolic analysis only when its
@@ -441,11 +453,12 @@ class Multigrid {
   }
 
   /// The level's copy for the V-cycle's products (MultigridOptions::storage), from its matrix.
-  /// `for_galerkin`: the double blocks too, which BlockGalerkin reads.
+  /// The double blocks where the products or (`galerkin`: a rebuild) BlockGalerkin read them and
+  /// the caller gave none; the single-precision ones for Storage::block_single.
   template <exec::HostPolicy P>
-  void store_blocks(P policy, Level& L, bool for_galerkin = false) const {
+  void store_blocks(P policy, Level& L, bool galerkin) const {
     using enum MultigridOptions::Storage;
-    if (options_.storage == block || (options_.storage == block_single && for_galerkin)) L.block.assign(policy, L.matrix());
+    if (!L.given_blocks && (options_.storage == block || (galerkin && L.W))) L.block.assign(policy, L.matrix());
     if (options_.storage == block_single) L.block_single.assign(policy, L.matrix());
   }
 
@@ -453,7 +466,7 @@ class Multigrid {
   template <exec::HostPolicy P>
   void multiply(P policy, const Level& L, const VecX<S>& x, VecX<S>& y) const {
     switch (options_.storage) {
-      case MultigridOptions::Storage::block: L.block.multiply(policy, x, y); break;
+      case MultigridOptions::Storage::block: L.blocks().multiply(policy, x, y); break;
       case MultigridOptions::Storage::block_single: L.block_single.multiply(policy, x, y); break;
       case MultigridOptions::Storage::csr: sparse_multiply(policy, L.matrix(), x, y); break;
     }

@@ -39,6 +39,32 @@ S dot(P policy, const VecX<S>& a, const VecX<S>& b) {
   return exec::parallel_reduce(policy, a.size(), S(0), [&](Index i) { return a[i] * b[i]; }, [](S u, S v) { return u + v; });
 }
 
+namespace detail {
+/// A CSR pattern (sizes, row starts, column indices) kept to tell whether the next matrix has the
+/// same one: SparseProduct's operands, BlockCsr's source, BlockGalerkin's operands.
+template <class StorageIndex = int>
+struct CsrPattern {
+  Index rows = -1, cols = -1;
+  std::vector<StorageIndex> outer, inner;
+  bool matches(Index r, Index c, const StorageIndex* o, const StorageIndex* i, Index nonzeros) const {
+    return r == rows && c == cols && Index(inner.size()) == nonzeros && std::equal(outer.begin(), outer.end(), o) && std::equal(inner.begin(), inner.end(), i);
+  }
+  void remember(Index r, Index c, const StorageIndex* o, const StorageIndex* i, Index nonzeros) {
+    rows = r, cols = c;
+    outer.assign(o, o + r + 1);
+    inner.assign(i, i + nonzeros);
+  }
+  template <class M>
+  bool matches(const M& m) const {
+    return matches(m.rows(), m.cols(), m.outerIndexPtr(), m.innerIndexPtr(), m.nonZeros());
+  }
+  template <class M>
+  void remember(const M& m) {
+    remember(m.rows(), m.cols(), m.outerIndexPtr(), m.innerIndexPtr(), m.nonZeros());
+  }
+};
+}  // namespace detail
+
 /// C = A·B for row-major CSR matrices whose patterns repeat (the Galerkin products of a multigrid
 /// hierarchy at every Newton iteration): C's structure is built when A's or B's pattern differs
 /// from the last call's, otherwise only its values are recomputed, row by row under the policy
@@ -54,7 +80,7 @@ class SparseProduct {
   const Matrix& compute(P policy, const Matrix& A, const Matrix& B) {
     if (A.cols() != B.rows()) throw ShapeError("SparseProduct: B's rows (A's columns)", {A.cols(), -1}, {B.rows(), B.cols()});
     if (!A.isCompressed() || !B.isCompressed()) throw ArgumentError("SparseProduct: A and B must be compressed");
-    if (!same_pattern(A, a_pattern_) || !same_pattern(B, b_pattern_)) symbolic(A, B);
+    if (!a_pattern_.matches(A) || !b_pattern_.matches(B)) symbolic(A, B);
     const StorageIndex* ao = A.outerIndexPtr();
     const StorageIndex* ai = A.innerIndexPtr();
     const S* av = A.valuePtr();
@@ -89,20 +115,6 @@ class SparseProduct {
 
  private:
   static constexpr Index kChunks = 16;
-  struct Pattern {
-    Index rows = -1, cols = -1;
-    std::vector<StorageIndex> outer, inner;
-  };
-  static bool same_pattern(const Matrix& M, const Pattern& p) {
-    if (M.rows() != p.rows || M.cols() != p.cols || Index(p.inner.size()) != Index(M.nonZeros())) return false;
-    return std::equal(p.outer.begin(), p.outer.end(), M.outerIndexPtr()) && std::equal(p.inner.begin(), p.inner.end(), M.innerIndexPtr());
-  }
-  static void remember(const Matrix& M, Pattern& p) {
-    p.rows = M.rows();
-    p.cols = M.cols();
-    p.outer.assign(M.outerIndexPtr(), M.outerIndexPtr() + M.rows() + 1);
-    p.inner.assign(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros());
-  }
   void symbolic(const Matrix& A, const Matrix& B) {
     std::vector<StorageIndex> outer(std::size_t(A.rows()) + 1, 0), inner, row;
     std::vector<char> mark(std::size_t(B.cols()), 0);
@@ -126,13 +138,13 @@ class SparseProduct {
     std::copy(inner.begin(), inner.end(), C_.innerIndexPtr());
     std::fill(C_.valuePtr(), C_.valuePtr() + inner.size(), S(0));
     scratch_.assign(std::size_t(kChunks), VecX<S>::Zero(B.cols()));
-    remember(A, a_pattern_);
-    remember(B, b_pattern_);
+    a_pattern_.remember(A);
+    b_pattern_.remember(B);
     ++version_;
   }
 
   Matrix C_;
-  Pattern a_pattern_, b_pattern_;
+  detail::CsrPattern<StorageIndex> a_pattern_, b_pattern_;
   std::vector<VecX<S>> scratch_;
   std::uint64_t version_ = 0;
 };

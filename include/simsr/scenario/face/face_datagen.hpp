@@ -226,7 +226,7 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
   f.add(o.substep_levels).add(std::int64_t(o.carry_with_jaw));
   // the products' storage changes frames to rounding, the lagged levels by PCG's tolerance
   f.add(std::int64_t(o.linear.block_products)).add(std::int64_t(o.multigrid.storage)).add(std::int64_t(o.multigrid.coarse_refresh_every));
-  f.add(std::int64_t(o.multigrid.smoothing_sweeps)).add(o.multigrid.damping).add(std::int64_t(o.multigrid.power_iterations));
+  f.add(std::int64_t(o.multigrid.smoothing_sweeps)).add(o.multigrid.damping).add(std::int64_t(o.multigrid.power_iterations)).add(std::int64_t(o.multigrid.warm_power_iterations));
   if (p) {
     f.add(p->weights);
     for (const auto& n : p->names) f.add_bytes(n.data(), n.size());
