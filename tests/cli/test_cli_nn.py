@@ -163,6 +163,17 @@ def main():
     check(m["lr_rest"].shape == (N, 3) and m["hr_faces"].shape == (len(hrF), 3) and m["up_indices"].shape == (M, 4) and m["lr_graph"].shape == (N, 3),
           "model file holds rest shapes, faces and neighbourhoods")
 
+    # --eval-every 2: the held-out frames evaluated at epochs 2 and 3 (the last) only; the weights as evaluated every epoch
+    p = run(exe, base + ["--epochs", "3", "--eval-every", "2", "--out", P("e2.npz"), "--out-dir", P("hist_e2")])
+    p1 = run(exe, base + ["--epochs", "3", "--out", P("e1.npz")])
+    if check(p.returncode == 0 and p1.returncode == 0, "train --eval-every 2 exits 0"):
+        rows = [r.split(",") for r in open(P("hist_e2", "training_history.csv")).read().strip().splitlines()[1:]]
+        check([r[10] != "" for r in rows] == [False, True, True], "--eval-every 2: held-out error at epochs 2 and 3 (the last), none at 1")
+        check(json.loads(p.stdout)["holdout_mean_error"] == json.loads(p1.stdout)["holdout_mean_error"], "the last epoch's held-out error as with --eval-every 1")
+        e1, e2 = np.load(P("e1.npz")), np.load(P("e2.npz"))
+        check(all(np.array_equal(e1[k], e2[k]) for k in e1.files if k.startswith("net_")), "evaluating less often changes no weight")
+    check(run(exe, base + ["--epochs", "1", "--eval-every", "-1", "--out", P("x.npz")], 64).returncode == 64, "train: --eval-every -1 refused (usage error)")
+
     # the same seed gives the same model; resuming a checkpoint continues identically
     p1 = run(exe, base + ["--epochs", "1", "--out", P("m1.npz"), "--checkpoint", P("c1.npz")])
     p2 = run(exe, base + ["--epochs", "2", "--resume", P("c1.npz"), "--out", P("m2.npz")])

@@ -226,10 +226,12 @@ class Mlp {
           for (Index c = 0; c < C; ++c) p[c] = p[c] > S(0) ? p[c] : slope * p[c];
         }
       } else if (s.spec.act == Act::sine) {
-        const S w0 = static_cast<S>(s.spec.omega0);
-        for (Index r = 0; r < rows; ++r) {
-          S* p = y + r * ldy;
-          for (Index c = 0; c < C; ++c) p[c] = std::sin(w0 * p[c]);
+        const S w0 = static_cast<S>(s.spec.omega0);  // Eigen's packet sin, as nn::Sine: the same bits
+        const auto sine = [w0](const auto& v) { return (v * w0).sin(); };
+        if (ldy == C) {
+          detail::map_packets(y, rows * C, sine, static_cast<const S*>(y));
+        } else {
+          for (Index r = 0; r < rows; ++r) detail::map_packets(y + r * ldy, C, sine, static_cast<const S*>(y + r * ldy));
         }
       }
       x = y;
