@@ -12,7 +12,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 bash scripts/deps.sh run
 build=${SIMSR_BUILD_DIR:-build}
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=OFF >/dev/null
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIMSR_TEST_BUILD=OFF -DSIMSR_NATIVE=ON >/dev/null
 cmake --build "$build" -j "$(nproc)" --target simsr_cli cantilever
 data=${SIMSR_DATA:-$root/../shared/data}
 out=${SIMSR_OUT:-$root/out}

@@ -150,6 +150,11 @@ def main():
     check(j["train_frames"] == 9 and j["holdout_frames"] == 3, "frames f %% 4 == 0 held out: 9 train, 3 held out")
     check(j["epochs"] == 2 and j["steps"] == 6, "2 epochs of ceil(9/4) = 3 steps")
     check(j["holdout_mean_error"] > 0 and j["embedded_relative_mean_error"] > 0, "held-out error and the Embedded baseline reported")
+    # the default recipe scales displacements so that the training frames' normalized HR displacement has RMS 1
+    sigma = 0.5 * (0.04998 + 0.05092)
+    trained_rows = [i for i in range(F) if ids[i] % 4 != 0]
+    rms = np.sqrt(np.mean((high[trained_rows] - hrV[None]) ** 2)) / sigma
+    check(abs(j["displacement_scale"] * rms - 1) < 1e-5, "default displacement scale: 1 / RMS of the training frames' normalized HR displacement")
     hist = open(P("hist", "training_history.csv")).read().strip().splitlines()
     check(len(hist) == 3 and hist[0].startswith("epoch,steps,loss"), "training_history.csv: header + one row per epoch")
     check(os.path.getsize(P("hist", "training_loss.svg")) > 500 and os.path.getsize(P("hist", "holdout_error.svg")) > 500, "SVG plots written")
