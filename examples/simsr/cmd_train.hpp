@@ -149,7 +149,7 @@ inline void add_train(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--official-neighbors", a->official_neighbors, "folder with the authors' geo_dist_*.npy files (the bunny layout)");
   auto& r = a->recipe;
   cmd->add_option("--profile", r.profile, "official (default) | paper")->check(CLI::IsMember({"official", "paper"}));
-  cmd->add_option("--epochs", r.epochs, "epochs (default: 60 official, 20 minutes for the bunny on 2 cores; 10 paper)");
+  cmd->add_option("--epochs", r.epochs, "epochs (default: 60 official, about 17 minutes for the bunny on 2 cores; 10 paper)");
   cmd->add_option("--seed", r.seed, "seed of the initial weights and the shuffling (default 0)");
   cmd->add_option("--batch-size", r.batch_size, "frames per batch (default 8; the official code uses 32)");
   cmd->add_option("--lr", r.lr, "Adam learning rate (default 1e-3; the official code uses 2e-4)");
