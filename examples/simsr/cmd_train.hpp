@@ -37,14 +37,7 @@ struct TrainArgs {
   std::string lr, hr, frames, out, neighbors, official_neighbors, checkpoint, resume, out_dir, contact;
   Index holdout = 4;
   Index eval_every = 1;  ///< evaluate the held-out frames every that many epochs (and after the last)
-  /// NetworkRecipe's defaults (batch 8, Adam 1e-3, residual, 60 epochs) with the bunny recipe's
-  /// unit-RMS displacements and the learning rate halved every 12 epochs (README, "Training on the bunny")
-  interp::NetworkRecipe recipe = [] {
-    interp::NetworkRecipe r;
-    r.displacement_scale = 0;
-    r.lr_decay_epochs = 12;
-    return r;
-  }();
+  interp::NetworkRecipe recipe;  ///< the library's defaults, the measured bunny recipe (network_recipe.hpp)
   bool quiet = false;
 };
 

@@ -8,9 +8,9 @@ import pytest
 import simsr
 from conftest import assert_no_memory_growth
 
-# the official network (706,871 parameters) over small neighbourhoods, with interp::NetworkRecipe's
-# recipe (the residual over Embedded, Adam 1e-3, the learning rate halved every 10 epochs; the tool is
-# told the official displacement scale and that decay: its own defaults are the bunny recipe's 0 and 12)
+# the official network (706,871 parameters) over small neighbourhoods, the residual over Embedded,
+# Adam 1e-3, the learning rate halved every 10 epochs, the official displacement scale; the tool is
+# told that scale and decay (its defaults, interp::NetworkRecipe's, are the bunny recipe's 0 and 12)
 SMALL = {"knn": 3, "upK": 4, "residual": True, "lr": 1e-3}
 
 

@@ -54,26 +54,6 @@ void map_rows_backward(Policy policy, const ConstView<S>& in, const ConstView<S>
     }
   });
 }
-/// out = op(in) over fixed row chunks, `op` an Eigen array expression on one span of values
-/// (`op(x)` for `Eigen::Map<const Eigen::Array<S, -1, 1>> x`): a chunk of a contiguous view is one
-/// span, so Eigen's packet math (e.g. its vectorized tanh) runs over the chunk, not over rows of 9.
-template <class S, class Policy, class Op>
-void map_spans(Policy policy, const ConstView<S>& in, Matrix<S>& out, Op&& op) {
-  const Index R = in.rows(), C = in.cols();
-  ensure_shape(out, R, C);
-  const bool contiguous = in.outerStride() == C;
-  const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
-  exec::for_chunks(policy, R, nc, workers, [&](Index, Index, Index b, Index e) {
-    using Span = Eigen::Map<Eigen::Array<S, Eigen::Dynamic, 1>>;
-    using ConstSpan = Eigen::Map<const Eigen::Array<S, Eigen::Dynamic, 1>>;
-    if (b >= e) return;
-    if (contiguous) {
-      Span(out.row(b).data(), (e - b) * C) = op(ConstSpan(in.row(b).data(), (e - b) * C));
-    } else {
-      for (Index r = b; r < e; ++r) Span(out.row(r).data(), C) = op(ConstSpan(in.row(r).data(), C));
-    }
-  });
-}
 /// y[i] = f(x[i], …) for i < n over one or more inputs, `f` an Eigen array expression of fixed
 /// blocks of 16 values: every value goes through Eigen's packet functions (the last block padded),
 /// so its result depends on the values alone. Eigen's own loop over a span computes the span's
@@ -145,8 +125,8 @@ class LeakyReLU {
 static_assert(assert_layer<LeakyReLU<float>>());
 
 /// tanh (the activation of Chen et al. 2023's mesh encoders, supplement §3). `out` must not
-/// alias `in`. Eigen's tanh: for float its vectorized rational approximation (within a few ulp
-/// of std::tanh; tested), which made the thin-shell network's training step 2× faster at the
+/// alias `in`. Eigen's packet tanh (detail::map_packets): for float its vectorized rational
+/// approximation (within a few ulp of std::tanh; tested), which made the thin-shell network's training step 2× faster at the
 /// fine SHEET's 4,225 vertices (libm's scalar tanhf and its expm1f were 40 % of a step). The
 /// gradient is 1 − y² from the forward's output y, not a second tanh of the input.
 template <class S = float>
@@ -157,7 +137,7 @@ class Tanh {
 
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
-    detail::map_spans<S>(policy, in, out, [](const auto& x) { return x.tanh(); });
+    detail::map_rows_packets<S>(policy, out, [](const auto& x) { return x.tanh(); }, in);
   }
   template <exec::HostPolicy Policy>
   void backward(Policy policy, const ConstView<S>& in, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_in) {
