@@ -6,6 +6,10 @@
 ///  - BM_official_forward_paper_size/{seq,omp}/baseline_blocked_gemm_knn: the same with the dynamic
 ///    feature graph's earlier kernel (neighbors::SelfKernel::blocked_gemm; issue #17 item 4's
 ///    baseline, run beside the default fused kernel).
+///  - BM_official_forward_paper_size/{seq,omp}/baseline_per_edge_first_layers: the same with the
+///    eval layers unfactorized (FeatureEmbedding::set_factorized_eval(false)): EdgeConv's first
+///    Linear per edge instead of per point, fc_out's first Linear on the stored concatenation
+///    cat(h, e, max, mean) instead of its parts with the global features once per item.
 ///  - BM_official_dynamic_knn_paper_size/{fused,blocked_gemm}/{seq,omp}: that graph alone (k = 5
 ///    nearest other points of the N = 15,872 rows of h¹, 64 features, as block 1's EdgeConv builds
 ///    it) on the features of one inference; the setup checks that both kernels give the same graph
@@ -103,9 +107,10 @@ Matrix<float> paper_ldx(Index B) {
 }
 
 template <class Search, exec::HostPolicy Policy>
-void BM_official_forward_paper_size(Policy policy, benchmark::State& state) {
+void BM_official_forward_paper_size(Policy policy, benchmark::State& state, bool factorized = true) {
   nn::Rng rng(0);
   nn::SuperResolutionNet<float, Search> net(paper_config(), paper_geo(), rng);
+  net.feature_embedding().set_factorized_eval(factorized);
   const Matrix<float> ldx = paper_ldx(1);
   Matrix<float> pred;
   net.prepare_inference(policy);
@@ -251,6 +256,8 @@ void BM_official_forward_paper_size_seq(benchmark::State& s) { BM_official_forwa
 void BM_official_forward_paper_size_omp(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::omp, s); }
 void BM_official_forward_paper_size_seq_baseline(benchmark::State& s) { BM_official_forward_paper_size<BaselineKnn>(exec::seq, s); }
 void BM_official_forward_paper_size_omp_baseline(benchmark::State& s) { BM_official_forward_paper_size<BaselineKnn>(exec::omp, s); }
+void BM_official_forward_paper_size_seq_per_edge(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::seq, s, false); }
+void BM_official_forward_paper_size_omp_per_edge(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::omp, s, false); }
 
 /// h¹ of one inference at the paper's size: the rows block 1's dynamic graph is built on.
 const FusedKnn::point_matrix& paper_block1_features() {
@@ -298,6 +305,16 @@ BENCHMARK(BM_official_forward_paper_size_seq_baseline)
     ->MinTime(3.0);
 BENCHMARK(BM_official_forward_paper_size_omp_baseline)
     ->Name("BM_official_forward_paper_size/omp/baseline_blocked_gemm_knn")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK(BM_official_forward_paper_size_seq_per_edge)
+    ->Name("BM_official_forward_paper_size/seq/baseline_per_edge_first_layers")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK(BM_official_forward_paper_size_omp_per_edge)
+    ->Name("BM_official_forward_paper_size/omp/baseline_per_edge_first_layers")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);

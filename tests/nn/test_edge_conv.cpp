@@ -221,3 +221,65 @@ TEST_CASE("nn::DynamicKnnGraph: the fused kNN kernel gives the blocked-GEMM kern
     CHECK(gb == gs);  // random features: no exact ties
   }
 }
+
+namespace {
+/// The edge MLP of `ec` run per edge on the gathered rows cat(h_j − h_i, h_i) (Mlp's eval path,
+/// its first Linear per edge), then the max over each point's k edges: EdgeConv's eval forward
+/// before the point-wise first layer.
+template <class S>
+Matrix<S> per_edge_eval(nn::EdgeConv<S>& ec, const Matrix<S>& h, Index N) {
+  nn::GraphFeatures<S> gf(ec.graph(), N);
+  Matrix<S> edges, values;
+  gf.forward(exec::seq, nn::Mode::eval, h, edges);
+  ec.edge_function().forward(exec::seq, nn::Mode::eval, edges, values);
+  const Index k = ec.k();
+  Matrix<S> y(h.rows(), values.cols());
+  for (Index r = 0; r < h.rows(); ++r) y.row(r) = values.middleRows(r * k, k).colwise().maxCoeff();
+  return y;
+}
+}  // namespace
+
+TEST_CASE("nn::EdgeConv: the eval path's point-wise first layer gives the per-edge edge MLP's values (random shapes, both edge functions)") {
+  std::mt19937_64 rng(78);
+  std::uniform_int_distribution<int> dim(1, 9), kk(1, 6), items(1, 3);
+  for (int trial = 0; trial < 40; ++trial) {
+    const Index B = items(rng), N = 8 + dim(rng), C = dim(rng), O = dim(rng), k = kk(rng);
+    const bool official = trial % 2 == 0, shared = trial % 3 != 0;
+    INFO("trial " << trial << ": B " << B << " N " << N << " C " << C << " O " << O << " k " << k << " official " << official);
+    typename nn::EdgeConv<double>::Options opt;
+    opt.edge_mlp = official ? nn::EdgeConv<double>::EdgeMlp::official : nn::EdgeConv<double>::EdgeMlp::single_linear;
+    nn::ParameterStore<double> sd;
+    nn::ParameterStore<float> sf;
+    nn::Rng id(trial), iff(trial);
+    nn::EdgeConv<double> ecd(sd, "ec", C, O, k, id, opt);
+    typename nn::EdgeConv<float>::Options optf;
+    optf.edge_mlp = official ? nn::EdgeConv<float>::EdgeMlp::official : nn::EdgeConv<float>::EdgeMlp::single_linear;
+    nn::EdgeConv<float> ecf(sf, "ec", C, O, k, iff, optf);
+    if (official) {  // running statistics and affine parameters away from the identity
+      ecd.batch_norm().running_mean() = random_matrix(rng, 2 * O, 1);
+      ecd.batch_norm().running_var() = random_matrix(rng, 2 * O, 1, 0.3, 2.0);
+      ecd.batch_norm().weight() = random_matrix(rng, 2 * O, 1, 0.5, 1.5);
+      ecd.batch_norm().bias() = random_matrix(rng, 2 * O, 1);
+    }
+    sf.values() = sd.values().cast<float>();
+    sf.buffers() = sd.buffers().cast<float>();
+    const GraphIndices g = random_graph(rng, shared ? N : B * N, N, k);
+    ecd.set_graph(g, N);
+    ecf.set_graph(g, N);
+    // features far from the origin beside their differences: the point-wise form's cancellation
+    Matrix<double> h = random_matrix(rng, B * N, C, -1.0, 1.0);
+    h.rowwise() += random_matrix(rng, 1, C, -20.0, 20.0).row(0);
+    const Matrix<float> hf = h.cast<float>();
+    Matrix<double> yd;
+    Matrix<float> yf, yf_omp;
+    ecd.forward(exec::seq, nn::Mode::eval, h, yd);
+    ecf.forward(exec::seq, nn::Mode::eval, hf, yf);
+    ecf.forward(exec::omp, nn::Mode::eval, hf, yf_omp);
+    CHECK(test::bitwise_equal(yf, yf_omp));
+    const Matrix<double> refd = per_edge_eval(ecd, h, N);
+    const Matrix<float> reff = per_edge_eval(ecf, hf, N);
+    const double scale = 1.0 + refd.cwiseAbs().maxCoeff();
+    CHECK((yd - refd).cwiseAbs().maxCoeff() <= 1e-12 * scale * 20);
+    CHECK((yf - reff).cwiseAbs().maxCoeff() <= 2e-5 * scale * 20);
+  }
+}

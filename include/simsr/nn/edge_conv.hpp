@@ -94,10 +94,19 @@ class EdgeConv {
   /// The edge function's output of the last forward, (B·N·k)×out: what max_pool() pooled.
   const Matrix<S>& edge_values() const { return e4_; }
 
-  /// In eval mode (BatchNorm on running statistics) the edge rows are gathered chunk by chunk
-  /// into per-worker scratch and run through the edge MLP there (Mlp::eval_block, the chunks of
-  /// Linear::forward): the (B·N·k)×2C edge features and the MLP's intermediates are never stored,
-  /// and the values are those of the stored path. A backward after it recomputes them.
+  /// Eval forward with the first Linear per point (the default) or per edge (false: the values of
+  /// the stored path bit for bit, k times the first layer's products; the benchmarks' baseline).
+  void set_point_wise_first_layer(bool on) { point_wise_ = on; }
+  bool point_wise_first_layer() const { return point_wise_; }
+
+  /// In eval mode (BatchNorm on running statistics) no edge row is stored. The first Linear is
+  /// applied per point, not per edge: on cat(h_j − h_i, h_i) its weight [W_d | W_s] gives
+  /// W_d·h_j + (W_s − W_d)·h_i, so the products P = h·[W_d; W_s − W_d]ᵀ (two numbers per point and
+  /// channel) serve every edge, k times fewer multiply-adds than per edge; each chunk of edge rows
+  /// then sums its two rows of P into per-worker scratch and runs the rest of the edge MLP there
+  /// (Mlp::eval_block_after_first_linear). The values are those of the stored path up to rounding
+  /// (the same sums in another order); seq == omp bitwise. A backward after it recomputes the
+  /// stored path.
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode mode, const ConstView<S>& in, Matrix<S>& out) {
     detail::check_shape("nn::EdgeConv", "input", in, -1, in_);
@@ -106,7 +115,9 @@ class EdgeConv {
       features_.set_graph(dyn_graph_, n_);
     }
     lean_ = mode == Mode::eval && mlp_.eval_fusable();
-    if (lean_) {
+    if (lean_ && point_wise_) {
+      forward_point_wise(policy, in);
+    } else if (lean_) {
       forward_fused(policy, in);
     } else {
       features_.forward(policy, mode, in, e0_);
@@ -129,22 +140,70 @@ class EdgeConv {
   }
 
  private:
-  template <class Policy>
-  void forward_fused(Policy policy, const ConstView<S>& in) {
+  void check_fused_input(const ConstView<S>& in) const {
     if (features_.graph().size() == 0) throw ArgumentError("nn::GraphFeatures: no graph set (call set_graph first)");
     if (in.rows() % features_.graph().rows())
       throw ShapeError("nn::GraphFeatures: input rows (a multiple of the graph's " + std::to_string(features_.graph().rows()) + ")",
                        {-1, in.cols()}, {in.rows(), in.cols()});
-    const Index R = in.rows() * k_, C2 = 2 * in_;
+  }
+
+  /// The eval path with the first Linear per edge: each chunk of edge rows gathered into
+  /// per-worker scratch and run through the whole edge MLP there (Mlp::eval_block).
+  template <class Policy>
+  void forward_fused(Policy policy, const ConstView<S>& in) {
+    check_fused_input(in);
+    const Index C2 = 2 * in_;
+    for_edge_chunks(policy, in.rows() * k_, C2, [&](Index w, Index b, Index e, S* g) {
+      features_.gather(in, b, e, g, C2);
+      mlp_.eval_block(w, e - b, g, C2, e4_.data() + b * e4_.cols(), e4_.cols());
+    });
+  }
+
+  /// The eval paths' loop over chunks of the R edge rows: e4_ and the edge MLP's scratch sized,
+  /// body(worker, begin, end, scratch) with a per-worker scratch block of `width` columns.
+  template <class Policy, class Body>
+  void for_edge_chunks(Policy policy, Index R, Index width, Body&& body) {
     ensure_shape(e4_, R, mlp_.out_features());
     const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
     mlp_.prepare_eval_blocks(R, workers);
     if (gathered_.size() < std::size_t(workers)) gathered_.resize(std::size_t(workers));
-    for (auto& g : gathered_) ensure_shape(g, exec::max_chunk_size(R, nc), C2);
-    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
-      Matrix<S>& g = gathered_[std::size_t(w)];
-      features_.gather(in, b, e, g.data(), C2);
-      mlp_.eval_block(w, e - b, g.data(), C2, e4_.data() + b * e4_.cols(), e4_.cols());
+    for (auto& g : gathered_) ensure_shape(g, exec::max_chunk_size(R, nc), width);
+    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) { body(w, b, e, gathered_[std::size_t(w)].data()); });
+  }
+
+  template <class Policy>
+  void forward_point_wise(Policy policy, const ConstView<S>& in) {
+    check_fused_input(in);
+    // the point-wise first layer: point_w_ = [W_d; W_s − W_d] (2H × C), P = in·point_wᵀ (+ bias on the point's half)
+    Linear<S>& first = mlp_.linear(0);
+    const Index C = in_, H = first.out_features(), P = in.rows(), R = P * k_;
+    const auto W = first.weight();
+    ensure_shape(point_w_, 2 * H, C);
+    point_w_.topRows(H) = W.leftCols(C);
+    point_w_.bottomRows(H) = W.rightCols(C) - W.leftCols(C);
+    ensure_shape(point_terms_, P, 2 * H);
+    const Index pc = exec::chunk_count(P, product_chunks), pw = exec::worker_count(policy, pc);
+    if (point_gemm_.size() < std::size_t(pw)) point_gemm_.resize(std::size_t(pw));
+    for (Index w = 0; w < pw; ++w) point_gemm_[std::size_t(w)].reserve(exec::max_chunk_size(P, pc), 2 * H, C);
+    detail::for_chunks_dynamic(policy, P, pc, pw, [&](Index w, Index, Index b, Index e) {
+      S* dst = point_terms_.data() + b * 2 * H;
+      point_gemm_[std::size_t(w)].run(e - b, 2 * H, C, in.data() + b * in.outerStride(), in.outerStride(), false, point_w_.data(), C, true, dst,
+                                      2 * H, false);
+      if (first.has_bias()) {
+        Eigen::Map<Matrix<S>> half(dst, e - b, 2 * H);
+        half.rightCols(H).rowwise() += first.bias().transpose();
+      }
+    });
+    // the edges: row (point, j) = P[neighbour, :H] + P[point, H:], then the rest of the edge MLP
+    for_edge_chunks(policy, R, H, [&](Index w, Index b, Index e, S* y0) {  // y0: the first Linear's output of the chunk
+      for (Index er = b; er < e; ++er) {
+        const auto [row, nbr] = features_.edge_rows(er);
+        const S* pn = point_terms_.data() + nbr * 2 * H;
+        const S* pr = point_terms_.data() + row * 2 * H + H;
+        S* y = y0 + (er - b) * H;
+        for (Index c = 0; c < H; ++c) y[c] = pn[c] + pr[c];
+      }
+      mlp_.eval_block_after_first_linear(w, e - b, y0, H, e4_.data() + b * e4_.cols(), e4_.cols());
     });
   }
 
@@ -157,8 +216,11 @@ class EdgeConv {
   Mlp<S> mlp_;
   GroupPool<S> pool_;
   Matrix<S> e0_, e4_, g0_, g4_;
-  std::vector<Matrix<S>> gathered_;  ///< fused eval path: per worker, one chunk of edge rows
-  bool lean_ = false;                ///< the last forward was the fused eval one (e0_ not made)
+  std::vector<Matrix<S>> gathered_;  ///< eval paths: per worker, one chunk's edge rows (per edge) or first Linear output (point-wise)
+  Matrix<S> point_w_, point_terms_;  ///< fused eval path: [W_d; W_s − W_d] and the per-point products
+  std::vector<SerialGemm<S>> point_gemm_;
+  bool lean_ = false;                ///< the last forward was an eval one (e0_ not made)
+  bool point_wise_ = true;           ///< eval: the first Linear per point
 };
 static_assert(assert_layer<EdgeConv<float>>());
 

@@ -53,18 +53,42 @@ class EmbeddingBlock {
   /// The edge convolution's output of the last forward, (B·N)×out.
   const Matrix<S>& edge_output() const { return e_; }
 
+  /// The eval forward's factorized first layers (EdgeConv's per point, fc_out's on the parts; the
+  /// default) or the layers as the stored path computes them (false: those bits, more products;
+  /// the benchmarks' baseline).
+  void set_factorized_eval(bool on) {
+    factorized_ = on;
+    edge_.set_point_wise_first_layer(on);
+  }
+
+  /// In eval mode fc_out's first Linear reads the parts of cat(h, e, max, mean) in place, the
+  /// global max and mean (the same on every point of an item) once per item
+  /// (Mlp::forward_eval_parts): a third to a half of its multiply-adds, no concatenation stored.
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode mode, const ConstView<S>& h, Matrix<S>& out) {
     edge_.forward(policy, mode, h, e_);
     gmax_.forward(policy, mode, e_, max_);
     gmean_.forward(policy, mode, e_, mean_);
+    if (mode == Mode::eval && factorized_ && fc_out_.eval_fusable() && h.rows() % n_ == 0) {
+      using Items = Eigen::Map<const Matrix<S>, 0, Eigen::OuterStride<>>;  // row b·N of the broadcast pools: item b's value
+      const Index B = h.rows() / n_;
+      const Items max_items(max_.data(), B, out_, Eigen::OuterStride<>(n_ * out_)), mean_items(mean_.data(), B, out_, Eigen::OuterStride<>(n_ * out_));
+      fc_out_.forward_eval_parts(policy, {{h, false}, {e_, false}, {max_items, true}, {mean_items, true}}, n_, out);
+      cat_stale_ = true;
+      return;
+    }
     cat_.forward(policy, {h, e_, max_, mean_}, cat_out_);
     fc_out_.forward(policy, mode, cat_out_, out);
+    cat_stale_ = false;
   }
 
   /// d_h written when not null (the block's input gradient, all paths summed).
   template <exec::HostPolicy Policy>
   void backward(Policy policy, const ConstView<S>& h, const ConstView<S>& out, const ConstView<S>& d_out, Matrix<S>* d_h) {
+    if (cat_stale_) {  // the eval forward formed no concatenation
+      cat_.forward(policy, {h, e_, max_, mean_}, cat_out_);
+      cat_stale_ = false;
+    }
     fc_out_.backward(policy, cat_out_, out, d_out, &d_cat_);
     cat_.backward(policy, d_cat_, {&d_h_direct_, &d_e_, &d_max_, &d_mean_}, false);
     gmax_.backward(policy, e_, max_, d_max_, &d_e_part_);
@@ -117,6 +141,8 @@ class EmbeddingBlock {
   Concat<S> cat_;
   Mlp<S> fc_out_;
   Matrix<S> e_, max_, mean_, cat_out_, d_cat_, d_h_direct_, d_e_, d_max_, d_mean_, d_e_part_;
+  bool cat_stale_ = false;  ///< the last forward was the eval one: cat_out_ not formed
+  bool factorized_ = true;
 };
 static_assert(assert_layer<EmbeddingBlock<float>>());
 
@@ -179,6 +205,10 @@ class FeatureEmbedding {
   Index out_features(Index = -1) const { return cat_->out_features(); }
   /// h^{s+1}, the output of block s after its dropout, from the last forward.
   const Matrix<S>& block_output(Index s) const { return h_.at(std::size_t(s)); }
+  /// EmbeddingBlock::set_factorized_eval for every block.
+  void set_factorized_eval(bool on) {
+    for (auto& b : blocks_) b->set_factorized_eval(on);
+  }
 
   /// h0: (B·N)×D₀ → z = [h0, h¹, …] (B·N)×Σ D.
   template <exec::HostPolicy Policy>

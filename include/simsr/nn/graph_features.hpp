@@ -14,6 +14,7 @@
 
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "../neighbors/brute_force_knn.hpp"
@@ -104,13 +105,20 @@ class GraphFeatures {
   /// at `dst` with leading dimension `ld` (≥ 2C): EdgeConv's fused eval path gathers its chunks
   /// with it.
   void gather(const ConstView<S>& in, Index e0, Index e1, S* dst, Index ld) const {
-    const Index R = graph_.rows(), k = graph_.cols(), C = in.cols();
+    const Index C = in.cols();
     for (Index er = e0; er < e1; ++er) {
-      const Index row = er / k, j = er % k, p = row / R, r = row % R, base = p * R + (r / n_) * n_;
+      const auto [row, nbr] = edge_rows(er);
       Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> o(dst + (er - e0) * ld, 2 * C);
-      o.head(C) = in.row(base + graph_(r, j)) - in.row(row);
+      o.head(C) = in.row(nbr) - in.row(row);
       o.tail(C) = in.row(row);
     }
+  }
+
+  /// The input rows that edge row er of forward's output joins: {its point, the neighbour}.
+  std::pair<Index, Index> edge_rows(Index er) const {
+    const Index R = graph_.rows(), k = graph_.cols();
+    const Index row = er / k, j = er % k, p = row / R, r = row % R, base = p * R + (r / n_) * n_;
+    return {row, base + graph_(r, j)};
   }
 
   /// d_in[t] = Σ_{edges (n, j) → t} d_nbr − Σ_j d_nbr(t, j) + Σ_j d_ctr(t, j), where d_nbr and

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <string>
@@ -207,36 +208,90 @@ class Mlp {
     }
     lean_ = true;
   }
-  void eval_block(Index w, Index rows, const S* in, Index ld_in, S* out, Index ld_out) {
-    Scratch& sc = scratch_[std::size_t(w)];
-    const S* x = in;
-    Index ldx = ld_in;
-    const std::size_t last = stages_.size() - 1;
-    for (std::size_t i = 0; i <= last; ++i) {
-      Stage& s = *stages_[i];
-      S* y = i == last ? out : sc.buf[i % 2].data();
-      const Index ldy = i == last ? ld_out : sc.buf[i % 2].cols();
-      s.linear->forward_block(sc.gemm[i], rows, x, ldx, y, ldy);
-      if (s.bn) s.bn->apply_eval(y, ldy, rows);
-      const Index C = s.spec.out;
-      if (s.spec.act == Act::leaky_relu) {
-        const S slope = static_cast<S>(s.spec.slope);
-        for (Index r = 0; r < rows; ++r) {
-          S* p = y + r * ldy;
-          for (Index c = 0; c < C; ++c) p[c] = p[c] > S(0) ? p[c] : slope * p[c];
-        }
-      } else if (s.spec.act == Act::sine) {
-        const S w0 = static_cast<S>(s.spec.omega0);  // Eigen's packet sin, as nn::Sine: the same bits
-        const auto sine = [w0](const auto& v) { return (v * w0).sin(); };
-        if (ldy == C) {
-          detail::map_packets(y, rows * C, sine, static_cast<const S*>(y));
-        } else {
-          for (Index r = 0; r < rows; ++r) detail::map_packets(y + r * ldy, C, sine, static_cast<const S*>(y + r * ldy));
-        }
-      }
-      x = y;
-      ldx = ldy;
+  void eval_block(Index w, Index rows, const S* in, Index ld_in, S* out, Index ld_out) { eval_stages(w, rows, in, ld_in, nullptr, out, ld_out); }
+  /// eval_block for a caller that computed stage 0's Linear itself (bias included) into `y0`
+  /// (rows × spec(0).out, leading dimension ld0): stage 0's BatchNorm and activation are applied
+  /// to it in place, then the later stages run as in eval_block. EdgeConv's point-wise first
+  /// layer and forward_eval_parts use it.
+  void eval_block_after_first_linear(Index w, Index rows, S* y0, Index ld0, S* out, Index ld_out) {
+    eval_stages(w, rows, nullptr, 0, y0, out, ld_out, ld0);
+  }
+
+  /// One input part of forward_eval_parts: `per_item` parts hold one row per batch item (B rows),
+  /// the others one row per row of the output (B·rows_per_item rows).
+  struct InputPart {
+    ConstView<S> values;
+    bool per_item = false;
+  };
+
+  /// Eval forward (BatchNorm on running statistics) of cat(parts) without forming it: stage 0's
+  /// Linear is applied part by part, and the parts that are the same on every row of a batch
+  /// item (an embedding block's global max and mean) once per item instead of once per row:
+  /// W·cat(x, g) = W_x·x + (W_g·g + b). The values are forward(Mode::eval)'s on the concatenation
+  /// up to rounding (the products are summed in another order), seq == omp bitwise. Allocates
+  /// nothing once warm; a backward after it needs the concatenation (as after forward: pass it).
+  template <exec::HostPolicy Policy>
+  void forward_eval_parts(Policy policy, std::initializer_list<InputPart> parts, Index rows_per_item, Matrix<S>& out) {
+    if (!eval_fusable()) throw ArgumentError("nn::Mlp::forward_eval_parts: needs BatchNorm with running statistics (eval mode)");
+    if (parts.size() == 0 || rows_per_item < 1) throw ArgumentError("nn::Mlp::forward_eval_parts: needs parts and rows_per_item >= 1");
+    Index R = -1, width = 0;
+    for (const InputPart& p : parts) {
+      width += p.values.cols();
+      if (!p.per_item) R = p.values.rows();
     }
+    const auto where = [&] { return "nn::Mlp::forward_eval_parts ('" + stages_[0]->linear->name() + "')"; };  // built only to throw
+    if (R < 0) throw ArgumentError(where() + ": every part is per item; at least one must have a row per output row");
+    if (width != in_features())
+      throw ShapeError(where() + ": the parts' columns must add up to the input width", {R, in_features()}, {R, width});
+    if (R % rows_per_item)
+      throw ShapeError(where() + ": rows (a multiple of rows_per_item = " + std::to_string(rows_per_item) + ")", {-1, width}, {R, width});
+    const Index B = R / rows_per_item;
+    Index part = 0;
+    for (const InputPart& p : parts) {
+      if (p.values.rows() != (p.per_item ? B : R))
+        throw ShapeError(where() + ": part " + std::to_string(part) + (p.per_item ? " (one row per item)" : " (one row per row)"),
+                         {p.per_item ? B : R, p.values.cols()}, {p.values.rows(), p.values.cols()});
+      ++part;
+    }
+
+    Stage& s0 = *stages_[0];
+    const Index H = s0.spec.out, in = in_features();
+    const S* W = s0.linear->weight().data();  // H × in, row-major: the columns of part p start at W + offset
+    // the per-item terms, with the bias: item_terms_ (B × H)
+    ensure_shape(item_terms_, B, H);
+    if (s0.linear->has_bias())
+      item_terms_.rowwise() = s0.linear->bias().transpose();
+    else
+      item_terms_.setZero();
+    Index offset = 0;
+    for (const InputPart& p : parts) {
+      if (p.per_item) item_gemm_.run(B, H, p.values.cols(), p.values.data(), p.values.outerStride(), false, W + offset, in, true, item_terms_.data(), H, true);
+      offset += p.values.cols();
+    }
+    ensure_shape(out, R, out_features());
+    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    prepare_eval_blocks(R, workers);
+    for (Index w = 0; w < workers; ++w) ensure_shape(scratch_[std::size_t(w)].first, exec::max_chunk_size(R, nc), H);
+    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+      Scratch& sc = scratch_[std::size_t(w)];
+      S* y0 = sc.first.data();
+      Index off = 0;
+      bool accumulate = false;
+      for (const InputPart& p : parts) {
+        if (!p.per_item) {
+          sc.gemm[0].run(e - b, H, p.values.cols(), p.values.data() + b * p.values.outerStride(), p.values.outerStride(), false, W + off, in, true, y0, H,
+                         accumulate);
+          accumulate = true;
+        }
+        off += p.values.cols();
+      }
+      for (Index r = b; r < e; ++r) {
+        Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> y(y0 + (r - b) * H, H);
+        y += item_terms_.row(r / rows_per_item);
+      }
+      eval_block_after_first_linear(w, e - b, y0, H, out.data() + b * out.cols(), out.cols());
+    });
+    lean_ = true;
   }
 
  private:
@@ -350,13 +405,60 @@ class Mlp {
   /// Per worker of the fused eval path: ping-pong stage outputs of one chunk, a GEMM per stage.
   struct Scratch {
     Matrix<S> buf[2];
+    Matrix<S> first;  ///< forward_eval_parts: stage 0's Linear output of the chunk
     std::vector<SerialGemm<S>> gemm;
   };
+
+  /// eval_block's body. With `y0` set, stage 0's Linear output is there already (leading
+  /// dimension ld0) and is post-processed in place; otherwise stage 0 reads `in`.
+  void eval_stages(Index w, Index rows, const S* in, Index ld_in, S* y0, S* out, Index ld_out, Index ld0 = 0) {
+    Scratch& sc = scratch_[std::size_t(w)];
+    const S* x = in;
+    Index ldx = ld_in;
+    const std::size_t last = stages_.size() - 1;
+    for (std::size_t i = 0; i <= last; ++i) {
+      Stage& s = *stages_[i];
+      S* y = i == last ? out : sc.buf[i % 2].data();
+      Index ldy = i == last ? ld_out : sc.buf[i % 2].cols();
+      if (i == 0 && y0) {
+        y = y0, ldy = ld0;
+      } else {
+        s.linear->forward_block(sc.gemm[i], rows, x, ldx, y, ldy);
+      }
+      if (s.bn) s.bn->apply_eval(y, ldy, rows);
+      apply_activation(s, y, ldy, rows);
+      if (i == last && y != out)
+        for (Index r = 0; r < rows; ++r) std::copy_n(y + r * ldy, s.spec.out, out + r * ld_out);
+      x = y;
+      ldx = ldy;
+    }
+  }
+  /// The stage's activation on a rows × out block in place (as LeakyReLU / Sine: the same bits).
+  static void apply_activation(const Stage& s, S* y, Index ldy, Index rows) {
+    const Index C = s.spec.out;
+    if (s.spec.act == Act::leaky_relu) {
+      const S slope = static_cast<S>(s.spec.slope);
+      for (Index r = 0; r < rows; ++r) {
+        S* p = y + r * ldy;
+        for (Index c = 0; c < C; ++c) p[c] = p[c] > S(0) ? p[c] : slope * p[c];
+      }
+    } else if (s.spec.act == Act::sine) {
+      const S w0 = static_cast<S>(s.spec.omega0);  // Eigen's packet sin, as nn::Sine: the same bits
+      const auto sine = [w0](const auto& v) { return (v * w0).sin(); };
+      if (ldy == C) {
+        detail::map_packets(y, rows * C, sine, static_cast<const S*>(y));
+      } else {
+        for (Index r = 0; r < rows; ++r) detail::map_packets(y + r * ldy, C, sine, static_cast<const S*>(y + r * ldy));
+      }
+    }
+  }
 
   std::vector<std::unique_ptr<Stage>> stages_;
   std::vector<Scratch> scratch_;
   bool lean_ = false;     ///< the last forward was the fused eval one: only its output is stored
   Matrix<S> recomputed_;  ///< output of the storing forward that an eval backward redoes
+  Matrix<S> item_terms_;  ///< forward_eval_parts: the per-item parts' products and the bias (B × out of stage 0)
+  SerialGemm<S> item_gemm_;
 };
 static_assert(assert_layer<Mlp<float>>());
 
