@@ -217,7 +217,7 @@ class EdgeConv {
   GroupPool<S> pool_;
   Matrix<S> e0_, e4_, g0_, g4_;
   std::vector<Matrix<S>> gathered_;  ///< eval paths: per worker, one chunk's edge rows (per edge) or first Linear output (point-wise)
-  Matrix<S> point_w_, point_terms_;  ///< fused eval path: [W_d; W_s − W_d] and the per-point products
+  Matrix<S> point_w_, point_terms_;  ///< point-wise eval path: [W_d; W_s − W_d] and the per-point products
   std::vector<SerialGemm<S>> point_gemm_;
   bool lean_ = false;                ///< the last forward was an eval one (e0_ not made)
   bool point_wise_ = true;           ///< eval: the first Linear per point
