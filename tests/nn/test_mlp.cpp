@@ -1,5 +1,8 @@
 #include <simsr/nn/mlp.hpp>
 
+#include <span>
+#include <vector>
+
 #include "gradient_check.hpp"
 
 using namespace simsr;
@@ -70,13 +73,10 @@ TEST_CASE("nn::Mlp::forward_eval_parts: the concatenation's eval forward, per-it
       for (Index r = 0; r < R; ++r) cat.block(r, off, 1, widths[std::size_t(p)]) = values.back().row(per_item[std::size_t(p)] ? r / n : r);
       off += widths[std::size_t(p)];
     }
-    auto run = [&](auto& m, auto policy, const std::vector<Matrix<typename std::decay_t<decltype(m)>::scalar_type>>& v, auto& out) {
-      switch (P) {  // an initializer_list of the trial's length
-        case 1: m.forward_eval_parts(policy, {{v[0], per_item[0]}}, n, out); break;
-        case 2: m.forward_eval_parts(policy, {{v[0], per_item[0]}, {v[1], per_item[1]}}, n, out); break;
-        case 3: m.forward_eval_parts(policy, {{v[0], per_item[0]}, {v[1], per_item[1]}, {v[2], per_item[2]}}, n, out); break;
-        default: m.forward_eval_parts(policy, {{v[0], per_item[0]}, {v[1], per_item[1]}, {v[2], per_item[2]}, {v[3], per_item[3]}}, n, out);
-      }
+    auto run = [&](auto& m, auto policy, const auto& v, auto& out) {  // the span overload: the trial's number of parts
+      std::vector<typename std::decay_t<decltype(m)>::InputPart> ps;
+      for (Index p = 0; p < P; ++p) ps.push_back({v[std::size_t(p)], per_item[std::size_t(p)]});
+      m.forward_eval_parts(policy, std::span<const typename std::decay_t<decltype(m)>::InputPart>(ps), n, out);
     };
     Matrix<double> yd, refd;
     run(mlp, exec::seq, values, yd);
@@ -108,9 +108,11 @@ TEST_CASE("nn::Mlp::forward_eval_parts: the concatenation's eval forward, per-it
     CHECK(test::bitwise_equal(g1, nn::Vector<double>(sd.gradients())));
 
     // warm: nothing allocated
-    run(mlpf, exec::omp, vf, yf);
+    std::vector<nn::Mlp<float>::InputPart> parts;
+    for (Index p = 0; p < P; ++p) parts.push_back({vf[std::size_t(p)], per_item[std::size_t(p)]});
+    mlpf.forward_eval_parts(exec::omp, std::span<const nn::Mlp<float>::InputPart>(parts), n, yf);
     const long before = simsr_test_malloc_count();
-    run(mlpf, exec::omp, vf, yf);
+    mlpf.forward_eval_parts(exec::omp, std::span<const nn::Mlp<float>::InputPart>(parts), n, yf);
     SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before);
   }
 }

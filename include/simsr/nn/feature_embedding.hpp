@@ -69,7 +69,7 @@ class EmbeddingBlock {
     edge_.forward(policy, mode, h, e_);
     gmax_.forward(policy, mode, e_, max_);
     gmean_.forward(policy, mode, e_, mean_);
-    if (mode == Mode::eval && factorized_ && fc_out_.eval_fusable() && h.rows() % n_ == 0) {
+    if (mode == Mode::eval && factorized_ && fc_out_.eval_fusable()) {  // the pools checked the rows: B whole items
       using Items = Eigen::Map<const Matrix<S>, 0, Eigen::OuterStride<>>;  // row b·N of the broadcast pools: item b's value
       const Index B = h.rows() / n_;
       const Items max_items(max_.data(), B, out_, Eigen::OuterStride<>(n_ * out_)), mean_items(mean_.data(), B, out_, Eigen::OuterStride<>(n_ * out_));

@@ -17,6 +17,7 @@
 #include <initializer_list>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -208,13 +209,13 @@ class Mlp {
     }
     lean_ = true;
   }
-  void eval_block(Index w, Index rows, const S* in, Index ld_in, S* out, Index ld_out) { eval_stages(w, rows, in, ld_in, nullptr, out, ld_out); }
+  void eval_block(Index w, Index rows, const S* in, Index ld_in, S* out, Index ld_out) { eval_stages(w, rows, in, ld_in, nullptr, 0, out, ld_out); }
   /// eval_block for a caller that computed stage 0's Linear itself (bias included) into `y0`
   /// (rows × spec(0).out, leading dimension ld0): stage 0's BatchNorm and activation are applied
   /// to it in place, then the later stages run as in eval_block. EdgeConv's point-wise first
   /// layer and forward_eval_parts use it.
   void eval_block_after_first_linear(Index w, Index rows, S* y0, Index ld0, S* out, Index ld_out) {
-    eval_stages(w, rows, nullptr, 0, y0, out, ld_out, ld0);
+    eval_stages(w, rows, nullptr, 0, y0, ld0, out, ld_out);
   }
 
   /// One input part of forward_eval_parts: `per_item` parts hold one row per batch item (B rows),
@@ -232,6 +233,11 @@ class Mlp {
   /// nothing once warm; a backward after it needs the concatenation (as after forward: pass it).
   template <exec::HostPolicy Policy>
   void forward_eval_parts(Policy policy, std::initializer_list<InputPart> parts, Index rows_per_item, Matrix<S>& out) {
+    forward_eval_parts(policy, std::span<const InputPart>(parts.begin(), parts.size()), rows_per_item, out);
+  }
+  /// The same with the parts in a span (a number of parts known at run time).
+  template <exec::HostPolicy Policy>
+  void forward_eval_parts(Policy policy, std::span<const InputPart> parts, Index rows_per_item, Matrix<S>& out) {
     if (!eval_fusable()) throw ArgumentError("nn::Mlp::forward_eval_parts: needs BatchNorm with running statistics (eval mode)");
     if (parts.size() == 0 || rows_per_item < 1) throw ArgumentError("nn::Mlp::forward_eval_parts: needs parts and rows_per_item >= 1");
     Index R = -1, width = 0;
@@ -268,30 +274,26 @@ class Mlp {
       if (p.per_item) item_gemm_.run(B, H, p.values.cols(), p.values.data(), p.values.outerStride(), false, W + offset, in, true, item_terms_.data(), H, true);
       offset += p.values.cols();
     }
-    ensure_shape(out, R, out_features());
-    const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
-    prepare_eval_blocks(R, workers);
-    for (Index w = 0; w < workers; ++w) ensure_shape(scratch_[std::size_t(w)].first, exec::max_chunk_size(R, nc), H);
-    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
-      Scratch& sc = scratch_[std::size_t(w)];
-      S* y0 = sc.first.data();
+    for_eval_chunks(policy, R, out, [&](Index w, Index b, Index e) {
+      Matrix<S>& first = scratch_[std::size_t(w)].buf[0];  // stage 0's output, as eval_block keeps it
+      S* y0 = first.data();
+      const Index ld0 = first.cols();
       Index off = 0;
       bool accumulate = false;
       for (const InputPart& p : parts) {
         if (!p.per_item) {
-          sc.gemm[0].run(e - b, H, p.values.cols(), p.values.data() + b * p.values.outerStride(), p.values.outerStride(), false, W + off, in, true, y0, H,
-                         accumulate);
+          scratch_[std::size_t(w)].gemm[0].run(e - b, H, p.values.cols(), p.values.data() + b * p.values.outerStride(), p.values.outerStride(), false,
+                                               W + off, in, true, y0, ld0, accumulate);
           accumulate = true;
         }
         off += p.values.cols();
       }
       for (Index r = b; r < e; ++r) {
-        Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> y(y0 + (r - b) * H, H);
+        Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> y(y0 + (r - b) * ld0, H);
         y += item_terms_.row(r / rows_per_item);
       }
-      eval_block_after_first_linear(w, e - b, y0, H, out.data() + b * out.cols(), out.cols());
+      eval_block_after_first_linear(w, e - b, y0, ld0, out.data() + b * out.cols(), out.cols());
     });
-    lean_ = true;
   }
 
  private:
@@ -327,12 +329,19 @@ class Mlp {
   void forward_fused(Policy policy, const ConstView<S>& in, Matrix<S>& out) {
     const Index R = in.rows();
     if (in.cols() != in_features()) detail::check_shape("nn::Linear '" + stages_[0]->linear->name() + "'", "input", in, -1, in_features());
+    for_eval_chunks(policy, R, out, [&](Index w, Index b, Index e) {
+      eval_block(w, e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out.cols(), out.cols());
+    });
+  }
+
+  /// The fused eval paths' loop: out sized R × out_features(), the scratch prepared, body(worker,
+  /// begin, end) on each row chunk of Linear::forward's chunking.
+  template <class Policy, class Body>
+  void for_eval_chunks(Policy policy, Index R, Matrix<S>& out, Body&& body) {
     ensure_shape(out, R, out_features());
     const Index nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
     prepare_eval_blocks(R, workers);
-    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
-      eval_block(w, e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out.cols(), out.cols());
-    });
+    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) { body(w, b, e); });
   }
 
   template <class Policy>
@@ -405,13 +414,12 @@ class Mlp {
   /// Per worker of the fused eval path: ping-pong stage outputs of one chunk, a GEMM per stage.
   struct Scratch {
     Matrix<S> buf[2];
-    Matrix<S> first;  ///< forward_eval_parts: stage 0's Linear output of the chunk
     std::vector<SerialGemm<S>> gemm;
   };
 
   /// eval_block's body. With `y0` set, stage 0's Linear output is there already (leading
   /// dimension ld0) and is post-processed in place; otherwise stage 0 reads `in`.
-  void eval_stages(Index w, Index rows, const S* in, Index ld_in, S* y0, S* out, Index ld_out, Index ld0 = 0) {
+  void eval_stages(Index w, Index rows, const S* in, Index ld_in, S* y0, Index ld0, S* out, Index ld_out) {
     Scratch& sc = scratch_[std::size_t(w)];
     const S* x = in;
     Index ldx = ld_in;
