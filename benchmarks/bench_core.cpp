@@ -1,11 +1,18 @@
 // Parallel primitives: overhead and scaling of seq vs omp on memory-bound and compute-bound work.
 //   build/benchmarks/bench_core --benchmark_filter=Reduce
+// The layers' products y = b + x·Wᵀ on one thread, a chunk of 560 rows at the widths of the
+// paper-size network's largest layers (in:out = 64:512 EdgeConv block 1's point-wise first layer,
+// 256:128 its edge MLP's second layer and the decoder's, 227:256 the decoder's first, 384:256
+// block 1's fc_out), PackedGemm (the weight packed once per forward, the sums started at the
+// bias) against SerialGemm, Eigen's packed kernel, then the bias added (nn::Linear before it):
+//   build/benchmarks/bench_core --benchmark_filter=LayerProducts
 #include <benchmark/benchmark.h>
 
 #include <simsr/core/core.hpp>
 
 #include <cmath>
 #include <functional>
+#include <random>
 #include <vector>
 
 using namespace simsr;
@@ -37,5 +44,53 @@ static void BM_ForTranscendental(benchmark::State& state) {
 }
 BENCHMARK(BM_ForTranscendental<exec::seq_t>)->Arg(1 << 20)->UseRealTime();
 BENCHMARK(BM_ForTranscendental<exec::omp_t>)->Arg(1 << 20)->UseRealTime();
+
+struct LayerOperands {
+  Index rows, in, out;
+  std::vector<float> x, W, b, y;
+  explicit LayerOperands(const benchmark::State& state) : rows(560), in(state.range(0)), out(state.range(1)) {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> u(-1, 1);
+    x.resize(std::size_t(rows * in));
+    W.resize(std::size_t(out * in));
+    b.resize(std::size_t(out));
+    y.resize(std::size_t(rows * out));
+    for (auto* v : {&x, &W, &b})
+      for (float& e : *v) e = u(rng);
+  }
+  void count(benchmark::State& state) const {
+    state.counters["GMAC"] = benchmark::Counter(1e-9 * double(rows * in * out), benchmark::Counter::kIsIterationInvariantRate);
+  }
+};
+
+static void BM_LayerProducts_PackedGemm(benchmark::State& state) {
+  LayerOperands o(state);
+  PackedGemm<float> g;
+  PackedGemm<float>::Workspace ws;
+  g.pack(o.W.data(), o.out, o.in, o.in);
+  g.run(ws, o.rows, o.x.data(), o.in, o.b.data(), o.y.data(), o.out, false);  // warm
+  for (auto _ : state) {
+    g.run(ws, o.rows, o.x.data(), o.in, o.b.data(), o.y.data(), o.out, false);
+    benchmark::DoNotOptimize(o.y.data());
+  }
+  o.count(state);
+}
+
+static void BM_LayerProducts_SerialGemm(benchmark::State& state) {
+  LayerOperands o(state);
+  SerialGemm<float> g;
+  g.reserve(o.rows, o.out, o.in);
+  for (auto _ : state) {
+    g.run(o.rows, o.out, o.in, o.x.data(), o.in, false, o.W.data(), o.in, true, o.y.data(), o.out, false);
+    Eigen::Map<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> y(o.y.data(), o.rows, o.out);
+    y.rowwise() += Eigen::Map<const Eigen::RowVectorXf>(o.b.data(), o.out);
+    benchmark::DoNotOptimize(o.y.data());
+  }
+  o.count(state);
+}
+
+#define SIMSR_LAYER_SHAPES ->ArgNames({"in", "out"})->Args({64, 512})->Args({256, 128})->Args({227, 256})->Args({384, 256})->Args({64, 32})
+BENCHMARK(BM_LayerProducts_PackedGemm) SIMSR_LAYER_SHAPES;
+BENCHMARK(BM_LayerProducts_SerialGemm) SIMSR_LAYER_SHAPES;
 
 BENCHMARK_MAIN();

@@ -10,6 +10,9 @@
 ///    eval layers unfactorized (FeatureEmbedding::set_factorized_eval(false)): EdgeConv's first
 ///    Linear per edge instead of per point, fc_out's first Linear on the stored concatenation
 ///    cat(h, e, max, mean) instead of its parts with the global features once per item.
+///  - BM_official_forward_paper_size/{seq,omp}/baseline_decoder_first_layer_on_hr: the same with the
+///    decoder's first Linear on the M upsampled rows (SuperResolutionNet::set_decoder_first_layer_on_lr(false))
+///    instead of on the N LR rows before the upsampling.
 ///  - BM_official_dynamic_knn_paper_size/{fused,blocked_gemm}/{seq,omp}: that graph alone (k = 5
 ///    nearest other points of the N = 15,872 rows of h¹, 64 features, as block 1's EdgeConv builds
 ///    it) on the features of one inference; the setup checks that both kernels give the same graph
@@ -106,11 +109,18 @@ Matrix<float> paper_ldx(Index B) {
   return x;
 }
 
+/// The inference's exact rewrites (issue #17 item 4), each switched off in its baseline row.
+struct ForwardRewrites {
+  bool factorized_eval = true;            ///< EdgeConv's first Linear per point, fc_out on its parts
+  bool decoder_first_layer_on_lr = true;  ///< the decoder's first Linear before the upsampling
+};
+
 template <class Search, exec::HostPolicy Policy>
-void BM_official_forward_paper_size(Policy policy, benchmark::State& state, bool factorized = true) {
+void BM_official_forward_paper_size(Policy policy, benchmark::State& state, ForwardRewrites rewrites = {}) {
   nn::Rng rng(0);
   nn::SuperResolutionNet<float, Search> net(paper_config(), paper_geo(), rng);
-  net.feature_embedding().set_factorized_eval(factorized);
+  net.feature_embedding().set_factorized_eval(rewrites.factorized_eval);
+  net.set_decoder_first_layer_on_lr(rewrites.decoder_first_layer_on_lr);
   const Matrix<float> ldx = paper_ldx(1);
   Matrix<float> pred;
   net.prepare_inference(policy);
@@ -256,8 +266,14 @@ void BM_official_forward_paper_size_seq(benchmark::State& s) { BM_official_forwa
 void BM_official_forward_paper_size_omp(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::omp, s); }
 void BM_official_forward_paper_size_seq_baseline(benchmark::State& s) { BM_official_forward_paper_size<BaselineKnn>(exec::seq, s); }
 void BM_official_forward_paper_size_omp_baseline(benchmark::State& s) { BM_official_forward_paper_size<BaselineKnn>(exec::omp, s); }
-void BM_official_forward_paper_size_seq_per_edge(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::seq, s, false); }
-void BM_official_forward_paper_size_omp_per_edge(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::omp, s, false); }
+void BM_official_forward_paper_size_seq_per_edge(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::seq, s, {.factorized_eval = false}); }
+void BM_official_forward_paper_size_omp_per_edge(benchmark::State& s) { BM_official_forward_paper_size<FusedKnn>(exec::omp, s, {.factorized_eval = false}); }
+void BM_official_forward_paper_size_seq_decoder_on_hr(benchmark::State& s) {
+  BM_official_forward_paper_size<FusedKnn>(exec::seq, s, {.decoder_first_layer_on_lr = false});
+}
+void BM_official_forward_paper_size_omp_decoder_on_hr(benchmark::State& s) {
+  BM_official_forward_paper_size<FusedKnn>(exec::omp, s, {.decoder_first_layer_on_lr = false});
+}
 
 /// h¹ of one inference at the paper's size: the rows block 1's dynamic graph is built on.
 const FusedKnn::point_matrix& paper_block1_features() {
@@ -315,6 +331,16 @@ BENCHMARK(BM_official_forward_paper_size_seq_per_edge)
     ->MinTime(3.0);
 BENCHMARK(BM_official_forward_paper_size_omp_per_edge)
     ->Name("BM_official_forward_paper_size/omp/baseline_per_edge_first_layers")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK(BM_official_forward_paper_size_seq_decoder_on_hr)
+    ->Name("BM_official_forward_paper_size/seq/baseline_decoder_first_layer_on_hr")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK(BM_official_forward_paper_size_omp_decoder_on_hr)
+    ->Name("BM_official_forward_paper_size/omp/baseline_decoder_first_layer_on_hr")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);

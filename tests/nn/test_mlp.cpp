@@ -1,6 +1,8 @@
 #include <simsr/nn/mlp.hpp>
 
+#include <array>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "gradient_check.hpp"
@@ -37,6 +39,20 @@ void randomize_buffers(nn::ParameterStore<S>& store, std::mt19937_64& rng) {
     store.buffers().segment(e.offset, e.size) = random_matrix(rng, e.size, 1, var ? 0.3 : -1.0, var ? 2.0 : 1.0).template cast<S>();
   }
 }
+/// One random stack twice: in double with random BatchNorm statistics, and its float copy.
+struct TwinMlps {
+  nn::ParameterStore<double> sd;
+  nn::ParameterStore<float> sf;
+  nn::Rng init_d, init_f;
+  nn::Mlp<double> d;
+  nn::Mlp<float> f;
+  TwinMlps(const std::vector<nn::MlpStage>& stages, int seed, std::mt19937_64& rng)
+      : init_d(std::uint64_t(seed)), init_f(std::uint64_t(seed)), d(sd, "m", stages, init_d), f(sf, "m", stages, init_f) {
+    randomize_buffers(sd, rng);
+    sf.values() = sd.values().cast<float>();
+    sf.buffers() = sd.buffers().cast<float>();
+  }
+};
 }  // namespace
 
 TEST_CASE("nn::Mlp::forward_eval_parts: the concatenation's eval forward, per-item parts once per item (random stacks and splits)") {
@@ -53,15 +69,10 @@ TEST_CASE("nn::Mlp::forward_eval_parts: the concatenation's eval forward, per-it
       in += widths.back();
     }
     const auto stages = random_stages(rng, in);
-    nn::ParameterStore<double> sd;
-    nn::Rng init(trial);
-    nn::Mlp<double> mlp(sd, "m", stages, init);
-    randomize_buffers(sd, rng);
-    nn::ParameterStore<float> sf;
-    nn::Rng init2(trial);
-    nn::Mlp<float> mlpf(sf, "m", stages, init2);
-    sf.values() = sd.values().cast<float>();
-    sf.buffers() = sd.buffers().cast<float>();
+    TwinMlps twins(stages, trial, rng);
+    auto& sd = twins.sd;
+    auto& mlp = twins.d;
+    auto& mlpf = twins.f;
     INFO("trial " << trial << ": B " << B << " rows per item " << n << " parts " << P << " in " << in << " stages " << stages.size());
 
     // the parts, and their concatenation with each per-item row repeated over its item's rows
@@ -115,6 +126,83 @@ TEST_CASE("nn::Mlp::forward_eval_parts: the concatenation's eval forward, per-it
     mlpf.forward_eval_parts(exec::omp, std::span<const nn::Mlp<float>::InputPart>(parts), n, yf);
     SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before);
   }
+}
+
+TEST_CASE("nn::Mlp: the eval forward split after stage 0's products (random stacks; a linear map of the rows in between)") {
+  std::mt19937_64 rng(93);
+  std::uniform_int_distribution<int> width(1, 9), rows(1, 700);
+  for (int trial = 0; trial < 40; ++trial) {
+    const Index in = width(rng), R = rows(rng);
+    const auto stages = random_stages(rng, in);
+    TwinMlps twins(stages, trial, rng);
+    auto& mlp = twins.d;
+    auto& mlpf = twins.f;
+    INFO("trial " << trial << ": rows " << R << " in " << in << " stages " << stages.size());
+    const Index H = stages[0].out;
+    const Matrix<double> x = random_matrix(rng, R, in, -2.0, 2.0);
+    const Matrix<float> xf = x.cast<float>();
+
+    // products handed back unchanged: forward(eval) to rounding (there the sums start at the bias,
+    // here the bias is added to them), seq == omp bitwise
+    Matrix<float> pf, yf, yf_omp, reff;
+    mlpf.first_linear_products(exec::omp, xf, pf);
+    REQUIRE(pf.rows() == R);
+    REQUIRE(pf.cols() == H);
+    auto copy_rows = [](const Matrix<float>& p) {
+      return [&p](Index b, Index e, float* y, Index ld) {
+        for (Index r = b; r < e; ++r) std::copy_n(p.row(r).data(), p.cols(), y + (r - b) * ld);
+      };
+    };
+    mlpf.forward_eval_from_products(exec::seq, R, copy_rows(pf), yf);
+    mlpf.forward_eval_from_products(exec::omp, R, copy_rows(pf), yf_omp);
+    mlpf.forward(exec::seq, nn::Mode::eval, xf, reff);
+    CHECK(test::bitwise_equal(yf, yf_omp));
+    CHECK((yf - reff).cwiseAbs().maxCoeff() <= 1e-5f * (1.0f + reff.cwiseAbs().maxCoeff()));
+    Matrix<float> pf_seq;
+    mlpf.first_linear_products(exec::seq, xf, pf_seq);
+    CHECK(test::bitwise_equal(pf, pf_seq));
+
+    // a linear map of the rows between the two halves (each output row a random combination of
+    // three input rows): the eval forward of the mapped input, in double to rounding
+    std::vector<std::array<std::pair<Index, double>, 3>> map(static_cast<std::size_t>(R));
+    Matrix<double> mapped = Matrix<double>::Zero(R, in);
+    for (Index r = 0; r < R; ++r)
+      for (auto& [j, c] : map[std::size_t(r)]) {
+        j = Index(rng() % std::uint64_t(R));
+        c = std::uniform_real_distribution<double>(-1, 1)(rng);
+        mapped.row(r) += c * x.row(j);
+      }
+    Matrix<double> pd, yd, refd;
+    mlp.first_linear_products(exec::seq, x, pd);
+    mlp.forward_eval_from_products(
+        exec::omp, R,
+        [&](Index b, Index e, double* y, Index ld) {
+          for (Index r = b; r < e; ++r) {
+            Eigen::Map<Eigen::RowVectorXd> o(y + (r - b) * ld, H);
+            o.setZero();
+            for (const auto& [j, c] : map[std::size_t(r)]) o += c * pd.row(j);
+          }
+        },
+        yd);
+    mlp.forward(exec::seq, nn::Mode::eval, mapped, refd);
+    CHECK((yd - refd).cwiseAbs().maxCoeff() <= 1e-12 * (1.0 + refd.cwiseAbs().maxCoeff()));
+
+    // warm: nothing allocated
+    const long before = simsr_test_malloc_count();
+    mlpf.first_linear_products(exec::omp, xf, pf);
+    mlpf.forward_eval_from_products(exec::omp, R, copy_rows(pf), yf);
+    SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before);
+  }
+  // refused: the wrong input width, BatchNorm on batch statistics
+  nn::ParameterStore<double> store;
+  nn::Rng init(1);
+  nn::Mlp<double> mlp(store, "m", {nn::MlpStage::linear(5, 3, "lin").then(nn::Act::sine, 1.0)}, init);
+  Matrix<double> p, y;
+  CHECK_THROWS_AS(mlp.first_linear_products(exec::seq, Matrix<double>(4, 6), p), ShapeError);
+  CHECK_THROWS_AS(mlp.forward_eval_from_products(exec::seq, -1, [](Index, Index, double*, Index) {}, y), ArgumentError);
+  nn::ParameterStore<double> s2;
+  nn::Mlp<double> batch_stats(s2, "m", {nn::MlpStage::linear(5, 3, "lin").norm("bn", {.track_running_stats = false})}, init);
+  CHECK_THROWS_AS(batch_stats.forward_eval_from_products(exec::seq, 4, [](Index, Index, double*, Index) {}, y), ArgumentError);
 }
 
 TEST_CASE("nn::Mlp::forward_eval_parts: bad parts are refused by name") {

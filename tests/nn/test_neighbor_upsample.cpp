@@ -43,6 +43,21 @@ TEST_CASE("nn::NeighborUpsample: softmax weights and the weighted gather against
     nn::NeighborUpsample<double>::softmax_rows(exec::seq, logits, w);
     up.apply(exec::seq, w, z, out2);
     CHECK(test::bitwise_equal(out, out2));
+    // any row range into a wider buffer: apply's rows, bit for bit
+    for (int t = 0; t < 20; ++t) {
+      const Index b = Index(rng() % std::uint64_t(B * M + 1)), e = b + Index(rng() % std::uint64_t(B * M - b + 1)), ld = C + Index(rng() % 3);
+      Matrix<double> part = Matrix<double>::Constant(std::max<Index>(e - b, 1), ld, 7.0);
+      up.apply_rows(w, z, b, e, part.data(), ld);
+      for (Index r = b; r < e; ++r) {
+        CHECK(test::bitwise_equal(Matrix<double>(part.row(r - b).head(C)), Matrix<double>(out2.row(r))));
+        CHECK((part.row(r - b).tail(ld - C).array() == 7.0).all());  // the padding untouched
+      }
+    }
+    Matrix<double> part(B * M, C);
+    CHECK_THROWS_AS(up.apply_rows(w, z, 2, 1, part.data(), C), ArgumentError);          // end before begin
+    CHECK_THROWS_AS(up.apply_rows(w, z, 0, B * M + 1, part.data(), C), ArgumentError);  // past the last row
+    CHECK_THROWS_AS(up.apply_rows(w, z, 0, 1, part.data(), C - 1), ArgumentError);      // a row does not fit
+    CHECK_THROWS_AS(up.apply_rows(w, Matrix<double>(N + 1, C), 0, 1, part.data(), C), ShapeError);
   }
   // large logits do not overflow
   Matrix<double> big = Matrix<double>::Constant(M, K, 1000.0), w;

@@ -167,6 +167,7 @@ TEST_CASE("nn::SuperResolutionNet: seq == omp bitwise; infer (precomputed sparse
   Matrix<float> pe, pi, pi2;
   net.forward(exec::seq, nn::Mode::eval, ldx, pe);
   net.prepare_inference(exec::omp);
+  net.set_decoder_first_layer_on_lr(false);  // the unsplit decoder: the eval forward's very sums (the next case splits it)
   net.infer(exec::omp, ldx, pi);
   CHECK(test::bitwise_equal(pe, pi));
   // the sparse M×N matrix is the same operator
@@ -194,6 +195,85 @@ TEST_CASE("nn::SuperResolutionNet: seq == omp bitwise; infer (precomputed sparse
   // bad input
   CHECK_THROWS_AS(net.infer(exec::seq, Matrix<float>::Zero(59, 3), pi), ShapeError);
   CHECK_THROWS_AS(net.infer(exec::seq, Matrix<float>::Zero(60, 2), pi), ShapeError);
+}
+
+/// infer with the decoder's first Linear before the upsampling (Σ_i w_ji·W₁z_i instead of
+/// W₁·Σ_i w_ji z_i) against the eval forward that forms z^H, on random networks: the profiles and
+/// ablations, B = 1…3, random weights and BatchNorm statistics.
+template <class S>
+void check_first_layer_on_lr(const nn::NetworkConfig& cfg, Index N, Index M, Index B, std::uint64_t seed, double tol) {
+  CAPTURE(seed);
+  CAPTURE(B);
+  std::mt19937_64 rng(seed);
+  const auto geo = test::small_network_geometry(rng, N, M, cfg);
+  nn::Rng init(seed + 100);
+  nn::SuperResolutionNet<S> net(cfg, geo, init);
+  if (cfg.residual) {  // a fresh residual network predicts the base alone: give the decoder's output layer weights
+    for (const char* n : {"net_decoder.decoder.last_layer.fc.weight", "net_decoder.decoder.last_layer.fc.bias"})
+      for (S& v : net.store().values(net.store().at(n))) v = static_cast<S>(std::uniform_real_distribution<double>(-0.5, 0.5)(rng));
+  }
+  for (S& v : net.store().buffers()) v = static_cast<S>(std::uniform_real_distribution<double>(0.5, 1.5)(rng));  // running means and variances
+  const Matrix<S> ldx = test::random_matrix(rng, B * N, 3, -0.5, 0.5).template cast<S>();
+  REQUIRE(net.infer_moves_decoder_first_layer());
+  Matrix<S> pe, ps, po, po2;
+  net.forward(exec::seq, nn::Mode::eval, ldx, pe);
+  net.prepare_inference(exec::omp);
+  net.infer(exec::seq, ldx, ps);
+  net.infer(exec::omp, ldx, po);
+  CHECK(test::bitwise_equal(ps, po));
+  REQUIRE(ps.rows() == pe.rows());
+  const double scale = std::max(1.0, double(pe.cwiseAbs().maxCoeff()));
+  CHECK(double((ps - pe).cwiseAbs().maxCoeff()) <= tol * scale);
+  // not the same sums: the split is real (rounding differs somewhere in float)
+  if constexpr (std::is_same_v<S, float>) CHECK_FALSE(test::bitwise_equal(ps, pe));
+  // what the split did not form, it does not hand out; no backward after an inference
+  CHECK_THROWS_AS((void)net.hr_code(), ArgumentError);
+  CHECK_THROWS_AS(net.backward(exec::seq, pe, nullptr), ArgumentError);
+  // warm calls allocate nothing
+  net.infer(exec::omp, ldx, po2);
+  const long before = simsr_test_malloc_count();
+  net.infer(exec::omp, ldx, po2);
+  SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before);
+  CHECK(test::bitwise_equal(po, po2));
+  // switched off: the unsplit decoder, bitwise the eval forward; hr_code back
+  net.set_decoder_first_layer_on_lr(false);
+  Matrix<S> pu;
+  net.infer(exec::omp, ldx, pu);
+  CHECK(test::bitwise_equal(pu, pe));
+  CHECK(net.hr_code().rows() == B * M);
+}
+
+TEST_CASE("nn::SuperResolutionNet: infer with the decoder's first layer on the LR rows == the eval forward up to rounding") {
+  std::mt19937_64 pick(77);
+  for (int trial = 0; trial < 24; ++trial) {
+    nn::NetworkConfig cfg = test::tiny_config(trial % 2 ? nn::NetworkConfig::paper() : nn::NetworkConfig::official());
+    switch (trial % 6) {
+      case 2: cfg.disable_feature_embedding(); break;
+      case 3: cfg.upsampling = nn::UpsamplingKind::table; break;
+      case 4: cfg.residual = true; break;  // over the embedding
+      default: break;
+    }
+    const Index N = 20 + Index(pick() % 30), M = N + 30 + Index(pick() % 60), B = 1 + Index(pick() % 3);
+    const std::uint64_t seed = pick();
+    check_first_layer_on_lr<double>(cfg, N, M, B, seed, 1e-12);
+    check_first_layer_on_lr<float>(cfg, N, M, B, seed, 2e-4);
+  }
+}
+
+TEST_CASE("nn::SuperResolutionNet: the decoder's first layer stays on the HR rows when moving it costs more") {
+  std::mt19937_64 rng(3);
+  const nn::NetworkConfig cfg = test::tiny_config(nn::NetworkConfig::official());
+  // 162·N + 36·M < 234·M is false for N = 80, M = 50: infer keeps the unsplit decoder (bitwise the eval forward)
+  const auto geo = test::small_network_geometry(rng, 80, 50, cfg);
+  nn::Rng init(9);
+  nn::SuperResolutionNet<float> net(cfg, geo, init);
+  CHECK_FALSE(net.infer_moves_decoder_first_layer());
+  const Matrix<float> ldx = test::random_matrix(rng, 80, 3, -0.5, 0.5).cast<float>();
+  Matrix<float> pe, pi;
+  net.forward(exec::seq, nn::Mode::eval, ldx, pe);
+  net.infer(exec::omp, ldx, pi);
+  CHECK(test::bitwise_equal(pe, pi));
+  CHECK(net.hr_code().rows() == 50);
 }
 
 TEST_CASE("nn::NetworkConfig: JSON round trip, presets, the converter's official keys, and errors") {

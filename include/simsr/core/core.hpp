@@ -7,6 +7,7 @@
 #include "error.hpp"
 #include "host_device.hpp"
 #include "parallel.hpp"
+#include "packed_gemm.hpp"
 #include "serial_gemm.hpp"
 #include "types.hpp"
 #include "work_shard.hpp"

@@ -241,20 +241,45 @@ class BruteForceKnn {
         ws.reserve(T, T, d_, cap);
       ws.reserve_lists(fused ? n + NR : n, cap);  // fused: the column thresholds are read a whole panel at a time
     }
-    std::atomic<Index> next{0};
-    exec::parallel_for(policy, workers, [&](Index w) {
-      Workspace& ws = ws_[static_cast<std::size_t>(w)];
-      // pair number p → offset d and first tile I: offsets 0, 1, … each with nb − d pairs
-      Index d = 0, first = 0;  // pairs before offset d
-      for (Index p; (p = next.fetch_add(1, std::memory_order_relaxed)) < pairs;) {
-        while (p >= first + (nb - d)) first += nb - d, ++d;
-        const Index I = p - first, J = I + d;
-        if constexpr (fused)
-          fused_tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
-        else
-          tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
+    // The offsets in phases; after each phase but the last, every worker's row thresholds become
+    // the smallest any worker holds. Each worker sees only its share of the tiles, so its own
+    // thresholds tighten more slowly than one worker's would (with two workers, twice the offers
+    // of one); a threshold from another worker is safe: that worker's list already holds cap
+    // candidates at or below it, so anything strictly farther cannot be among the row's cap
+    // nearest, and the merged lists are the same set as before.
+    const Index phase_end[] = {1, 3, nb};
+    Index d_begin = 0;
+    for (Index d_end : phase_end) {
+      d_end = std::min(d_end, nb);
+      if (d_end <= d_begin) continue;
+      Index phase_pairs = 0;
+      for (Index d = d_begin; d < d_end; ++d) phase_pairs += nb - d;
+      std::atomic<Index> next{0};
+      exec::parallel_for(policy, workers, [&](Index w) {
+        Workspace& ws = ws_[static_cast<std::size_t>(w)];
+        // pair number p → offset d and first tile I: offsets d_begin, d_begin + 1, … each with nb − d pairs
+        Index d = d_begin, first = 0;  // pairs of this phase before offset d
+        for (Index p; (p = next.fetch_add(1, std::memory_order_relaxed)) < phase_pairs;) {
+          while (p >= first + (nb - d)) first += nb - d, ++d;
+          const Index I = p - first, J = I + d;
+          if constexpr (fused)
+            fused_tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
+          else
+            tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
+        }
+      });
+      if (workers > 1 && d_end < nb) {
+        const Index chunks = exec::chunk_count(n, workers);
+        exec::for_chunks(policy, n, chunks, workers, [&](Index, Index, Index b, Index e) {
+          for (Index q = b; q < e; ++q) {
+            S m = ws_[0].self_worst[static_cast<std::size_t>(q)];
+            for (Index o = 1; o < workers; ++o) m = std::min(m, ws_[static_cast<std::size_t>(o)].self_worst[static_cast<std::size_t>(q)]);
+            for (Index o = 0; o < workers; ++o) ws_[static_cast<std::size_t>(o)].self_worst[static_cast<std::size_t>(q)] = m;
+          }
+        });
       }
-    });
+      d_begin = d_end;
+    }
     // merge the workers' lists into worker 0's, then re-rank (chunks of T rows)
     const Index wk = std::min(workers, nb);
     exec::parallel_for(policy, wk, [&](Index w) {
@@ -287,7 +312,10 @@ class BruteForceKnn {
     for (; t > 0 && detail::closer(d2, idx, cd[t - 1], ci[t - 1]); --t) cd[t] = cd[t - 1], ci[t] = ci[t - 1];
     cd[t] = d2;
     ci[t] = idx;
-    if (cnt == cap) ws.self_worst[static_cast<std::size_t>(row)] = cd[cap - 1];
+    if (cnt == cap) {  // never above a threshold shared by another worker (run_self's phases)
+      S& worst = ws.self_worst[static_cast<std::size_t>(row)];
+      worst = std::min(worst, cd[cap - 1]);
+    }
   }
 
   /// The tile of rows [q0, q0 + m) × columns [p0, p0 + pn) (q0 ≤ p0): every entry is offered to

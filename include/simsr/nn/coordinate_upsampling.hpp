@@ -190,6 +190,13 @@ class CoordinateUpsampling {
     up_.apply(policy, weights_, z, zH);
   }
 
+  /// apply's rows [begin, end) into `out` (leading dimension ld_out), the same arithmetic: for a
+  /// caller that consumes them chunk by chunk (NeighborUpsample::apply_rows).
+  void apply_rows(const ConstView<S>& z, Index begin, Index end, S* out, Index ld_out) const {
+    if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::apply_rows: call precompute_weights(policy) first");
+    up_.apply_rows(weights_, z, begin, end, out, ld_out);
+  }
+
   /// The precomputed upsampling as an M×N sparse matrix (duplicate neighbours summed).
   SparseMatrix sparse_matrix() const {
     if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::sparse_matrix: call precompute_weights(policy) first");

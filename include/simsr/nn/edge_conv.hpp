@@ -181,18 +181,20 @@ class EdgeConv {
     ensure_shape(point_w_, 2 * H, C);
     point_w_.topRows(H) = W.leftCols(C);
     point_w_.bottomRows(H) = W.rightCols(C) - W.leftCols(C);
+    point_packed_.pack(point_w_.data(), 2 * H, C, C);
+    ensure_shape(point_bias_, 1, 2 * H);  // the bias on the point's half only
+    point_bias_.leftCols(H).setZero();
+    if (first.has_bias())
+      point_bias_.rightCols(H) = first.bias().transpose();
+    else
+      point_bias_.rightCols(H).setZero();
     ensure_shape(point_terms_, P, 2 * H);
     const Index pc = exec::chunk_count(P, product_chunks), pw = exec::worker_count(policy, pc);
-    if (point_gemm_.size() < std::size_t(pw)) point_gemm_.resize(std::size_t(pw));
-    for (Index w = 0; w < pw; ++w) point_gemm_[std::size_t(w)].reserve(exec::max_chunk_size(P, pc), 2 * H, C);
+    if (point_ws_.size() < std::size_t(pw)) point_ws_.resize(std::size_t(pw));
+    for (Index w = 0; w < pw; ++w) point_packed_.reserve(point_ws_[std::size_t(w)]);
     detail::for_chunks_dynamic(policy, P, pc, pw, [&](Index w, Index, Index b, Index e) {
-      S* dst = point_terms_.data() + b * 2 * H;
-      point_gemm_[std::size_t(w)].run(e - b, 2 * H, C, in.data() + b * in.outerStride(), in.outerStride(), false, point_w_.data(), C, true, dst,
-                                      2 * H, false);
-      if (first.has_bias()) {
-        Eigen::Map<Matrix<S>> half(dst, e - b, 2 * H);
-        half.rightCols(H).rowwise() += first.bias().transpose();
-      }
+      point_packed_.run(point_ws_[std::size_t(w)], e - b, in.data() + b * in.outerStride(), in.outerStride(), point_bias_.data(),
+                        point_terms_.data() + b * 2 * H, 2 * H, false);
     });
     // the edges: row (point, j) = P[neighbour, :H] + P[point, H:], then the rest of the edge MLP
     for_edge_chunks(policy, R, H, [&](Index w, Index b, Index e, S* y0) {  // y0: the first Linear's output of the chunk
@@ -218,7 +220,9 @@ class EdgeConv {
   Matrix<S> e0_, e4_, g0_, g4_;
   std::vector<Matrix<S>> gathered_;  ///< eval paths: per worker, one chunk's edge rows (per edge) or first Linear output (point-wise)
   Matrix<S> point_w_, point_terms_;  ///< point-wise eval path: [W_d; W_s − W_d] and the per-point products
-  std::vector<SerialGemm<S>> point_gemm_;
+  Matrix<S> point_bias_;  ///< [0, b]: the first Linear's bias on the point's half of P
+  PackedGemm<S> point_packed_;
+  std::vector<typename PackedGemm<S>::Workspace> point_ws_;
   bool lean_ = false;                ///< the last forward was an eval one (e0_ not made)
   bool point_wise_ = true;           ///< eval: the first Linear per point
 };

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "../core/packed_gemm.hpp"
 #include "../core/serial_gemm.hpp"
 #include "batch_split.hpp"
 #include "layer.hpp"
@@ -105,27 +106,35 @@ class Linear {
     ensure_shape(out, R, out_);
     const auto chunks = detail::row_chunks(split_, R, product_chunks, where_);
     const Index workers = exec::worker_count(policy, chunks.count());
-    if (gemm_fwd_.size() < std::size_t(workers)) gemm_fwd_.resize(std::size_t(workers));
-    for (Index w = 0; w < workers; ++w) gemm_fwd_[std::size_t(w)].reserve(chunks.max_size(), out_, in_);
+    prepare_forward();
+    if (ws_fwd_.size() < std::size_t(workers)) ws_fwd_.resize(std::size_t(workers));
+    for (Index w = 0; w < workers; ++w) reserve_forward(ws_fwd_[std::size_t(w)]);
     detail::for_row_chunks_dynamic(policy, chunks, workers, [&](Index w, Index, Index b, Index e) {
-      forward_block(gemm_fwd_[std::size_t(w)], e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out_, out_);
+      forward_block(ws_fwd_[std::size_t(w)], e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out_, out_);
     });
   }
 
-  /// The pieces of forward for callers that run it chunk by chunk (Mlp's fused eval path):
-  /// reserve_forward sizes a worker's SerialGemm as forward does for R rows, and forward_block
-  /// computes one block of rows (row-major, leading dimensions ld_in, ld_out) with it. Over the
-  /// row chunks of forward (exec::chunk_count(R, product_chunks)) they give forward's values exactly.
-  void reserve_forward(SerialGemm<S>& gemm, Index R) const {
-    gemm.reserve(exec::max_chunk_size(R, exec::chunk_count(R, product_chunks)), out_, in_);
-  }
-  void forward_block(SerialGemm<S>& gemm, Index rows, const S* in, Index ld_in, S* out, Index ld_out) const {
+  /// A worker's scratch of forward_block.
+  using Workspace = typename PackedGemm<S>::Workspace;
+  /// The pieces of forward for callers that run it chunk by chunk (Mlp's fused eval path,
+  /// EdgeConv's): prepare_forward packs the current weight (once per forward: the parameters may
+  /// have changed since the last), reserve_forward sizes a worker's scratch, forward_block computes
+  /// one block of rows (row-major, leading dimensions ld_in, ld_out) with the weight packed last.
+  /// Each output entry depends on its row and the parameters only (PackedGemm): any chunking gives
+  /// forward's values exactly.
+  void prepare_forward() {
     const ParameterStore<S>& store = *store_;
-    gemm.run(rows, out_, in_, in, ld_in, false, store.value(w_off_, out_, in_).data(), in_, true, out, ld_out, false);
-    if (has_bias()) {
-      Eigen::Map<Matrix<S>, 0, Eigen::OuterStride<>> o(out, rows, out_, Eigen::OuterStride<>(ld_out));
-      o.rowwise() += ConstMatrixMap<S>(store.values().data() + b_off_, 1, out_).row(0);
-    }
+    packed_.pack(store.value(w_off_, out_, in_).data(), out_, in_, in_);
+  }
+  void reserve_forward(Workspace& ws) const { packed_.reserve(ws); }
+  void forward_block(Workspace& ws, Index rows, const S* in, Index ld_in, S* out, Index ld_out) const {
+    check_packed();
+    packed_.run(ws, rows, in, ld_in, has_bias() ? std::as_const(*store_).values().data() + b_off_ : nullptr, out, ld_out, false);
+  }
+  /// forward_block without the bias: out = in·Wᵀ, or with `accumulate` out += in·Wᵀ.
+  void products_block(Workspace& ws, Index rows, const S* in, Index ld_in, S* out, Index ld_out, bool accumulate) const {
+    check_packed();
+    packed_.run(ws, rows, in, ld_in, nullptr, out, ld_out, accumulate);
   }
 
   /// Adds ∂/∂W = d_outᵀ·in and ∂/∂b = column sums of d_out into the store; d_in = d_out·W.
@@ -179,6 +188,9 @@ class Linear {
     if (!has_bias()) throw ArgumentError(where() + " has no bias");
     return b_off_;
   }
+  void check_packed() const {
+    if (packed_.in_features() != in_ || packed_.out_features() != out_) throw ArgumentError(where() + ": forward_block before prepare_forward");
+  }
   static void reserve(std::vector<SerialGemm<S>>& g, Index workers, Index rows, Index cols, Index depth) {
     if (g.size() < std::size_t(workers)) g.resize(std::size_t(workers));
     for (Index w = 0; w < workers; ++w) g[std::size_t(w)].reserve(rows, cols, depth);
@@ -189,7 +201,9 @@ class Linear {
   Index in_, out_;
   Index w_off_ = -1, b_off_ = -1;
   BatchSplit* split_ = nullptr;
-  std::vector<SerialGemm<S>> gemm_fwd_, gemm_din_, gemm_dw_;
+  PackedGemm<S> packed_;           ///< the weight as forward's register panels (prepare_forward)
+  std::vector<Workspace> ws_fwd_;  ///< forward's per-worker scratch
+  std::vector<SerialGemm<S>> gemm_din_, gemm_dw_;
   Matrix<S> parts_;  ///< weight-gradient partials, one row per chunk (W's out·in, then b's out)
 };
 static_assert(assert_layer<Linear<float>>());

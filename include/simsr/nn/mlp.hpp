@@ -200,12 +200,12 @@ class Mlp {
     Index width = 0;
     for (const auto& s : stages_) width = std::max(width, s->spec.out);
     const Index rows = exec::max_chunk_size(R, exec::chunk_count(R, product_chunks));
+    for (auto& s : stages_) s->linear->prepare_forward();  // the current weights, packed once for every chunk
     if (scratch_.size() < std::size_t(workers)) scratch_.resize(std::size_t(workers));
     for (Index w = 0; w < workers; ++w) {
       Scratch& sc = scratch_[std::size_t(w)];
       for (auto& m : sc.buf) ensure_shape(m, rows, width);
-      if (sc.gemm.size() < stages_.size()) sc.gemm.resize(stages_.size());
-      for (std::size_t i = 0; i < stages_.size(); ++i) stages_[i]->linear->reserve_forward(sc.gemm[i], R);
+      for (auto& s : stages_) s->linear->reserve_forward(sc.ws);
     }
     lean_ = true;
   }
@@ -269,28 +269,69 @@ class Mlp {
       item_terms_.rowwise() = s0.linear->bias().transpose();
     else
       item_terms_.setZero();
+    // the per-row parts' columns of W, each packed once for every chunk
+    if (part_packed_.size() < parts.size()) part_packed_.resize(parts.size());
     Index offset = 0;
-    for (const InputPart& p : parts) {
-      if (p.per_item) item_gemm_.run(B, H, p.values.cols(), p.values.data(), p.values.outerStride(), false, W + offset, in, true, item_terms_.data(), H, true);
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const InputPart& p = parts[i];
+      if (p.per_item)
+        item_gemm_.run(B, H, p.values.cols(), p.values.data(), p.values.outerStride(), false, W + offset, in, true, item_terms_.data(), H, true);
+      else
+        part_packed_[i].pack(W + offset, H, p.values.cols(), in);
       offset += p.values.cols();
     }
+    for_eval_chunks(policy, R, out, [&](Index w, Index b, Index e) {
+      Scratch& sc = scratch_[std::size_t(w)];
+      Matrix<S>& first = sc.buf[0];  // stage 0's output, as eval_block keeps it
+      S* y0 = first.data();
+      const Index ld0 = first.cols();
+      for (Index r = b; r < e; ++r) std::copy_n(item_terms_.row(r / rows_per_item).data(), H, y0 + (r - b) * ld0);  // the sums start there
+      for (std::size_t i = 0; i < parts.size(); ++i) {
+        const InputPart& p = parts[i];
+        if (!p.per_item)
+          part_packed_[i].run(sc.ws, e - b, p.values.data() + b * p.values.outerStride(), p.values.outerStride(), nullptr, y0, ld0, true);
+      }
+      eval_block_after_first_linear(w, e - b, y0, ld0, out.data() + b * out.cols(), out.cols());
+    });
+  }
+
+  /// Stage 0's Linear without its bias: out = in·W₀ᵀ (rows × spec(0).out). With
+  /// forward_eval_from_products it splits the eval forward where a linear map of the rows can sit
+  /// between the two (SuperResolutionNet's inference moves the decoder's first layer before the
+  /// upsampling: W₀·Σ_i w_i z_i = Σ_i w_i·W₀z_i). Row chunks as Linear::forward; seq == omp bitwise.
+  template <exec::HostPolicy Policy>
+  void first_linear_products(Policy policy, const ConstView<S>& in, Matrix<S>& out) {
+    Stage& s0 = *stages_[0];
+    if (in.cols() != in_features()) detail::check_shape("nn::Linear '" + s0.linear->name() + "'", "input", in, -1, in_features());
+    const Index R = in.rows(), H = s0.spec.out, nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
+    ensure_shape(out, R, H);
+    s0.linear->prepare_forward();
+    if (products_ws_.size() < std::size_t(workers)) products_ws_.resize(std::size_t(workers));
+    for (Index w = 0; w < workers; ++w) s0.linear->reserve_forward(products_ws_[std::size_t(w)]);
+    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
+      s0.linear->products_block(products_ws_[std::size_t(w)], e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * H, H, false);
+    });
+  }
+
+  /// Eval forward (BatchNorm on running statistics) of R rows whose stage-0 products (in·W₀ᵀ, no
+  /// bias) the caller writes chunk by chunk: `products(begin, end, y, ld)` fills rows [begin, end)
+  /// into y (leading dimension ld); the bias, BatchNorm, activation and the later stages follow
+  /// as in forward(Mode::eval), on the chunk while it is in cache. Allocates nothing once warm; a
+  /// backward after it needs the input (as after forward: pass it).
+  template <exec::HostPolicy Policy, class Products>
+  void forward_eval_from_products(Policy policy, Index R, Products&& products, Matrix<S>& out) {
+    if (!eval_fusable()) throw ArgumentError("nn::Mlp::forward_eval_from_products: needs BatchNorm with running statistics (eval mode)");
+    if (R < 0) throw ArgumentError("nn::Mlp::forward_eval_from_products: negative row count " + std::to_string(R));
+    Stage& s0 = *stages_[0];
+    const Index H = s0.spec.out;
     for_eval_chunks(policy, R, out, [&](Index w, Index b, Index e) {
       Matrix<S>& first = scratch_[std::size_t(w)].buf[0];  // stage 0's output, as eval_block keeps it
       S* y0 = first.data();
       const Index ld0 = first.cols();
-      Index off = 0;
-      bool accumulate = false;
-      for (const InputPart& p : parts) {
-        if (!p.per_item) {
-          scratch_[std::size_t(w)].gemm[0].run(e - b, H, p.values.cols(), p.values.data() + b * p.values.outerStride(), p.values.outerStride(), false,
-                                               W + off, in, true, y0, ld0, accumulate);
-          accumulate = true;
-        }
-        off += p.values.cols();
-      }
-      for (Index r = b; r < e; ++r) {
-        Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> y(y0 + (r - b) * ld0, H);
-        y += item_terms_.row(r / rows_per_item);
+      products(b, e, y0, ld0);
+      if (s0.linear->has_bias()) {
+        Eigen::Map<Matrix<S>, 0, Eigen::OuterStride<>> y(y0, e - b, H, Eigen::OuterStride<>(ld0));
+        y.rowwise() += s0.linear->bias().transpose();
       }
       eval_block_after_first_linear(w, e - b, y0, ld0, out.data() + b * out.cols(), out.cols());
     });
@@ -414,7 +455,7 @@ class Mlp {
   /// Per worker of the fused eval path: ping-pong stage outputs of one chunk, a GEMM per stage.
   struct Scratch {
     Matrix<S> buf[2];
-    std::vector<SerialGemm<S>> gemm;
+    typename Linear<S>::Workspace ws;  ///< every stage's products (one stage after the other)
   };
 
   /// eval_block's body. With `y0` set, stage 0's Linear output is there already (leading
@@ -431,7 +472,7 @@ class Mlp {
       if (i == 0 && y0) {
         y = y0, ldy = ld0;
       } else {
-        s.linear->forward_block(sc.gemm[i], rows, x, ldx, y, ldy);
+        s.linear->forward_block(sc.ws, rows, x, ldx, y, ldy);
       }
       if (s.bn) s.bn->apply_eval(y, ldy, rows);
       apply_activation(s, y, ldy, rows);
@@ -467,6 +508,8 @@ class Mlp {
   Matrix<S> recomputed_;  ///< output of the storing forward that an eval backward redoes
   Matrix<S> item_terms_;  ///< forward_eval_parts: the per-item parts' products and the bias (B × out of stage 0)
   SerialGemm<S> item_gemm_;
+  std::vector<PackedGemm<S>> part_packed_;                ///< forward_eval_parts: the per-row parts' columns of stage 0's weight
+  std::vector<typename Linear<S>::Workspace> products_ws_;  ///< first_linear_products, per worker
 };
 static_assert(assert_layer<Mlp<float>>());
 

@@ -78,19 +78,27 @@ class NeighborUpsample {
   /// with precomputed weights (M×upK shared, or (B·M)×upK), summed in ascending i.
   template <exec::HostPolicy Policy>
   void apply(Policy policy, const ConstView<S>& weights, const ConstView<S>& z, Matrix<S>& out) const {
-    const Index B = check_z(z), M = idx_.rows(), K = idx_.cols();
+    const Index B = check_z(z), M = idx_.rows();
     const bool shared = check_weights("weights", weights, B);
     ensure_shape(out, B * M, z.cols());
     const Index rows = B * M;
     const Index nc = exec::chunk_count(rows, product_chunks), workers = exec::worker_count(policy, nc);
-    exec::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) {
-      for (Index r = b; r < e; ++r) {
-        const Index item = r / M, j = r % M, wr = shared ? j : r;
-        auto o = out.row(r);
-        o.setZero();
-        for (Index i = 0; i < K; ++i) o += weights(wr, i) * z.row(item * n_ + idx_(j, i));
-      }
-    });
+    exec::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) { gather_rows(weights, shared, z, b, e, out.data() + b * out.cols(), out.cols()); });
+  }
+
+  /// apply's rows [begin, end) alone, written to `out` (row-major, leading dimension ld_out ≥
+  /// z.cols()), the same arithmetic: for a caller that consumes the upsampled rows chunk by chunk
+  /// while they are in cache (SuperResolutionNet's inference gathers the decoder's first-layer
+  /// products into the decoder's own row chunks). ShapeError / ArgumentError for shapes or a range
+  /// that apply would refuse.
+  void apply_rows(const ConstView<S>& weights, const ConstView<S>& z, Index begin, Index end, S* out, Index ld_out) const {
+    const Index B = check_z(z);
+    const bool shared = check_weights("weights", weights, B);
+    if (begin < 0 || end < begin || end > B * idx_.rows() || ld_out < z.cols())
+      throw ArgumentError("nn::NeighborUpsample::apply_rows: rows [" + std::to_string(begin) + ", " + std::to_string(end) + ") of " +
+                          std::to_string(B * idx_.rows()) + " with leading dimension " + std::to_string(ld_out) + " for " +
+                          std::to_string(z.cols()) + " columns");
+    gather_rows(weights, shared, z, begin, end, out, ld_out);
   }
 
   /// After forward(policy, logits, z, …): d_logits (shape of the logits) = w ⊙ (dw − Σ_i w dw) with
@@ -176,6 +184,17 @@ class NeighborUpsample {
         for (Index i = 0; i < K; ++i) dl[i] = w_(j, i) * (dl[i] - dot);
       }
     });
+  }
+
+  /// Rows [b, e) of the gather into out (row b first, leading dimension ld_out).
+  void gather_rows(const ConstView<S>& weights, bool shared, const ConstView<S>& z, Index b, Index e, S* out, Index ld_out) const {
+    const Index M = idx_.rows(), K = idx_.cols(), C = z.cols();
+    for (Index r = b; r < e; ++r) {
+      const Index item = r / M, j = r % M, wr = shared ? j : r;
+      Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> o(out + (r - b) * ld_out, C);
+      o.setZero();
+      for (Index i = 0; i < K; ++i) o += weights(wr, i) * z.row(item * n_ + idx_(j, i));
+    }
   }
 
   /// Number of batch items B of z ((B·N)×C); ShapeError otherwise.

@@ -12,6 +12,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mlp.hpp"
@@ -45,6 +46,25 @@ class SirenDecoder {
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode mode, const ConstView<S>& zH, Matrix<S>& out) {
     net_.forward(policy, mode, zH, out);
+  }
+
+  /// Width of the first sine layer (its Linear's outputs).
+  Index first_layer_width() const { return net_.template layer<0>().spec(0).out; }
+
+  /// The eval forward split after the first Linear's products, for a caller with a linear map of
+  /// the rows in between (SuperResolutionNet's inference: W₁·Σ_i w_ji z_i = Σ_i w_ji·W₁z_i, so the
+  /// products are taken on the N LR rows and gathered, instead of on the M upsampled ones).
+  /// first_layer_products: y = z·W₁ᵀ, no bias. forward_eval_from_products: `products(begin, end,
+  /// y, ld)` writes rows [begin, end) of the (gathered) products; the bias, the sine, the later
+  /// layers and last_layer follow as in forward(Mode::eval). Not for training: no backward after it.
+  template <exec::HostPolicy Policy>
+  void first_layer_products(Policy policy, const ConstView<S>& z, Matrix<S>& y) {
+    net_.template layer<0>().first_linear_products(policy, z, y);
+  }
+  template <exec::HostPolicy Policy, class Products>
+  void forward_eval_from_products(Policy policy, Index rows, Products&& products, Matrix<S>& out) {
+    net_.template layer<0>().forward_eval_from_products(policy, rows, std::forward<Products>(products), hidden_);
+    net_.template layer<1>().forward(policy, Mode::eval, hidden_, out);
   }
 
   template <exec::HostPolicy Policy>
@@ -94,6 +114,7 @@ class SirenDecoder {
 
   std::unique_ptr<Mlp<S>> dead_;  ///< registered only (official weights load), never run; before net_ (built first)
   Net net_;
+  Matrix<S> hidden_;  ///< forward_eval_from_products: the sine layers' output, last_layer's input
 };
 static_assert(assert_layer<SirenDecoder<float>>());
 

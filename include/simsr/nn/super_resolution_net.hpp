@@ -143,22 +143,49 @@ class SuperResolutionNet {
   }
   bool has_feature_embedding() const { return bool(fe_); }
   /// The LR code z = [h⁰, h¹, …] of the last forward ((B·N)×latent_dim) and its upsampling z^H.
+  /// An infer that moved the decoder's first layer before the upsampling formed no z^H:
+  /// hr_code() then throws ArgumentError (forward(…, Mode::eval) forms it, with the same values).
   const Matrix<S>& code() const { return fe_ ? z_ : h0_; }
-  const Matrix<S>& hr_code() const { return zh_; }
+  const Matrix<S>& hr_code() const {
+    if (last_ == LastCall::infer_first_layer_on_lr)
+      throw ArgumentError("nn::SuperResolutionNet::hr_code: the last infer moved the decoder's first layer before the upsampling and formed no z^H "
+                          "(run forward(policy, Mode::eval, …), or set_decoder_first_layer_on_lr(false) before infer)");
+    return zh_;
+  }
+
+  /// Inference (infer) takes the decoder's first Linear before the upsampling when that needs
+  /// fewer multiply-adds: W₁·z^H_j = W₁·Σ_i w_ji z_i = Σ_i w_ji·(W₁z_i), so the products run on
+  /// the B·N LR rows and the gather on their H₁ columns, instead of the products on the B·M HR
+  /// rows (official paper size: N·227·256 + M·20·256 against M·227·256 + M·20·227, 1.1 G fewer
+  /// per frame). The same values up to rounding (the products summed in another order). On by
+  /// default; false keeps infer bitwise equal to forward(policy, Mode::eval, …) (the benchmark's
+  /// baseline).
+  void set_decoder_first_layer_on_lr(bool on) { first_layer_on_lr_ = on; }
+  bool decoder_first_layer_on_lr() const { return first_layer_on_lr_; }
+  /// Whether infer moves the first layer: switched on and fewer multiply-adds per batch item.
+  bool infer_moves_decoder_first_layer() const {
+    if (!first_layer_on_lr_) return false;
+    const double D = double(cfg_.latent_dim()), H = double(decoder_->first_layer_width()), K = double(cfg_.up_k);
+    return double(n_) * D * H + double(m_) * K * H < double(m_) * D * H + double(m_) * K * D;
+  }
 
   /// Training (or eval-mode) forward: ldx (B·N)×3 normalized LR displacements → pred (B·M)×3
   /// normalized HR displacements. f_θ runs once per call, whatever B.
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode mode, const ConstView<S>& ldx, Matrix<S>& pred) {
+    last_ = LastCall::none;  // until it has finished
     encode(policy, mode, ldx);
     up_->forward(policy, mode, code(), zh_);
     decode(policy, mode, ldx, pred);
+    last_ = LastCall::forward;
   }
 
   /// After forward: d_pred (B·M)×3 → parameter gradients (added to the store; zero_grad first).
   /// `d_code`, when given, is an extra gradient on z (the latent regularizer's).
   template <exec::HostPolicy Policy>
   void backward(Policy policy, const ConstView<S>& d_pred, const Matrix<S>* d_code = nullptr) {
+    if (last_ != LastCall::forward)
+      throw ArgumentError("nn::SuperResolutionNet::backward: needs a finished forward(policy, mode, …) just before it (not infer)");
     detail::check_shape("nn::SuperResolutionNet", "prediction gradient", d_pred, zh_.rows(), 3);
     decoder_->backward(policy, zh_, pred_ref(), d_pred, &d_zh_);
     up_->backward(policy, code(), d_zh_, &d_z_);
@@ -179,10 +206,21 @@ class SuperResolutionNet {
   /// Inference: eval mode with the precomputed upsampling (prepare_inference first).
   template <exec::HostPolicy Policy>
   void infer(Policy policy, const ConstView<S>& ldx, Matrix<S>& pred) {
+    last_ = LastCall::none;  // until it has finished
     if (!up_->has_precomputed_weights()) prepare_inference(policy);
     encode(policy, Mode::eval, ldx);
-    up_->apply(policy, code(), zh_);
-    decode(policy, Mode::eval, ldx, pred);
+    if (!infer_moves_decoder_first_layer()) {
+      up_->apply(policy, code(), zh_);
+      decode(policy, Mode::eval, ldx, pred);
+      last_ = LastCall::infer;
+      return;
+    }
+    decoder_->first_layer_products(policy, code(), lr_products_);
+    const ConstView<S> products(lr_products_);
+    decoder_->forward_eval_from_products(
+        policy, ldx.rows() / n_ * m_, [&](Index b, Index e, S* y, Index ld) { up_->apply_rows(products, b, e, y, ld); }, pred);
+    add_residual_base(policy, ldx, pred);
+    last_ = LastCall::infer_first_layer_on_lr;
   }
 
   /// The batch split of data-parallel training (nn/batch_split.hpp; nullptr: none) for every part
@@ -211,6 +249,11 @@ class SuperResolutionNet {
   void decode(Policy policy, Mode mode, const ConstView<S>& ldx, Matrix<S>& pred) {
     decoder_->forward(policy, mode, zh_, pred);
     pred_ = &pred;
+    add_residual_base(policy, ldx, pred);
+  }
+  /// pred += the residual base's prediction from ldx (cfg.residual; nothing otherwise).
+  template <class Policy>
+  void add_residual_base(Policy policy, const ConstView<S>& ldx, Matrix<S>& pred) {
     if (!cfg_.residual) return;
     // Row by row under the policy: Eigen's sparse × dense product may start its own OpenMP
     // threads, and exec::seq must start none (tests/threads).
@@ -251,7 +294,12 @@ class SuperResolutionNet {
   std::unique_ptr<SirenDecoder<S>> decoder_;
   Eigen::SparseMatrix<S, Eigen::RowMajor> embedding_, residual_map_;
   Matrix<S> h0_, z_, zh_, d_zh_, d_z_;
+  Matrix<S> lr_products_;  ///< infer with the decoder's first layer moved: z·W₁ᵀ on the LR rows
   const Matrix<S>* pred_ = nullptr;
+  bool first_layer_on_lr_ = true;
+  /// What ran last (and finished): backward needs a forward, hr_code a z^H.
+  enum class LastCall { none, forward, infer, infer_first_layer_on_lr };
+  LastCall last_ = LastCall::none;
 };
 
 }  // namespace simsr::nn
