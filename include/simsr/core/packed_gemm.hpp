@@ -39,7 +39,7 @@ class PackedGemm {
   /// registers (32 with AVX-512, 16 with SSE/AVX).
   static constexpr int MR = P * int(sizeof(S)) >= 64 ? 8 : 4;
 
-  /// Per-worker scratch of run(): the micro-tile's rows packed depth-major, and the edge tiles.
+  /// Per-worker scratch of run(): the last rows and the edge tiles.
   struct Workspace {
     std::vector<S> buf;
   };
@@ -75,15 +75,17 @@ class PackedGemm {
   void run(Workspace& ws, Index rows, const S* x, Index ldx, const S* bias, S* y, Index ldy, bool accumulate) const {
     if (rows == 0 || out_ == 0) return;
     reserve(ws);
-    S* xp = ws.buf.data();       // MR rows of x, depth-major
+    S* xp = ws.buf.data();       // the last MR rows of x, when fewer remain
     S* yt = xp + MR * in_;       // an edge tile's MR×NR output
     S* init = yt + MR * NR;      // an edge tile's MR×NR starting values
     const Index np = (out_ + NR - 1) / NR;
     for (Index r0 = 0; r0 < rows; r0 += MR) {
       const Index m = std::min<Index>(MR, rows - r0);
-      for (Index r = 0; r < MR; ++r) {  // rows past m repeat the last one: computed, never stored
-        const S* src = x + (r0 + std::min<Index>(r, m - 1)) * ldx;
-        for (Index d = 0; d < in_; ++d) xp[d * MR + r] = src[d];
+      const S* xs = x + r0 * ldx;  // the rows are read in place: MR broadcasts per depth step
+      Index lds = ldx;
+      if (m < MR) {  // the last rows through a copy whose rows past m repeat the last one (computed, never stored)
+        for (Index r = 0; r < MR; ++r) std::copy_n(x + (r0 + std::min<Index>(r, m - 1)) * ldx, in_, xp + r * in_);
+        xs = xp, lds = in_;
       }
       for (Index p = 0; p < np; ++p) {
         const Index o0 = p * NR, cols = std::min<Index>(NR, out_ - o0);
@@ -108,9 +110,9 @@ class PackedGemm {
         }
         const S* panel = panels_.data() + p * NR * in_;
         if (full) {
-          micro(xp, panel, in_, start, ld_start, yb, ldy);
+          micro(xs, lds, panel, in_, start, ld_start, yb, ldy);
         } else {
-          micro(xp, panel, in_, start, ld_start, yt, NR);
+          micro(xs, lds, panel, in_, start, ld_start, yt, NR);
           for (Index r = 0; r < m; ++r) std::copy_n(yt + r * NR, cols, yb + r * ldy);
         }
       }
@@ -121,8 +123,10 @@ class PackedGemm {
   std::size_t workspace_size() const { return static_cast<std::size_t>(MR * in_ + 2 * MR * NR); }
 
   /// One MR×NR tile: accumulators from `start` (row r at start + r·ld_start; ld_start 0: one row
-  /// for all), then the depth loop, then stored to y (leading dimension ldy).
-  static void micro(const S* xp, const S* panel, Index in, const S* start, Index ld_start, S* y, Index ldy) {
+  /// for all), then the depth loop over the MR rows of x in place (leading dimension ldx), then
+  /// stored to y (leading dimension ldy). Packing x too (as DistanceTile packs its rows) measured
+  /// slower here: the transposing copy cost more than the strided broadcasts.
+  static void micro(const S* x, Index ldx, const S* panel, Index in, const S* start, Index ld_start, S* y, Index ldy) {
     using namespace Eigen::internal;
     Packet acc[MR][2];
 #pragma GCC unroll 16
@@ -134,7 +138,7 @@ class PackedGemm {
       const Packet w0 = ploadu<Packet>(panel + d * NR), w1 = ploadu<Packet>(panel + d * NR + P);
 #pragma GCC unroll 16
       for (int r = 0; r < MR; ++r) {
-        const Packet a = pset1<Packet>(xp[d * MR + r]);
+        const Packet a = pset1<Packet>(x[r * ldx + d]);
         acc[r][0] = pmadd(a, w0, acc[r][0]);
         acc[r][1] = pmadd(a, w1, acc[r][1]);
       }
