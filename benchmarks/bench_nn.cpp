@@ -17,6 +17,8 @@
 ///    nearest other points of the N = 15,872 rows of h¹, 64 features, as block 1's EdgeConv builds
 ///    it) on the features of one inference; the setup checks that both kernels give the same graph
 ///    (it reports an error otherwise).
+///  - BM_official_dynamic_knn_paper_size/fused/omp/baseline_unshared_thresholds: the fused kernel with
+///    each worker filtering by its own candidate lists alone (BruteForceKnnParams::share_thresholds).
 ///  - BM_official_forward_train_mode_paper_size/omp: forward(Mode::train), B = 1, same sizes
 ///    (f_θ over the M·upK = 712,740 queries at every call, BatchNorm on batch statistics).
 ///  - BM_official_train_step_bunny/omp/B:{32,8}: one training step on the bunny (zero_grad,
@@ -289,10 +291,10 @@ const FusedKnn::point_matrix& paper_block1_features() {
 }
 
 template <class Knn, exec::HostPolicy Policy>
-void BM_official_dynamic_knn_paper_size(Policy policy, benchmark::State& state) {
+void BM_official_dynamic_knn_paper_size(Policy policy, benchmark::State& state, bool share_thresholds = true) {
   const auto& h1 = paper_block1_features();
   const Index k = paper_config().knn;
-  Knn knn(h1);
+  Knn knn(h1, {.share_thresholds = share_thresholds});
   neighbors::KnnResult<float> r, other;
   knn.query_self_into(policy, k, r, true);
   // the other kernel's graph, once: the rows must agree (exact ties aside; the features have none)
@@ -307,6 +309,7 @@ void BM_official_dynamic_knn_paper_size(Policy policy, benchmark::State& state) 
 }
 void BM_dynamic_knn_fused_seq(benchmark::State& s) { BM_official_dynamic_knn_paper_size<FusedKnn>(exec::seq, s); }
 void BM_dynamic_knn_fused_omp(benchmark::State& s) { BM_official_dynamic_knn_paper_size<FusedKnn>(exec::omp, s); }
+void BM_dynamic_knn_fused_unshared_omp(benchmark::State& s) { BM_official_dynamic_knn_paper_size<FusedKnn>(exec::omp, s, false); }
 void BM_dynamic_knn_gemm_seq(benchmark::State& s) { BM_official_dynamic_knn_paper_size<BaselineKnn>(exec::seq, s); }
 void BM_dynamic_knn_gemm_omp(benchmark::State& s) { BM_official_dynamic_knn_paper_size<BaselineKnn>(exec::omp, s); }
 
@@ -346,6 +349,11 @@ BENCHMARK(BM_official_forward_paper_size_omp_decoder_on_hr)
     ->MinTime(3.0);
 BENCHMARK(BM_dynamic_knn_fused_seq)->Name("BM_official_dynamic_knn_paper_size/fused/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_dynamic_knn_fused_omp)->Name("BM_official_dynamic_knn_paper_size/fused/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_dynamic_knn_fused_unshared_omp)
+    ->Name("BM_official_dynamic_knn_paper_size/fused/omp/baseline_unshared_thresholds")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(1.0);
 BENCHMARK(BM_dynamic_knn_gemm_seq)->Name("BM_official_dynamic_knn_paper_size/blocked_gemm/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_dynamic_knn_gemm_omp)->Name("BM_official_dynamic_knn_paper_size/blocked_gemm/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_official_forward_train_mode_paper_size)->Name("BM_official_forward_train_mode_paper_size/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);

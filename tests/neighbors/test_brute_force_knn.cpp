@@ -233,6 +233,12 @@ TEST_CASE("BruteForceKnn's fused kernel: many tiles, seq == omp bitwise and the 
     CHECK(omp.indices == seq.indices);
     CHECK(omp.distances == seq.distances);
     check_same_up_to_ties(seq, ref, "1500×64 kind " + std::to_string(kind));
+    // the workers' thresholds kept apart (share_thresholds = false): the same graph
+    BruteForceKnn<float> unshared(P, {64, 1024, 8, false});
+    KnnResult<float> apart;
+    unshared.query_self_into(exec::omp, 5, apart);
+    CHECK(apart.indices == seq.indices);
+    CHECK(apart.distances == seq.distances);
   }
 }
 

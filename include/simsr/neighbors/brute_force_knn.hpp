@@ -43,6 +43,10 @@ struct BruteForceKnnParams {
   Index query_block = 256;     ///< queries per GEMM block (rows of the block product; self queries: the tile size)
   Index point_block = 1024;    ///< points per GEMM block (columns)
   Index extra_candidates = 8;  ///< candidates kept beyond k for the exact re-ranking
+  /// Self queries with several workers: between phases of tile offsets, each row's threshold
+  /// becomes the smallest any worker holds (the same result; false: each worker filters with its
+  /// own lists alone, the benchmark's baseline).
+  bool share_thresholds = true;
 };
 
 /// Exact brute-force kNN over N points of dimension D (row-major N×D, float by default).
@@ -268,7 +272,7 @@ class BruteForceKnn {
             tile(I * T, std::min(T, n - I * T), J * T, std::min(T, n - J * T), cap, exclude_self, ws);
         }
       });
-      if (workers > 1 && d_end < nb) {
+      if (params_.share_thresholds && workers > 1 && d_end < nb) {
         const Index chunks = exec::chunk_count(n, workers);
         exec::for_chunks(policy, n, chunks, workers, [&](Index, Index, Index b, Index e) {
           for (Index q = b; q < e; ++q) {
