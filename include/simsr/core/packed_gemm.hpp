@@ -5,11 +5,11 @@
 /// hundred square), the same for every row chunk of a forward, and x has many rows.
 ///
 /// Why not SerialGemm (Eigen's packed kernel) here: Eigen packs W again on every call (one per
-/// row chunk), zeroes C before it accumulates, and its 48×4 register block reaches ~67 of the ~96
-/// float multiply-adds per ns one core of this machine (Zen 5, AVX-512) can do at these widths;
-/// this kernel, the register tiling of neighbors::detail::DistanceTile applied to a product,
-/// reaches 85–94 (measured at rows 560 × in 64…256 × out 32…256, the layers' chunk shapes) and
-/// starts its accumulators from the bias, so there is no zeroing pass and no bias pass.
+/// row chunk), zeroes C before it accumulates, and its 48×4 register block reached 39–75 float
+/// multiply-adds per ns on one core of this machine (Zen 5, AVX-512) at the layers' chunk shapes
+/// (560 rows × in 64…384 × out 32…512; bench_core's BM_LayerProducts_*), the bias added in another
+/// pass; this kernel, the register tiling of neighbors::detail::DistanceTile applied to a product,
+/// reached 107–113 there, and starts its accumulators from the bias: no zeroing pass, no bias pass.
 ///
 /// Arithmetic of one entry: y(r, o) = init(o) + Σ_d x(r, d)·W(o, d), accumulated over d in order
 /// with pmadd (a fused multiply-add where the target has one), init the bias (or 0, or y's own
@@ -48,7 +48,9 @@ class PackedGemm {
   /// depth-major: W(o, d) at panels[(o / NR)·NR·in + d·NR + o % NR], the outputs past `out`
   /// padded with zeros. Allocates only when the shape grows.
   void pack(const S* W, Index out, Index in, Index ldw) {
-    if (out < 0 || in < 0 || ldw < in) throw ArgumentError("PackedGemm::pack: out " + std::to_string(out) + ", in " + std::to_string(in) + ", ldw " + std::to_string(ldw));
+    if (out < 0 || in < 0 || ldw < in)
+      throw ArgumentError("PackedGemm::pack: out " + std::to_string(out) + ", in " + std::to_string(in) + ", ldw " + std::to_string(ldw) +
+                          " (needs out, in >= 0 and ldw >= in)");
     out_ = out, in_ = in;
     const Index np = (out + NR - 1) / NR;
     panels_.resize(static_cast<std::size_t>(np * NR * in));

@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Single-threaded GEMM on raw row-major buffers: the block products of the feature kNN
-/// (neighbors::BruteForceKnn) and of the network layers (nn::Linear).
+/// (neighbors::BruteForceKnn's blocked-GEMM kernel) and of the network layers' backward (nn::Linear;
+/// their forward products go through PackedGemm, packed_gemm.hpp).
 
 #include <Eigen/Core>
 #include <memory>

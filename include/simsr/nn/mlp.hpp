@@ -452,7 +452,7 @@ class Mlp {
       s.sine->backward(policy, x, y, g, &dx);
   }
 
-  /// Per worker of the fused eval path: ping-pong stage outputs of one chunk, a GEMM per stage.
+  /// Per worker of the fused eval path: ping-pong stage outputs of one chunk, the products' scratch.
   struct Scratch {
     Matrix<S> buf[2];
     typename Linear<S>::Workspace ws;  ///< every stage's products (one stage after the other)

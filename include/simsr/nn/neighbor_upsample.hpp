@@ -83,7 +83,8 @@ class NeighborUpsample {
     ensure_shape(out, B * M, z.cols());
     const Index rows = B * M;
     const Index nc = exec::chunk_count(rows, product_chunks), workers = exec::worker_count(policy, nc);
-    exec::for_chunks(policy, rows, nc, workers, [&](Index, Index, Index b, Index e) { gather_rows(weights, shared, z, b, e, out.data() + b * out.cols(), out.cols()); });
+    exec::for_chunks(policy, rows, nc, workers,
+                     [&](Index, Index, Index b, Index e) { gather_rows(weights, shared, z, b, e, out.data() + b * out.cols(), out.cols()); });
   }
 
   /// apply's rows [begin, end) alone, written to `out` (row-major, leading dimension ld_out ≥

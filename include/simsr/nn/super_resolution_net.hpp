@@ -144,7 +144,8 @@ class SuperResolutionNet {
   bool has_feature_embedding() const { return bool(fe_); }
   /// The LR code z = [h⁰, h¹, …] of the last forward ((B·N)×latent_dim) and its upsampling z^H.
   /// An infer that moved the decoder's first layer before the upsampling formed no z^H:
-  /// hr_code() then throws ArgumentError (forward(…, Mode::eval) forms it, with the same values).
+  /// hr_code() then throws ArgumentError (forward(…, Mode::eval) forms it; its outputs are the same
+  /// up to rounding).
   const Matrix<S>& code() const { return fe_ ? z_ : h0_; }
   const Matrix<S>& hr_code() const {
     if (last_ == LastCall::infer_first_layer_on_lr)
