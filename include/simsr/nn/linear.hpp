@@ -101,17 +101,13 @@ class Linear {
   /// out (rows×out) = in (rows×in)·Wᵀ + b. The mode does not matter here.
   template <exec::HostPolicy Policy>
   void forward(Policy policy, Mode, const ConstView<S>& in, Matrix<S>& out) {
-    detail::check_shape(where_, "input", in, -1, in_);
-    const Index R = in.rows();
-    ensure_shape(out, R, out_);
-    const auto chunks = detail::row_chunks(split_, R, product_chunks, where_);
-    const Index workers = exec::worker_count(policy, chunks.count());
-    prepare_forward();
-    if (ws_fwd_.size() < std::size_t(workers)) ws_fwd_.resize(std::size_t(workers));
-    for (Index w = 0; w < workers; ++w) reserve_forward(ws_fwd_[std::size_t(w)]);
-    detail::for_row_chunks_dynamic(policy, chunks, workers, [&](Index w, Index, Index b, Index e) {
-      forward_block(ws_fwd_[std::size_t(w)], e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * out_, out_);
-    });
+    forward_rows(policy, in, out, true);
+  }
+  /// forward without the bias: out = in·Wᵀ (a caller that adds the bias after a linear map of the
+  /// rows: Mlp::first_linear_products).
+  template <exec::HostPolicy Policy>
+  void forward_without_bias(Policy policy, const ConstView<S>& in, Matrix<S>& out) {
+    forward_rows(policy, in, out, false);
   }
 
   /// A worker's scratch of forward_block.
@@ -183,6 +179,25 @@ class Linear {
   }
 
  private:
+  template <class Policy>
+  void forward_rows(Policy policy, const ConstView<S>& in, Matrix<S>& out, bool with_bias) {
+    detail::check_shape(where_, "input", in, -1, in_);
+    const Index R = in.rows();
+    ensure_shape(out, R, out_);
+    const auto chunks = detail::row_chunks(split_, R, product_chunks, where_);
+    const Index workers = exec::worker_count(policy, chunks.count());
+    prepare_forward();
+    if (ws_fwd_.size() < std::size_t(workers)) ws_fwd_.resize(std::size_t(workers));
+    for (Index w = 0; w < workers; ++w) reserve_forward(ws_fwd_[std::size_t(w)]);
+    detail::for_row_chunks_dynamic(policy, chunks, workers, [&](Index w, Index, Index b, Index e) {
+      const S* x = in.data() + b * in.outerStride();
+      if (with_bias)
+        forward_block(ws_fwd_[std::size_t(w)], e - b, x, in.outerStride(), out.data() + b * out_, out_);
+      else
+        products_block(ws_fwd_[std::size_t(w)], e - b, x, in.outerStride(), out.data() + b * out_, out_, false);
+    });
+  }
+
   const std::string& where() const { return where_; }
   Index bias_offset() const {
     if (!has_bias()) throw ArgumentError(where() + " has no bias");

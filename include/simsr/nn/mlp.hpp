@@ -298,19 +298,10 @@ class Mlp {
   /// Stage 0's Linear without its bias: out = in·W₀ᵀ (rows × spec(0).out). With
   /// forward_eval_from_products it splits the eval forward where a linear map of the rows can sit
   /// between the two (SuperResolutionNet's inference moves the decoder's first layer before the
-  /// upsampling: W₀·Σ_i w_i z_i = Σ_i w_i·W₀z_i). Row chunks as Linear::forward; seq == omp bitwise.
+  /// upsampling: W₀·Σ_i w_i z_i = Σ_i w_i·W₀z_i): Linear::forward_without_bias.
   template <exec::HostPolicy Policy>
   void first_linear_products(Policy policy, const ConstView<S>& in, Matrix<S>& out) {
-    Stage& s0 = *stages_[0];
-    if (in.cols() != in_features()) detail::check_shape("nn::Linear '" + s0.linear->name() + "'", "input", in, -1, in_features());
-    const Index R = in.rows(), H = s0.spec.out, nc = exec::chunk_count(R, product_chunks), workers = exec::worker_count(policy, nc);
-    ensure_shape(out, R, H);
-    s0.linear->prepare_forward();
-    if (products_ws_.size() < std::size_t(workers)) products_ws_.resize(std::size_t(workers));
-    for (Index w = 0; w < workers; ++w) s0.linear->reserve_forward(products_ws_[std::size_t(w)]);
-    detail::for_chunks_dynamic(policy, R, nc, workers, [&](Index w, Index, Index b, Index e) {
-      s0.linear->products_block(products_ws_[std::size_t(w)], e - b, in.data() + b * in.outerStride(), in.outerStride(), out.data() + b * H, H, false);
-    });
+    stages_[0]->linear->forward_without_bias(policy, in, out);
   }
 
   /// Eval forward (BatchNorm on running statistics) of R rows whose stage-0 products (in·W₀ᵀ, no
@@ -508,8 +499,7 @@ class Mlp {
   Matrix<S> recomputed_;  ///< output of the storing forward that an eval backward redoes
   Matrix<S> item_terms_;  ///< forward_eval_parts: the per-item parts' products and the bias (B × out of stage 0)
   SerialGemm<S> item_gemm_;
-  std::vector<PackedGemm<S>> part_packed_;                ///< forward_eval_parts: the per-row parts' columns of stage 0's weight
-  std::vector<typename Linear<S>::Workspace> products_ws_;  ///< first_linear_products, per worker
+  std::vector<PackedGemm<S>> part_packed_;  ///< forward_eval_parts: the per-row parts' columns of stage 0's weight
 };
 static_assert(assert_layer<Mlp<float>>());
 
