@@ -39,6 +39,9 @@
 //       (CHOLMOD's supernodal LLᵀ; built with -DSIMSR_WITH_CHOLMOD=ON). Counters:
 //       newton_iterations, linear_iterations (PCG iterations summed over the frame), projected
 //       (Newton iterations whose exact Hessian was not positive definite: assembled twice), fps.
+//   BM_frame_73k/pcg_multigrid_inexact…/omp   NewtonOptions::Forcing::adaptive (Eisenstat–Walker's
+//       forcing, each Newton system solved to η_k instead of kCgTolerance) with Kelley's safeguard
+//       η_k ≥ ½ τ/‖g_k‖ (forcing_safeguard, default); `_unguarded` without it (the baseline)
 //   BM_frame_73k/<linear>_extrapolated/omp   the same frame from the face simulator's warm start:
 //       2 x_A − x_before, with x_before the frame before A (jaw 0.08 rad, activation 0.05, targets
 //       −0.5 mm: the same step back), solved once at setup from x_A
@@ -318,13 +321,15 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 /// `Extrapolate`: the frame starts from 2 x_A − x_before (the last two frames' linear extrapolation,
 /// as the face simulator's warm start), not from x_A.
 template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
-          NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block, bool Extrapolate = false>
+          NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block, bool Extrapolate = false,
+          bool ForcingSafeguard = true>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
   EmbeddedSprings<> springs = *s.springs;
   NewtonOptions options;
   options.forcing = Forcing;
+  options.forcing_safeguard = ForcingSafeguard;
   QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
@@ -392,6 +397,11 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, Newton
 // the warm start of the face simulator: the last two frames extrapolated
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::fixed, Storage::block, true)->Name("BM_frame_73k/pcg_multigrid_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::fixed, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+// the inexact Newton from the extrapolated warm start: Eisenstat–Walker's forcing with Kelley's
+// safeguard (NewtonOptions::forcing_safeguard, the default), and without it (`…_unguarded…`)
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::adaptive, Storage::block, true)->Name("BM_frame_73k/pcg_multigrid_inexact_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, false)->Name("BM_frame_73k/pcg_multigrid_inexact_unguarded_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)
 BENCHMARK_TEMPLATE(BM_frame, CholmodCholesky<>, exec::omp_t)->Name("BM_frame_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #endif

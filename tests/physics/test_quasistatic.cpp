@@ -221,6 +221,7 @@ TEST_CASE("Forcing::adaptive (inexact Newton): the same equilibrium to the toler
     NewtonOptions o;
     o.relative_tolerance = 1e-9;
     o.forcing = forcing;
+    o.forcing_safeguard = false;  // Eisenstat–Walker alone (the safeguard: the next test case)
     QuasistaticSolver<Pcg> newton(mesh.num_vertices(), mesh.T, o, Pcg({.tolerance = 1e-8}));
     if (tolerances) newton.options().progress = [&](const NewtonIteration&) { tolerances->push_back(newton.linear_solver().options().tolerance); };
     Points<> x = mesh.V;
@@ -250,6 +251,64 @@ TEST_CASE("Forcing::adaptive (inexact Newton): the same equilibrium to the toler
   Points<> x = mesh.V;
   CHECK(direct.solve(exec::seq, x, ends.boundary(), flesh, gravity).converged);
   CHECK((x - x_fixed).cwiseAbs().maxCoeff() <= 1e-6 * moved);
+}
+
+TEST_CASE("Forcing::adaptive's safeguard (Kelley): no linear solve asked for much below the Newton tolerance, the same equilibrium in fewer PCG iterations") {
+  // a muscle block (Teran: its passive fibre curve's slope jumps at λ = 1, so Newton's contraction
+  // is limited) on a BCC lattice, its ends turned and pulled by random amounts
+  const auto box = box_tet_mesh<double>(2, 2, 6, Vec3<>(0, 0, 0), Vec3<>(0.1, 0.1, 0.3));
+  const TetMesh<double> mesh = discretize::bcc_lattice(box, 0.025).mesh;
+  std::vector<MuscleFibre<>> fibres(std::size_t(mesh.num_tets()), MuscleFibre<>{Vec3<>::UnitZ(), 0.3});
+  ElasticEnergy<TeranMuscle<>> flesh(mesh, TeranMuscle<>(), fibres);
+  Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
+  using Pcg = ConjugateGradient<BlockJacobi<>>;
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Index linear_safeguarded = 0, linear_eisenstat_walker = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    BoneAttachments<> ends(mesh.V);
+    ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
+    ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
+    ends.set_transform("bottom", RigidTransform<>{Eigen::AngleAxisd(0.4 * u(rng), Vec3<>::UnitZ()).toRotationMatrix(),
+                                                  Vec3<>(0.03 * u(rng), 0.03 * u(rng), 0.03 * u(rng))});
+    const double relative = trial % 2 ? 1e-9 : 1e-10;
+    const auto solve = [&](bool safeguard, std::vector<NewtonIteration>& seen) {
+      NewtonOptions o;
+      o.relative_tolerance = relative;
+      o.forcing = NewtonOptions::Forcing::adaptive;
+      o.forcing_safeguard = safeguard;
+      o.progress = [&](const NewtonIteration& it) { seen.push_back(it); };
+      QuasistaticSolver<Pcg> newton(mesh.num_vertices(), mesh.T, o, Pcg({.tolerance = 1e-10}));
+      Points<> x = mesh.V;
+      const NewtonReport r = newton.solve(exec::omp, x, ends.boundary(), flesh, gravity);
+      CHECK(r.converged);
+      CHECK(newton.linear_solver().options().tolerance == 1e-10);  // given back
+      return std::make_pair(x, r);
+    };
+    std::vector<NewtonIteration> guarded, plain;
+    const auto [x_guarded, r_guarded] = solve(true, guarded);
+    const auto [x_plain, r_plain] = solve(false, plain);
+    const double moved = (x_plain - mesh.V).cwiseAbs().maxCoeff();
+    REQUIRE(moved > 1e-3);
+    CHECK((x_guarded - x_plain).cwiseAbs().maxCoeff() <= 1e-5 * moved);
+    REQUIRE(!guarded.empty());
+    for (const NewtonIteration& it : guarded) {
+      CHECK(it.tolerance > 0);
+      CHECK(it.gradient_norm > it.tolerance);  // an iteration that steps has not converged
+      // η ≥ ½ τ/‖g‖ unless that exceeds the cap; never below the solver's own, never above the cap
+      CHECK(it.linear_tolerance >= std::min(0.1, 0.5 * it.tolerance / it.gradient_norm) * (1 - 1e-12));
+      CHECK((it.linear_tolerance >= 1e-10 && it.linear_tolerance <= 0.1));
+    }
+    for (const NewtonIteration& it : plain) CHECK((it.linear_tolerance >= 1e-10 && it.linear_tolerance <= 0.1));
+    // the safeguard only ever loosens a solve: the last one at least as loose as Eisenstat–Walker's
+    CHECK(guarded.back().linear_tolerance >= plain.back().linear_tolerance);
+    CHECK(r_guarded.iterations <= r_plain.iterations + 1);
+    linear_safeguarded += r_guarded.linear_iterations;
+    linear_eisenstat_walker += r_plain.linear_iterations;
+  }
+  MESSAGE("PCG iterations over 6 random loadings: Eisenstat-Walker alone ", linear_eisenstat_walker, ", with Kelley's safeguard ",
+          linear_safeguarded);
+  CHECK(linear_safeguarded < linear_eisenstat_walker);
 }
 
 TEST_CASE("Newton progress: every iteration is reported, with the Hessian it used") {

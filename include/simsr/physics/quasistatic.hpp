@@ -45,6 +45,8 @@ struct NewtonIteration {
   Index backtracks = 0;
   Index linear_iterations = 0;
   double linear_residual = 0;
+  double linear_tolerance = 0;    ///< the relative tolerance the linear solve was given (iterative solvers; 0: none)
+  double tolerance = 0;           ///< the gradient norm that counts as converged at this iteration (N)
   bool projected = false;         ///< the definiteness-fixed Hessian was used
   double shift = 0;               ///< Hessian::regularized: the τ of H + τ·mean|diag H|·I used (0: H itself)
 };
@@ -98,6 +100,14 @@ struct NewtonOptions {
   /// the solves tighten to the solver's own tolerance, keeping Newton's fast local convergence.
   enum class Forcing { fixed, adaptive } forcing = Forcing::fixed;
   double forcing_max = 0.1;
+  /// Forcing::adaptive also keeps η_k ≥ ½ τ / ‖g_k‖, τ the gradient norm that counts as converged
+  /// (Kelley 1995, "Iterative Methods for Linear and Nonlinear Equations", §6.3.2, eq. 6.20): a
+  /// linear solve need not make the next gradient much smaller than τ, so the last iterations stop
+  /// oversolving. Where Newton's own contraction is limited (a material whose second derivative
+  /// jumps, as the passive fibre curve's at λ = 1), the final solve then takes a few PCG
+  /// iterations instead of a full solve to the solver's tolerance (bench_physics,
+  /// BM_frame_73k/…_inexact…). false: Eisenstat–Walker's choice alone (the baseline).
+  bool forcing_safeguard = true;
   /// Called after every iteration (progress lines for long runs).
   std::function<void(const NewtonIteration&)> progress;
 };
@@ -190,7 +200,8 @@ class QuasistaticSolver {
       }
 
       // Newton direction: H d = −g (fixed DOFs: identity rows, zero right-hand side).
-      forcing.set(it, gnorm);
+      const double tolerance = test.threshold();
+      forcing.set(it, gnorm, tolerance);
       rhs_ = -g_;
       bool projected = options_.hessian == NewtonOptions::Hessian::projected;
       LinearSolveInfo info;
@@ -249,7 +260,7 @@ class QuasistaticSolver {
       x.swap(trial_);
       accepted = trial_energy;
       report.linear_iterations += info.iterations;
-      NewtonIteration record{it, E, gnorm, alpha, backtracks, info.iterations, info.relative_residual, projected, shift};
+      NewtonIteration record{it, E, gnorm, alpha, backtracks, info.iterations, info.relative_residual, forcing.linear_tolerance(), tolerance, projected, shift};
       report.history.push_back(record);
       if (options_.progress) options_.progress(record);
     }
@@ -267,8 +278,9 @@ class QuasistaticSolver {
     }
     ForcingTerm(const ForcingTerm&) = delete;
     ForcingTerm& operator=(const ForcingTerm&) = delete;
-    /// The tolerance of iteration `it`, whose gradient norm is `gnorm`.
-    void set(Index it, double gnorm) {
+    /// The tolerance of iteration `it`, whose gradient norm is `gnorm`; `converged_below` is the
+    /// gradient norm that counts as converged (the safeguard's τ).
+    void set(Index it, double gnorm, double converged_below) {
       if constexpr (kTunable) {
         if (s_.options_.forcing != NewtonOptions::Forcing::adaptive) return;
         const double cap = std::max(own_, s_.options_.forcing_max);
@@ -279,11 +291,20 @@ class QuasistaticSolver {
           const double safeguard = 0.9 * last_eta_ * last_eta_;
           if (safeguard > 0.1) eta = std::max(eta, safeguard);
         }
+        if (s_.options_.forcing_safeguard && gnorm > 0) eta = std::max(eta, 0.5 * converged_below / gnorm);
         eta = std::clamp(eta, own_, cap);
         s_.linear_.options().tolerance = eta;
         last_eta_ = eta;
         last_norm_ = gnorm;
       }
+    }
+
+    /// The linear solver's relative tolerance now (0 for a solver without one).
+    double linear_tolerance() const {
+      if constexpr (kTunable)
+        return s_.linear_.options().tolerance;
+      else
+        return 0;
     }
 
    private:

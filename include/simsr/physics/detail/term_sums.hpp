@@ -54,6 +54,8 @@ class GradientTest {
  public:
   GradientTest(double relative, double absolute, double reference_force)
       : relative_(relative), absolute_(absolute), reference_(reference_force) {}
+  /// The gradient norm below which the last iterate passed to converged() counts as converged.
+  double threshold() const { return std::max(absolute_, relative_ * reference_); }
   /// Whether iterate `it` (gradient norm, forces' scale) has converged; call once per iterate.
   bool converged(Index it, double gradient_norm, double balance) {
     if (it == 0) reference_ = std::max(reference_, gradient_norm);
