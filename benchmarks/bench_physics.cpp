@@ -41,7 +41,9 @@
 //       (Newton iterations whose exact Hessian was not positive definite: assembled twice), fps.
 //   BM_frame_73k/pcg_multigrid_inexact…/omp   NewtonOptions::Forcing::adaptive (Eisenstat–Walker's
 //       forcing, each Newton system solved to η_k instead of kCgTolerance) with Kelley's safeguard
-//       η_k ≥ ½ τ/‖g_k‖ (forcing_safeguard, default); `_unguarded` without it (the baseline)
+//       η_k ≥ ½ τ/‖g_k‖ (forcing_safeguard, default); `_unguarded` without it (the baseline);
+//       `_jacobi_svd` with the element Hessians on Eigen's Jacobi SVD (JacobiSvdMuscle, the
+//       baseline of signed_svd_from_eigen)
 //   BM_frame_73k/<linear>_extrapolated/omp   the same frame from the face simulator's warm start:
 //       2 x_A − x_before, with x_before the frame before A (jaw 0.08 rad, activation 0.05, targets
 //       −0.5 mm: the same step back), solved once at setup from x_A
@@ -50,6 +52,8 @@
 //       one first; same cost: both go through the signed SVD) gathered into the
 //       BlockHessian + assemble() of the scalar CSR with the Dirichlet rows (what each Newton
 //       iteration does before the linear solve)
+//   BM_kernel_73k/hessian_jacobi_svd/<policy>  the same with the Mooney–Rivlin part's SVD on Eigen's
+//       Jacobi sweeps (signed_svd) instead of the checked closed form (signed_svd_from_eigen)
 //   BM_linear_73k/<solver>[/<policy>]        one linear solve of the first Newton system of the
 //       frame (projected Hessian at frame A's solution with frame B's boundary applied, rhs = −g):
 //       cholesky = numeric LDLᵀ + solve (symbolic analysis done once before), cholesky_symbolic =
@@ -304,6 +308,17 @@ struct NineByNine {
 };
 static_assert(!physics::detail::HasElementStiffness<NineByNine<TeranMuscle<>>> && physics::detail::HasElementStiffness<TeranMuscle<>>);
 
+/// The baseline of signed_svd_from_eigen (issue #17 item 1): TeranMuscle's element stiffness with
+/// its Mooney–Rivlin part on Eigen's Jacobi SVD (signed_svd), as before.
+struct JacobiSvdMuscle : TeranMuscle<> {
+  Mat12<> element_stiffness(const Mat3<>& F, const Element& e, Definiteness d, const ShapeGradients<>& D, double vol) const {
+    const SignedSvd<> svd = signed_svd(F);
+    Mat12<> K = isotropic_element_stiffness(svd, principal_from_invariants(svd.sigma, isotropic().partials(invariants(svd.sigma))), d, D, vol);
+    add_fibre_element_stiffness(F, e, d, D, vol, K);
+    return K;
+  }
+};
+
 /// The multigrid levels' sizes as counters (vertices of level 1 and of the coarsest level).
 template <class Linear>
 void multigrid_counters(benchmark::State& state, Linear& linear) {
@@ -402,6 +417,8 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, Newton
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::adaptive, Storage::block, true)->Name("BM_frame_73k/pcg_multigrid_inexact_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, false)->Name("BM_frame_73k/pcg_multigrid_inexact_unguarded_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+// the same with the element Hessians' SVD on Eigen's Jacobi sweeps (the baseline of signed_svd_from_eigen)
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, JacobiSvdMuscle, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_jacobi_svd_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)
 BENCHMARK_TEMPLATE(BM_frame, CholmodCholesky<>, exec::omp_t)->Name("BM_frame_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #endif
@@ -472,6 +489,8 @@ void BM_hessian(benchmark::State& state) {
 }
 BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t)->Name("BM_kernel_73k/hessian/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t)->Name("BM_kernel_73k/hessian/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t, JacobiSvdMuscle)->Name("BM_kernel_73k/hessian_jacobi_svd/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t, JacobiSvdMuscle)->Name("BM_kernel_73k/hessian_jacobi_svd/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t, NineByNine<TeranMuscle<>>)->Name("BM_kernel_73k/hessian_9x9/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t, NineByNine<TeranMuscle<>>)->Name("BM_kernel_73k/hessian_9x9/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 

@@ -277,7 +277,7 @@ class InvariantMaterial {
 
   /// vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) straight from the eigen-modes (isotropic_element_stiffness).
   Mat12<S> element_stiffness(const Mat3<S>& F, const Element&, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
-    const SignedSvd<S> svd = signed_svd(F);
+    const SignedSvd<S> svd = signed_svd_from_eigen(F);  // checked, Jacobi where it cannot resolve F
     return isotropic_element_stiffness(svd, principal_from_invariants(svd.sigma, self().partials(invariants(svd.sigma))),
                                        definiteness, D, vol);
   }

@@ -99,14 +99,21 @@ class TeranMuscle {
   /// for block (a,b) with g = D a (both terms of stress_derivative's fibre part pushed through D⊗I).
   Mat12<S> element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
     Mat12<S> K = iso_.element_stiffness(F, {}, definiteness, D, vol);
+    add_fibre_element_stiffness(F, e, definiteness, D, vol, K);
+    return K;
+  }
+
+  /// K += the fibre term's part of element_stiffness (the Mooney–Rivlin part is the isotropic
+  /// material's own: a caller may compute it another way, as bench_physics's SVD baseline does).
+  void add_fibre_element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol,
+                                   Mat12<S>& K) const {
     const FibreStiffness f = fibre_stiffness(F, e, definiteness);
-    if (!f.active) return K;
+    if (!f.active) return;
     const Eigen::Matrix<S, 4, 1> g = D * e.fibre;
     const Mat3<S> nn = f.n * f.n.transpose();  // formed before scaling: exactly symmetric
     const Mat3<S> N = vol * (f.d1 * Mat3<S>::Identity() + (f.d2 - f.d1) * nn);
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b) K.template block<3, 3>(3 * a, 3 * b) += (g(a) * g(b)) * N;
-    return K;
   }
 
   /// ψ_f'(λ) = σ_max (f_p(λ) + α f_a(λ)), the fibre's first Piola stress magnitude [Pa].
