@@ -312,8 +312,7 @@ static_assert(!physics::detail::HasElementStiffness<NineByNine<TeranMuscle<>>> &
 /// its Mooney–Rivlin part on Eigen's Jacobi SVD (signed_svd), as before.
 struct JacobiSvdMuscle : TeranMuscle<> {
   Mat12<> element_stiffness(const Mat3<>& F, const Element& e, Definiteness d, const ShapeGradients<>& D, double vol) const {
-    const SignedSvd<> svd = signed_svd(F);
-    Mat12<> K = isotropic_element_stiffness(svd, principal_from_invariants(svd.sigma, isotropic().partials(invariants(svd.sigma))), d, D, vol);
+    Mat12<> K = isotropic().element_stiffness(signed_svd(F), {}, d, D, vol);
     add_fibre_element_stiffness(F, e, d, D, vol, K);
     return K;
   }

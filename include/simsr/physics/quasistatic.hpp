@@ -260,7 +260,17 @@ class QuasistaticSolver {
       x.swap(trial_);
       accepted = trial_energy;
       report.linear_iterations += info.iterations;
-      NewtonIteration record{it, E, gnorm, alpha, backtracks, info.iterations, info.relative_residual, forcing.linear_tolerance(), tolerance, projected, shift};
+      const NewtonIteration record{.iteration = it,
+                                   .energy = E,
+                                   .gradient_norm = gnorm,
+                                   .step_length = alpha,
+                                   .backtracks = backtracks,
+                                   .linear_iterations = info.iterations,
+                                   .linear_residual = info.relative_residual,
+                                   .linear_tolerance = forcing.linear_tolerance(),
+                                   .tolerance = tolerance,
+                                   .projected = projected,
+                                   .shift = shift};
       report.history.push_back(record);
       if (options_.progress) options_.progress(record);
     }

@@ -60,7 +60,7 @@ class GradientTest {
   bool converged(Index it, double gradient_norm, double balance) {
     if (it == 0) reference_ = std::max(reference_, gradient_norm);
     reference_ = std::max(reference_, balance);
-    return gradient_norm <= std::max(absolute_, relative_ * reference_);
+    return gradient_norm <= threshold();
   }
 
  private:

@@ -271,15 +271,22 @@ class InvariantMaterial {
 
   Mat9<S> stress_derivative(const Mat3<S>& F, const Element&, Definiteness definiteness) const {
     const SignedSvd<S> svd = signed_svd(F);
-    return isotropic_stress_derivative(svd, principal_from_invariants(svd.sigma, self().partials(invariants(svd.sigma))),
-                                       definiteness);
+    return isotropic_stress_derivative(svd, principal_derivatives(svd.sigma), definiteness);
   }
 
-  /// vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) straight from the eigen-modes (isotropic_element_stiffness).
-  Mat12<S> element_stiffness(const Mat3<S>& F, const Element&, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
-    const SignedSvd<S> svd = signed_svd_from_eigen(F);  // checked, Jacobi where it cannot resolve F
-    return isotropic_element_stiffness(svd, principal_from_invariants(svd.sigma, self().partials(invariants(svd.sigma))),
-                                       definiteness, D, vol);
+  /// vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) straight from the eigen-modes (isotropic_element_stiffness), on the
+  /// checked closed-form SVD (signed_svd_from_eigen: the Jacobi SVD where it cannot resolve F).
+  Mat12<S> element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
+    return element_stiffness(signed_svd_from_eigen(F), e, definiteness, D, vol);
+  }
+  /// The same from a signed SVD of F the caller made (bench_physics's Jacobi-SVD baseline).
+  Mat12<S> element_stiffness(const SignedSvd<S>& svd, const Element&, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
+    return isotropic_element_stiffness(svd, principal_derivatives(svd.sigma), definiteness, D, vol);
+  }
+
+  /// Ψ's derivatives in the signed singular values σ (principal_from_invariants of its partials).
+  PrincipalDerivatives<S> principal_derivatives(const Vec3<S>& sigma) const {
+    return principal_from_invariants(sigma, self().partials(invariants(sigma)));
   }
 
  private:
