@@ -43,7 +43,8 @@
 //       forcing, each Newton system solved to η_k instead of kCgTolerance) with Kelley's safeguard
 //       η_k ≥ ½ τ/‖g_k‖ (forcing_safeguard, default); `_unguarded` without it (the baseline);
 //       `_jacobi_svd` with the element Hessians on Eigen's Jacobi SVD (JacobiSvdMuscle, the
-//       baseline of signed_svd_from_eigen)
+//       baseline of signed_svd_from_eigen); `_coloured` with HessianAssembly::coloured (the default
+//       gather its baseline)
 //   BM_frame_73k/<linear>_extrapolated/omp   the same frame from the face simulator's warm start:
 //       2 x_A − x_before, with x_before the frame before A (jaw 0.08 rad, activation 0.05, targets
 //       −0.5 mm: the same step back), solved once at setup from x_A
@@ -52,6 +53,10 @@
 //       one first; same cost: both go through the signed SVD) gathered into the
 //       BlockHessian + assemble() of the scalar CSR with the Dirichlet rows (what each Newton
 //       iteration does before the linear solve)
+//   BM_kernel_73k/hessian_coloured/<policy>   the same assembled by HessianAssembly::coloured
+//       (chunks of 256 consecutive tets, coloured; each tet's blocks added straight into H, no
+//       per-tet buffer) against the default gather (a per-tet buffer, then summed block by
+//       block); `hessian_coloured_per_tet` the coloured one with one tet a chunk
 //   BM_kernel_73k/hessian_jacobi_svd/<policy>  the same with the Mooney–Rivlin part's SVD on Eigen's
 //       Jacobi sweeps (signed_svd) instead of the checked closed form (signed_svd_from_eigen)
 //   BM_linear_73k/<solver>[/<policy>]        one linear solve of the first Newton system of the
@@ -336,10 +341,11 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 /// as the face simulator's warm start), not from x_A.
 template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
           NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block, bool Extrapolate = false,
-          bool ForcingSafeguard = true>
+          bool ForcingSafeguard = true, HessianAssembly Assembly = HessianAssembly::gather>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
+  elastic.set_hessian_assembly(Assembly);
   EmbeddedSprings<> springs = *s.springs;
   NewtonOptions options;
   options.forcing = Forcing;
@@ -417,6 +423,7 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, Newton
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, false)->Name("BM_frame_73k/pcg_multigrid_inexact_unguarded_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 // the same with the element Hessians' SVD on Eigen's Jacobi sweeps (the baseline of signed_svd_from_eigen)
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, JacobiSvdMuscle, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_jacobi_svd_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)
 BENCHMARK_TEMPLATE(BM_frame, CholmodCholesky<>, exec::omp_t)->Name("BM_frame_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
@@ -464,10 +471,12 @@ void BM_energy_gradient(benchmark::State& state) {
 BENCHMARK_TEMPLATE(BM_energy_gradient, exec::seq_t)->Name("BM_kernel_73k/energy+gradient/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_energy_gradient, exec::omp_t)->Name("BM_kernel_73k/energy+gradient/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 
-template <class Policy, class Material = TeranMuscle<>>
+template <class Policy, class Material = TeranMuscle<>, HessianAssembly Assembly = HessianAssembly::gather,
+          int TetsPerChunk = ElasticEnergy<Material>::kDefaultTetsPerChunk>
 void BM_hessian(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_b);
+  elastic.set_hessian_assembly(Assembly, TetsPerChunk);
   std::vector<char> fixed;
   const Points<> x = frame_start(fixed);
   BlockHessian<> H(s.mesh.num_vertices(), s.mesh.T);
@@ -484,10 +493,15 @@ void BM_hessian(benchmark::State& state) {
   }
   scene_counters(state);
   state.counters["blocks"] = double(H.num_blocks());
+  state.counters["tets/chunk"] = double(Assembly == HessianAssembly::coloured ? TetsPerChunk : 0);
   state.counters["tets/s"] = benchmark::Counter(double(s.mesh.num_tets()), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t)->Name("BM_kernel_73k/hessian/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t)->Name("BM_kernel_73k/hessian/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t, TeranMuscle<>, HessianAssembly::coloured)->Name("BM_kernel_73k/hessian_coloured/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t, TeranMuscle<>, HessianAssembly::coloured)->Name("BM_kernel_73k/hessian_coloured/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t, TeranMuscle<>, HessianAssembly::coloured, 1)->Name("BM_kernel_73k/hessian_coloured_per_tet/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t, TeranMuscle<>, HessianAssembly::coloured, 1)->Name("BM_kernel_73k/hessian_coloured_per_tet/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t, JacobiSvdMuscle)->Name("BM_kernel_73k/hessian_jacobi_svd/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_hessian, exec::omp_t, JacobiSvdMuscle)->Name("BM_kernel_73k/hessian_jacobi_svd/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_hessian, exec::seq_t, NineByNine<TeranMuscle<>>)->Name("BM_kernel_73k/hessian_9x9/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);

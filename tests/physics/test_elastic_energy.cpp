@@ -5,6 +5,8 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Dense>
+#include <array>
+#include <numeric>
 #include <random>
 
 #include "stvk_material.hpp"
@@ -99,31 +101,137 @@ TEST_CASE("ElasticEnergy: gradient is the finite difference of the energy, Hessi
   }
 }
 
-TEST_CASE("ElasticEnergy: the gathered Hessian is the sum of the element Hessians; seq and omp agree bitwise") {
+TEST_CASE("ElasticEnergy: the assembled Hessian is the sum of the element Hessians; seq and omp agree bitwise") {
   const auto mesh = box_tet_mesh<double>(3, 2, 2);
   const Points<> x = perturbed(mesh.V, 0.1, 7);
   ElasticEnergy<simsr_test::StVK> E(mesh, {});
-  const Eigen::MatrixXd A = element_sum(E, x, Definiteness::project);
-  BlockHessian<> fast(mesh.num_vertices(), mesh.T), fast_omp(mesh.num_vertices(), mesh.T);
-  fast.set_zero();
-  E.add_hessian(exec::seq, x, fast, Definiteness::project);
-  fast_omp.set_zero();
-  E.add_hessian(exec::omp, x, fast_omp, Definiteness::project);
-  const Eigen::MatrixXd B = dense(exec::seq, fast);
-  const Eigen::MatrixXd C = dense(exec::omp, fast_omp);
-  CHECK((A - B).cwiseAbs().maxCoeff() < 1e-12 * A.cwiseAbs().maxCoeff());
-  CHECK((B - C).cwiseAbs().maxCoeff() == 0.0);
-  // added onto what is there, in the pattern of the tets only
-  E.add_hessian(exec::seq, x, fast, Definiteness::project);
-  CHECK((dense(exec::seq, fast) - 2 * B).cwiseAbs().maxCoeff() < 1e-12 * A.cwiseAbs().maxCoeff());
-  BlockHessian<> diagonal_only(mesh.num_vertices());
-  CHECK_THROWS_AS(E.add_hessian(exec::seq, x, diagonal_only, Definiteness::project), MeshError);
+  CHECK(E.hessian_assembly() == HessianAssembly::gather);
+  CHECK(E.tets_per_chunk() == ElasticEnergy<simsr_test::StVK>::kDefaultTetsPerChunk);
+  CHECK_THROWS_AS(E.set_hessian_assembly(HessianAssembly::coloured, 0), ArgumentError);
+  for (const auto& [assembly, chunk] : {std::pair{HessianAssembly::coloured, Index(1)}, std::pair{HessianAssembly::coloured, Index(5)},
+                                       std::pair{HessianAssembly::coloured, Index(256)}, std::pair{HessianAssembly::gather, Index(1)}}) {
+    CAPTURE(int(assembly));
+    CAPTURE(chunk);
+    E.set_hessian_assembly(assembly, chunk);
+    const Eigen::MatrixXd A = element_sum(E, x, Definiteness::project);
+    BlockHessian<> fast(mesh.num_vertices(), mesh.T), fast_omp(mesh.num_vertices(), mesh.T);
+    fast.set_zero();
+    E.add_hessian(exec::seq, x, fast, Definiteness::project);
+    fast_omp.set_zero();
+    E.add_hessian(exec::omp, x, fast_omp, Definiteness::project);
+    const Eigen::MatrixXd B = dense(exec::seq, fast);
+    const Eigen::MatrixXd C = dense(exec::omp, fast_omp);
+    CHECK((A - B).cwiseAbs().maxCoeff() < 1e-12 * A.cwiseAbs().maxCoeff());
+    CHECK((B - C).cwiseAbs().maxCoeff() == 0.0);
+    // added onto what is there, in the pattern of the tets only
+    E.add_hessian(exec::seq, x, fast, Definiteness::project);
+    CHECK((dense(exec::seq, fast) - 2 * B).cwiseAbs().maxCoeff() < 1e-12 * A.cwiseAbs().maxCoeff());
+    BlockHessian<> diagonal_only(mesh.num_vertices());
+    CHECK_THROWS_AS(E.add_hessian(exec::seq, x, diagonal_only, Definiteness::project), MeshError);
+  }
   Points<> g1 = Points<>::Zero(mesh.num_vertices(), 3), g2 = g1;
   E.add_gradient(exec::seq, x, g1);
   E.add_gradient(exec::omp, x, g2);
   CHECK((g1 - g2).cwiseAbs().maxCoeff() == 0.0);
   CHECK(E.energy(exec::seq, x) == E.energy(exec::omp, x));
   CHECK(E.count_inverted(exec::seq, x) == E.count_inverted(exec::omp, x));
+}
+
+TEST_CASE("ElasticEnergy: coloured and gathered assembly agree to rounding on random meshes and states; each is seq == omp bitwise") {
+  std::mt19937 rng(41);
+  for (int trial = 0; trial < 16; ++trial) {
+    const Index nx = 1 + Index(rng() % 4), ny = 1 + Index(rng() % 3), nz = 1 + Index(rng() % 3);
+    auto mesh = box_tet_mesh<double>(nx, ny, nz);
+    // shuffle the tets: the colouring follows element order, so a mesh in any order is covered
+    std::vector<Index> order(std::size_t(mesh.num_tets()));
+    std::iota(order.begin(), order.end(), Index(0));
+    std::shuffle(order.begin(), order.end(), rng);
+    const Tets T0 = mesh.T;
+    for (Index t = 0; t < T0.rows(); ++t) mesh.T.row(t) = T0.row(order[std::size_t(t)]);
+    const Points<> x = perturbed(mesh.V, 0.05 + 0.05 * double(trial % 4), unsigned(100 + trial));
+    const Definiteness d = trial % 2 ? Definiteness::exact : Definiteness::project;
+    ElasticEnergy<simsr_test::StVK> E(mesh, {});
+    const Eigen::MatrixXd A = element_sum(E, x, d);
+    const double scale = A.cwiseAbs().maxCoeff();
+    // coloured with 1 to 9 tets a chunk (more chunks than colours, and fewer) against gathered
+    const Index chunk = 1 + Index(rng() % 9);
+    CAPTURE(chunk);
+    std::array<Eigen::MatrixXd, 2> seq, omp;
+    for (int m = 0; m < 2; ++m) {
+      E.set_hessian_assembly(m == 0 ? HessianAssembly::coloured : HessianAssembly::gather, chunk);
+      BlockHessian<> Hs(mesh.num_vertices(), mesh.T), Ho(mesh.num_vertices(), mesh.T);
+      // start from a random H: assembly adds onto what is there
+      for (Index b = 0; b < Hs.num_blocks(); ++b) Hs.block(b) = Mat3<>::Random();
+      for (Index b = 0; b < Hs.num_blocks(); ++b) Ho.block(b) = Hs.block(b);
+      const Eigen::MatrixXd start = dense(exec::seq, Hs);
+      E.add_hessian(exec::seq, x, Hs, d);
+      E.add_hessian(exec::omp, x, Ho, d);
+      seq[std::size_t(m)] = dense(exec::seq, Hs) - start;
+      omp[std::size_t(m)] = dense(exec::seq, Ho) - start;
+      CHECK((dense(exec::seq, Hs) - dense(exec::seq, Ho)).cwiseAbs().maxCoeff() == 0.0);
+      CHECK((seq[std::size_t(m)] - A).cwiseAbs().maxCoeff() < 1e-12 * (scale + 1));
+      // from zero, block (j, i) is exactly block (i, j)ᵀ for i ≠ j
+      BlockHessian<> Hz(mesh.num_vertices(), mesh.T);
+      Hz.set_zero();
+      E.add_hessian(exec::omp, x, Hz, d);
+      Eigen::MatrixXd Z = dense(exec::seq, Hz);
+      Z -= Eigen::MatrixXd(Z.transpose());
+      for (Index v = 0; v < mesh.num_vertices(); ++v) Z.block<3, 3>(3 * v, 3 * v).setZero();
+      CHECK(Z.cwiseAbs().maxCoeff() == 0.0);
+    }
+    CHECK((seq[0] - seq[1]).cwiseAbs().maxCoeff() < 1e-12 * (scale + 1));
+  }
+}
+
+TEST_CASE("ElasticEnergy: coloured assembly follows a grown pattern and names a tet whose block is missing") {
+  const auto mesh = box_tet_mesh<double>(2, 2, 1);
+  const Points<> x = perturbed(mesh.V, 0.1, 8);
+  ElasticEnergy<simsr_test::StVK> E(mesh, {});
+  E.set_hessian_assembly(HessianAssembly::coloured, 2);
+  BlockHessian<> H(mesh.num_vertices(), mesh.T);
+  H.set_zero();
+  E.add_hessian(exec::omp, x, H, Definiteness::project);
+  const Eigen::MatrixXd once = dense(exec::seq, H);
+  // a block outside the tets' pattern (vertices 0 and the last), merged by assemble(), moves
+  // every slot after it and changes the pattern version
+  const std::uint64_t version = H.pattern_version();
+  H.add(0, VIndex(mesh.num_vertices() - 1), Mat3<>::Identity());
+  H.add(VIndex(mesh.num_vertices() - 1), 0, Mat3<>::Identity());
+  dense(exec::seq, H);
+  REQUIRE(H.pattern_version() != version);
+  E.add_hessian(exec::omp, x, H, Definiteness::project);
+  Eigen::MatrixXd expected = 2 * once;
+  expected.block<3, 3>(0, 3 * (mesh.num_vertices() - 1)) += Eigen::Matrix3d::Identity();
+  expected.block<3, 3>(3 * (mesh.num_vertices() - 1), 0) += Eigen::Matrix3d::Identity();
+  CHECK((dense(exec::seq, H) - expected).cwiseAbs().maxCoeff() < 1e-12 * once.cwiseAbs().maxCoeff());
+  // a pattern from fewer tets: the first tet (in tet order) not in it is named
+  const Tets some = mesh.T.topRows(3);
+  BlockHessian<> partial(mesh.num_vertices(), some);
+  for (const HessianAssembly a : {HessianAssembly::coloured, HessianAssembly::gather}) {
+    E.set_hessian_assembly(a, 2);
+    Index first_missing = -1;
+    for (Index t = 3; t < mesh.num_tets() && first_missing < 0; ++t)
+      for (int i = 0; i < 4 && first_missing < 0; ++i)
+        for (int j = 0; j < 4; ++j)
+          if (partial.slot(mesh.T(t, i), mesh.T(t, j)) < 0) {
+            first_missing = t;
+            break;
+          }
+    REQUIRE(first_missing >= 0);
+    const std::string named = "tet " + std::to_string(first_missing) + ":";
+    CHECK_THROWS_WITH_AS(E.add_hessian(exec::omp, x, partial, Definiteness::project), doctest::Contains(named.c_str()), MeshError);
+    // the refused pattern left nothing behind: the full one still assembles to the element sum
+    BlockHessian<> full(mesh.num_vertices(), mesh.T);
+    full.set_zero();
+    E.add_hessian(exec::omp, x, full, Definiteness::project);
+    CHECK((dense(exec::seq, full) - once).cwiseAbs().maxCoeff() < 1e-12 * once.cwiseAbs().maxCoeff());
+    full.set_zero();
+    E.add_hessian(exec::omp, x, full, Definiteness::project);  // same pattern, lists reused
+    CHECK_THROWS_AS(E.add_hessian(exec::omp, x, partial, Definiteness::project), MeshError);
+    full.set_zero();
+    E.add_hessian(exec::omp, x, full, Definiteness::project);  // after a refusal, with reused lists
+    CHECK((dense(exec::seq, full) - once).cwiseAbs().maxCoeff() < 1e-12 * once.cwiseAbs().maxCoeff());
+  }
 }
 
 TEST_CASE("BlockHessian: blocks outside the pattern grow it, keep every value and change the version") {

@@ -6,6 +6,7 @@
 #include "closest_point.hpp"
 #include "contact_patches.hpp"
 #include "cotangent_laplacian.hpp"
+#include "element_colouring.hpp"
 #include "harmonic_field.hpp"
 #include "normals.hpp"
 #include "poly_mesh.hpp"

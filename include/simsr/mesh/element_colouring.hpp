@@ -1,0 +1,116 @@
+#pragma once
+/// \file
+/// A colouring of a mesh's elements (tets, triangles, any cells given as rows of vertex indices)
+/// in which no two elements of one colour share a vertex: each colour's elements can then write
+/// their vertices' data (a Hessian's blocks, nodal sums) side by side on many threads without
+/// atomics, and in an order that does not depend on the thread count.
+///
+///     const ElementColouring c = greedy_element_colouring(mesh.T, mesh.num_vertices());
+///     for (Index k = 0; k < c.num_colours(); ++k)
+///       exec::parallel_for(exec::omp, c.size(k), [&](Index i) { scatter(c.element(k, i)); });
+///
+/// First-fit greedy in element order (Jones & Plassmann 1993 discuss the parallel variants): each
+/// element takes the smallest colour none of its earlier vertex-sharing neighbours has: at most
+/// 1 + the largest number of neighbours of one element colours. Cells of any size (CSR) colour
+/// groups of elements alike: physics::ElasticEnergy colours chunks of consecutive tets.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "../core/error.hpp"
+#include "../core/types.hpp"
+
+namespace simsr {
+
+/// The elements of each colour, colour by colour, each colour's in increasing element order.
+struct ElementColouring {
+  std::vector<Index> offsets{0};  ///< colour k's elements are elements[offsets[k], offsets[k+1])
+  std::vector<Index> elements;    ///< every element exactly once
+  std::vector<Index> colour_of;   ///< element → its colour
+
+  Index num_colours() const { return Index(offsets.size()) - 1; }
+  Index num_elements() const { return Index(elements.size()); }
+  /// Number of elements of colour k.
+  Index size(Index k) const { return offsets[std::size_t(k) + 1] - offsets[std::size_t(k)]; }
+  /// The i-th element of colour k.
+  Index element(Index k, Index i) const { return elements[std::size_t(offsets[std::size_t(k)] + i)]; }
+};
+
+/// First-fit greedy colouring of cells of any sizes given as CSR: cell c's vertices are
+/// vertices[offsets[c], offsets[c+1]), in [0, num_vertices) and distinct. No two cells of one
+/// colour share a vertex. Sequential, O(Σ_c Σ_{v∈c} valence(v)). Throws MeshError naming the
+/// first cell with an index out of range or a vertex repeated within it (such a cell would
+/// conflict with itself), ArgumentError for offsets that do not start at 0, decrease or do not
+/// end at vertices.size().
+inline ElementColouring greedy_colouring(const std::vector<Index>& offsets, const std::vector<Index>& vertices, Index num_vertices) {
+  if (num_vertices < 0) throw ArgumentError("greedy_colouring: negative vertex count " + std::to_string(num_vertices));
+  if (offsets.empty() || offsets.front() != 0 || offsets.back() != Index(vertices.size()))
+    throw ArgumentError("greedy_colouring: offsets must run from 0 to the " + std::to_string(vertices.size()) + " vertices listed");
+  const Index nc = Index(offsets.size()) - 1;
+  for (Index c = 0; c < nc; ++c)
+    if (offsets[std::size_t(c) + 1] < offsets[std::size_t(c)]) throw ArgumentError("greedy_colouring: offsets decrease at cell " + std::to_string(c));
+  std::vector<Index> mark(std::size_t(num_vertices), 0);
+  for (Index c = 0; c < nc; ++c) {
+    for (Index i = offsets[std::size_t(c)]; i < offsets[std::size_t(c) + 1]; ++i) {
+      const Index v = vertices[std::size_t(i)];
+      if (v < 0 || v >= num_vertices)
+        throw MeshError("cell", c, "vertex index " + std::to_string(v) + " out of range [0, " + std::to_string(num_vertices) + ")");
+      if (mark[std::size_t(v)] == c + 1) throw MeshError("cell", c, "vertex " + std::to_string(v) + " appears twice");
+      mark[std::size_t(v)] = c + 1;
+    }
+  }
+  // vertex → cells
+  std::vector<Index> first(std::size_t(num_vertices) + 1, 0);
+  for (Index v : vertices) ++first[std::size_t(v) + 1];
+  for (Index v = 0; v < num_vertices; ++v) first[std::size_t(v) + 1] += first[std::size_t(v)];
+  std::vector<Index> incident(vertices.size());
+  {
+    std::vector<Index> fill(first.begin(), first.end() - 1);
+    for (Index c = 0; c < nc; ++c)
+      for (Index i = offsets[std::size_t(c)]; i < offsets[std::size_t(c) + 1]; ++i) incident[std::size_t(fill[std::size_t(vertices[std::size_t(i)])]++)] = c;
+  }
+  ElementColouring out;
+  out.colour_of.assign(std::size_t(nc), -1);
+  // forbidden[colour] == c + 1: a neighbour of cell c has that colour (stamps: no clearing per cell)
+  std::vector<Index> forbidden;
+  std::vector<Index> count;
+  for (Index c = 0; c < nc; ++c) {
+    for (Index i = offsets[std::size_t(c)]; i < offsets[std::size_t(c) + 1]; ++i) {
+      const std::size_t v = std::size_t(vertices[std::size_t(i)]);
+      for (Index j = first[v]; j < first[v + 1]; ++j) {
+        const Index col = out.colour_of[std::size_t(incident[std::size_t(j)])];
+        if (col >= 0) forbidden[std::size_t(col)] = c + 1;
+      }
+    }
+    Index col = 0;
+    while (col < Index(forbidden.size()) && forbidden[std::size_t(col)] == c + 1) ++col;
+    if (col == Index(forbidden.size())) {
+      forbidden.push_back(0);
+      count.push_back(0);
+    }
+    out.colour_of[std::size_t(c)] = col;
+    ++count[std::size_t(col)];
+  }
+  out.offsets.assign(count.size() + 1, 0);
+  for (std::size_t col = 0; col < count.size(); ++col) out.offsets[col + 1] = out.offsets[col] + count[col];
+  out.elements.resize(std::size_t(nc));
+  std::vector<Index> fill(out.offsets.begin(), out.offsets.end() - 1);
+  for (Index c = 0; c < nc; ++c) out.elements[std::size_t(fill[std::size_t(out.colour_of[std::size_t(c)])]++)] = c;
+  return out;
+}
+
+/// First-fit greedy colouring of the rows of `cells` (#C×k vertex indices) over `num_vertices`
+/// vertices (greedy_colouring with k vertices per cell; the same errors).
+template <class DC>
+ElementColouring greedy_element_colouring(const Eigen::MatrixBase<DC>& cells, Index num_vertices) {
+  const Index nc = cells.rows(), k = cells.cols();
+  std::vector<Index> offsets(std::size_t(nc) + 1), vertices(std::size_t(nc * k));
+  for (Index c = 0; c <= nc; ++c) offsets[std::size_t(c)] = c * k;
+  for (Index c = 0; c < nc; ++c)
+    for (Index a = 0; a < k; ++a) vertices[std::size_t(c * k + a)] = Index(cells(c, a));
+  return greedy_colouring(offsets, vertices, num_vertices);
+}
+
+}  // namespace simsr
