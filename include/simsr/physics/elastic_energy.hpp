@@ -75,8 +75,8 @@ enum class HessianAssembly {
   /// The tets cut into chunks of consecutive tets, the chunks coloured once (greedy_colouring: no
   /// two chunks of a colour share a vertex); colour by colour, chunks on any thread, each chunk's
   /// tets' stiffnesses computed and added straight into their 16 blocks in turn. No per-tet
-  /// buffer (on the 73k-tet lattice 53 MB written and read again every assembly): 1.2× the
-  /// gather there (README, "Physics at the paper's LR size").
+  /// buffer (on the 73k-tet lattice 53 MB written and read again every assembly): 1.2× (one
+  /// thread) to 1.4× (two) the gather's speed there (README, "Physics at the paper's LR size").
   coloured,
 };
 
@@ -133,7 +133,7 @@ class ElasticEnergy {
   }
   /// Tets per chunk of the coloured assembly: one thread adds a chunk's consecutive tets in turn,
   /// so its blocks are touched with the mesh order's locality (coloured tet by tet, each colour's
-  /// tets lie spread over the whole mesh: 1.8× the gather's time on the 73k-tet lattice).
+  /// tets lie spread over the whole mesh: 1.6–1.8× the gather's time on the 73k-tet lattice).
   static constexpr Index kDefaultTetsPerChunk = 256;
   /// Replaces the per-tet data (e.g. this frame's activations); checked like the constructor's.
   void set_elements(std::vector<Element> elements) {
