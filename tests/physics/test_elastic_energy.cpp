@@ -108,8 +108,11 @@ TEST_CASE("ElasticEnergy: the assembled Hessian is the sum of the element Hessia
   CHECK(E.hessian_assembly() == HessianAssembly::gather);
   CHECK(E.tets_per_chunk() == ElasticEnergy<simsr_test::StVK>::kDefaultTetsPerChunk);
   CHECK_THROWS_AS(E.set_hessian_assembly(HessianAssembly::coloured, 0), ArgumentError);
-  for (const auto& [assembly, chunk] : {std::pair{HessianAssembly::coloured, Index(1)}, std::pair{HessianAssembly::coloured, Index(5)},
-                                       std::pair{HessianAssembly::coloured, Index(256)}, std::pair{HessianAssembly::gather, Index(1)}}) {
+  for (const auto& setting : {std::pair{HessianAssembly::coloured, Index(1)}, std::pair{HessianAssembly::coloured, Index(5)},
+                              std::pair{HessianAssembly::coloured, Index(256)}, std::pair{HessianAssembly::gather, Index(1)}}) {
+    // (no structured binding: clang 14 cannot capture one in CAPTURE's lambda)
+    const HessianAssembly assembly = setting.first;
+    const Index chunk = setting.second;
     CAPTURE(int(assembly));
     CAPTURE(chunk);
     E.set_hessian_assembly(assembly, chunk);
