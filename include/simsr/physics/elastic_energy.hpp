@@ -221,8 +221,9 @@ class ElasticEnergy {
   /// H += Σ_t element_hessian(x, t, d) (EnergyTerm), assembled as hessian_assembly() says; block
   /// (b, a) of a tet, b > a, is its block (a, b) transposed, so an H assembled from zero has
   /// H(j, i) = H(i, j)ᵀ exactly for i ≠ j. No allocation once the slot lists exist (built on the
-  /// first call, again when H's pattern version changes). H's pattern must contain the tets' blocks, as BlockHessian(num_vertices, T) does
-  /// (MeshError naming the first tet whose block is missing).
+  /// first call, again when H's pattern version changes). H's pattern must contain the tets'
+  /// blocks, as BlockHessian(num_vertices, T) does (MeshError naming the first tet whose block is
+  /// missing).
   template <exec::HostPolicy P>
   void add_hessian(P policy, const Points<S>& x, BlockHessian<S>& H, Definiteness d) const {
     physics::detail::require_positions("ElasticEnergy::add_hessian: x", x, n_);
@@ -334,25 +335,23 @@ class ElasticEnergy {
     });
   }
 
-  /// slots[16 i + 4 a + b] = H's slot of block (a, b) of tet tets(i), i < count (MeshError naming
-  /// the lowest-numbered tet with a block H's pattern lacks, whatever the order).
-  template <exec::HostPolicy P, class TetOf>
-  static void tet_slots(P policy, const Tets& T, Index count, TetOf tets, const BlockHessian<S>& H, std::vector<Index>& slots) {
-    slots.resize(std::size_t(16 * count));
-    std::vector<char> missing(std::size_t(count), 0);
-    exec::parallel_for(policy, count, [&](Index i) {
-      const Index t = tets(i);
+  /// slots[16 t + 4 a + b] = H's slot of block (a, b) of tet t (MeshError naming the first tet
+  /// with a block H's pattern lacks).
+  template <exec::HostPolicy P>
+  void tet_slots(P policy, const BlockHessian<S>& H, std::vector<Index>& slots) const {
+    slots.resize(std::size_t(16 * T_.rows()));
+    std::vector<char> missing(std::size_t(T_.rows()), 0);
+    exec::parallel_for(policy, T_.rows(), [&](Index t) {
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b) {
-          const Index s = H.slot(T(t, a), T(t, b));
-          if (s < 0) missing[std::size_t(i)] = 1;
-          slots[std::size_t(16 * i + 4 * a + b)] = s;
+          const Index s = H.slot(T_(t, a), T_(t, b));
+          if (s < 0) missing[std::size_t(t)] = 1;
+          slots[std::size_t(16 * t + 4 * a + b)] = s;
         }
     });
-    Index first = -1;
-    for (Index i = 0; i < count; ++i)
-      if (missing[std::size_t(i)] && (first < 0 || tets(i) < first)) first = tets(i);
-    if (first >= 0) throw MeshError("tet", first, "its vertex pair is missing from the Hessian pattern (build it from the same tets)");
+    const auto first = std::find(missing.begin(), missing.end(), char(1));
+    if (first != missing.end())
+      throw MeshError("tet", first - missing.begin(), "its vertex pair is missing from the Hessian pattern (build it from the same tets)");
   }
 
   /// The chunks (chunk_ consecutive tets each) coloured once by the vertices they touch;
@@ -373,7 +372,7 @@ class ElasticEnergy {
       }
       colouring_ = greedy_colouring(offsets, vertices, n_);
     }
-    tet_slots(policy, T_, T_.rows(), [](Index t) { return t; }, H, colour_slots_);
+    tet_slots(policy, H, colour_slots_);
     colour_version_ = H.pattern_version();
   }
 
@@ -381,7 +380,7 @@ class ElasticEnergy {
   void build_gather(P policy, const BlockHessian<S>& H) const {
     const Index nb = H.num_blocks();
     std::vector<Index> slots;
-    tet_slots(policy, T_, T_.rows(), [](Index t) { return t; }, H, slots);
+    tet_slots(policy, H, slots);
     gather_offsets_.assign(std::size_t(nb) + 1, 0);
     for (Index s : slots) ++gather_offsets_[std::size_t(s) + 1];
     for (Index s = 0; s < nb; ++s) gather_offsets_[std::size_t(s) + 1] += gather_offsets_[std::size_t(s)];
