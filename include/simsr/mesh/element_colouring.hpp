@@ -21,8 +21,23 @@
 
 #include "../core/error.hpp"
 #include "../core/types.hpp"
+#include "topology.hpp"
 
 namespace simsr {
+
+namespace detail {
+/// Items 0..n−1 bucketed by key(i) ∈ [0, num_keys), each bucket in item order: bucket k is
+/// items[offsets[k], offsets[k+1]) (a counting sort).
+template <class Key>
+void bucket_by_key(Index n, Index num_keys, Key key, std::vector<Index>& offsets, std::vector<Index>& items) {
+  offsets.assign(std::size_t(num_keys) + 1, 0);
+  for (Index i = 0; i < n; ++i) ++offsets[std::size_t(key(i)) + 1];
+  for (Index k = 0; k < num_keys; ++k) offsets[std::size_t(k) + 1] += offsets[std::size_t(k)];
+  items.resize(std::size_t(n));
+  std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
+  for (Index i = 0; i < n; ++i) items[std::size_t(fill[std::size_t(key(i))]++)] = i;
+}
+}  // namespace detail
 
 /// The elements of each colour, colour by colour, each colour's in increasing element order.
 struct ElementColouring {
@@ -61,50 +76,41 @@ inline ElementColouring greedy_colouring(const std::vector<Index>& offsets, cons
       mark[std::size_t(v)] = c + 1;
     }
   }
-  // vertex → cells
-  std::vector<Index> first(std::size_t(num_vertices) + 1, 0);
-  for (Index v : vertices) ++first[std::size_t(v) + 1];
-  for (Index v = 0; v < num_vertices; ++v) first[std::size_t(v) + 1] += first[std::size_t(v)];
-  std::vector<Index> incident(vertices.size());
-  {
-    std::vector<Index> fill(first.begin(), first.end() - 1);
-    for (Index c = 0; c < nc; ++c)
-      for (Index i = offsets[std::size_t(c)]; i < offsets[std::size_t(c) + 1]; ++i) incident[std::size_t(fill[std::size_t(vertices[std::size_t(i)])]++)] = c;
-  }
+  // vertex → (cell, corner) entries; incident[j]'s cell is cell_of_entry[incident[j]]
+  std::vector<Index> cell_of_entry(vertices.size());
+  for (Index c = 0; c < nc; ++c)
+    for (Index i = offsets[std::size_t(c)]; i < offsets[std::size_t(c) + 1]; ++i) cell_of_entry[std::size_t(i)] = c;
+  std::vector<Index> first, incident;
+  detail::bucket_by_key(Index(vertices.size()), num_vertices, [&](Index i) { return vertices[std::size_t(i)]; }, first, incident);
   ElementColouring out;
   out.colour_of.assign(std::size_t(nc), -1);
   // forbidden[colour] == c + 1: a neighbour of cell c has that colour (stamps: no clearing per cell)
   std::vector<Index> forbidden;
-  std::vector<Index> count;
   for (Index c = 0; c < nc; ++c) {
     for (Index i = offsets[std::size_t(c)]; i < offsets[std::size_t(c) + 1]; ++i) {
       const std::size_t v = std::size_t(vertices[std::size_t(i)]);
       for (Index j = first[v]; j < first[v + 1]; ++j) {
-        const Index col = out.colour_of[std::size_t(incident[std::size_t(j)])];
+        const Index col = out.colour_of[std::size_t(cell_of_entry[std::size_t(incident[std::size_t(j)])])];
         if (col >= 0) forbidden[std::size_t(col)] = c + 1;
       }
     }
     Index col = 0;
     while (col < Index(forbidden.size()) && forbidden[std::size_t(col)] == c + 1) ++col;
-    if (col == Index(forbidden.size())) {
-      forbidden.push_back(0);
-      count.push_back(0);
-    }
+    if (col == Index(forbidden.size())) forbidden.push_back(0);
     out.colour_of[std::size_t(c)] = col;
-    ++count[std::size_t(col)];
   }
-  out.offsets.assign(count.size() + 1, 0);
-  for (std::size_t col = 0; col < count.size(); ++col) out.offsets[col + 1] = out.offsets[col] + count[col];
-  out.elements.resize(std::size_t(nc));
-  std::vector<Index> fill(out.offsets.begin(), out.offsets.end() - 1);
-  for (Index c = 0; c < nc; ++c) out.elements[std::size_t(fill[std::size_t(out.colour_of[std::size_t(c)])]++)] = c;
+  detail::bucket_by_key(nc, Index(forbidden.size()), [&](Index c) { return out.colour_of[std::size_t(c)]; }, out.offsets, out.elements);
   return out;
 }
 
 /// First-fit greedy colouring of the rows of `cells` (#C×k vertex indices) over `num_vertices`
-/// vertices (greedy_colouring with k vertices per cell; the same errors).
+/// vertices (greedy_colouring with k vertices per cell). An index outside [0, num_vertices) is a
+/// MeshError naming the element by its kind ("tet 3: …", mesh/topology's check); a repeated
+/// vertex, as greedy_colouring's.
 template <class DC>
 ElementColouring greedy_element_colouring(const Eigen::MatrixBase<DC>& cells, Index num_vertices) {
+  if (num_vertices < 0) throw ArgumentError("greedy_element_colouring: negative vertex count " + std::to_string(num_vertices));
+  detail::check_indices(cells, num_vertices);
   const Index nc = cells.rows(), k = cells.cols();
   std::vector<Index> offsets(std::size_t(nc) + 1), vertices(std::size_t(nc * k));
   for (Index c = 0; c <= nc; ++c) offsets[std::size_t(c)] = c * k;
