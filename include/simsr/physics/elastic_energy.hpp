@@ -31,6 +31,7 @@
 #include "../mesh/element_colouring.hpp"
 #include "../mesh/tet_mesh.hpp"
 #include "energy_term.hpp"
+#include "detail/elastic_element_body.hpp"
 #include "hessian.hpp"
 #include "materials/material.hpp"
 #include "tet_elements.hpp"
@@ -41,13 +42,6 @@ namespace detail {
 /// Materials with element data to validate offer `check(element)` (throws ArgumentError).
 template <class M>
 concept ChecksElements = requires(const M& m, const typename M::Element& e) { m.check(e); };
-/// Materials usable in the local–global solver offer the stiffness of their constant matrix.
-/// Materials that compute ψ and P together more cheaply than apart (one SVD instead of two)
-/// offer `energy_and_stress(F, element) -> std::pair<ψ, P>`.
-template <class M>
-concept HasEnergyAndStress = requires(const M& m, const Mat3<typename M::scalar_type>& F, const typename M::Element& e) {
-  { m.energy_and_stress(F, e) } -> std::convertible_to<std::pair<typename M::scalar_type, Mat3<typename M::scalar_type>>>;
-};
 /// Materials that compute the element stiffness vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) without forming ∂P/∂F
 /// (the isotropic ones from their eigen-modes) offer `element_stiffness(F, element, d, D, vol)`.
 template <class M>
@@ -61,6 +55,7 @@ template <class S>
 using UpperBlocks12 = std::array<Mat3<S>, 10>;
 /// The position of block (a, b), a ≤ b, in UpperBlocks12.
 constexpr int upper_block(int a, int b) { return a * 4 - a * (a - 1) / 2 + (b - a); }
+/// Materials usable in the local–global solver offer the stiffness of their constant matrix.
 template <class M>
 concept HasProjectiveStiffness = requires(const M& m) { { m.projective_stiffness() } -> std::convertible_to<typename M::scalar_type>; };
 }  // namespace detail
@@ -118,6 +113,12 @@ class ElasticEnergy {
   const M& material() const { return material_; }
   M& material() { return material_; }
   const std::vector<Element>& elements() const { return elements_; }
+  /// Every tet's shape gradients D (4×3: F = Σ_a x_a D(a, ·)), in tet order.
+  const std::vector<ShapeGradients<S>, Eigen::aligned_allocator<ShapeGradients<S>>>& element_shape_gradients() const { return D_; }
+  /// The gradient's gather lists: vertex v's (tet, corner) entries 4 t + a are
+  /// force_gather_entries()[force_gather_offsets()[v] .. force_gather_offsets()[v + 1]).
+  const std::vector<Index>& force_gather_offsets() const { return vertex_offsets_; }
+  const std::vector<std::int32_t>& force_gather_entries() const { return vertex_entries_; }
   HessianAssembly hessian_assembly() const { return assembly_; }
   Index tets_per_chunk() const { return chunk_; }
   /// Chooses add_hessian's assembly (HessianAssembly; gather by default) and, for the coloured
@@ -161,10 +162,7 @@ class ElasticEnergy {
   template <exec::HostPolicy P>
   S energy(P policy, const Points<S>& x) const {
     physics::detail::require_positions("ElasticEnergy::energy: x", x, n_);
-    return exec::parallel_reduce(
-        policy, T_.rows(), S(0),
-        [&](Index t) { return rest_.volume[t] * material_.energy(deformation_gradient(x, t), elements_[std::size_t(t)]); },
-        [](S a, S b) { return a + b; });
+    return exec::parallel_reduce(policy, T_.rows(), S(0), element_body<detail::ElementOutput::energy>(x), [](S a, S b) { return a + b; });
   }
 
   /// g += ∂E/∂x (#V×3, N).
@@ -173,9 +171,7 @@ class ElasticEnergy {
     physics::detail::require_positions("ElasticEnergy::add_gradient: x", x, n_);
     physics::detail::require_positions("ElasticEnergy::add_gradient: g", g, n_);
     forces_.resize(3, 4 * T_.rows());
-    exec::parallel_for(policy, T_.rows(), [&](Index t) {
-      element_forces(t, material_.stress(deformation_gradient(x, t), elements_[std::size_t(t)]));
-    });
+    exec::parallel_for(policy, T_.rows(), element_body<detail::ElementOutput::forces>(x));
     gather_forces(policy, g);
   }
 
@@ -186,23 +182,7 @@ class ElasticEnergy {
     physics::detail::require_positions("ElasticEnergy::add_energy_gradient: x", x, n_);
     physics::detail::require_positions("ElasticEnergy::add_energy_gradient: g", g, n_);
     forces_.resize(3, 4 * T_.rows());
-    const S e = exec::parallel_reduce(
-        policy, T_.rows(), S(0),
-        [&](Index t) {
-          const Mat3<S> F = deformation_gradient(x, t);
-          const Element& el = elements_[std::size_t(t)];
-          S psi;
-          if constexpr (detail::HasEnergyAndStress<M>) {
-            const auto [energy, stress] = material_.energy_and_stress(F, el);
-            psi = energy;
-            element_forces(t, stress);
-          } else {
-            psi = material_.energy(F, el);
-            element_forces(t, material_.stress(F, el));
-          }
-          return rest_.volume[t] * psi;
-        },
-        [](S a, S b) { return a + b; });
+    const S e = exec::parallel_reduce(policy, T_.rows(), S(0), element_body<detail::ElementOutput::energy_and_forces>(x), [](S a, S b) { return a + b; });
     gather_forces(policy, g);
     return e;
   }
@@ -320,19 +300,25 @@ class ElasticEnergy {
     }
   }
 
-  /// Tet t's nodal forces V_t P D_tᵀ into forces_.
-  void element_forces(Index t, const Mat3<S>& stress) const {
-    forces_.template middleCols<4>(4 * t).noalias() = rest_.volume[t] * stress * D_[std::size_t(t)].transpose();
+  /// The per-tet body over this object's arrays and x (elastic_element_body.hpp; the same body
+  /// DeviceElasticEnergy runs on the device). Forces go to forces_ (sized by the caller).
+  template <detail::ElementOutput Output>
+  detail::ElasticElementBody<M, Output> element_body(const Points<S>& x) const {
+    static_assert(sizeof(Mat3<S>) == 9 * sizeof(S) && sizeof(ShapeGradients<S>) == 12 * sizeof(S), "packed 3x3 and 4x3 blocks");
+    return {material_,
+            T_.data(),
+            rest_.Dm_inv.empty() ? nullptr : rest_.Dm_inv[0].data(),
+            D_.empty() ? nullptr : D_[0].data(),
+            rest_.volume.data(),
+            elements_.data(),
+            MatrixSpan<const S>{x.data(), x.rows(), 3, 3},
+            forces_.data()};
   }
 
   /// g += every vertex's sum of its tets' forces, in a fixed order (deterministic, no atomics).
   template <exec::HostPolicy P>
   void gather_forces(P policy, Points<S>& g) const {
-    exec::parallel_for(policy, n_, [&](Index v) {
-      Vec3<S> sum = Vec3<S>::Zero();
-      for (Index k = vertex_offsets_[std::size_t(v)]; k < vertex_offsets_[std::size_t(v) + 1]; ++k) sum += forces_.col(vertex_entries_[std::size_t(k)]);
-      g.row(v) += sum.transpose();
-    });
+    exec::parallel_for(policy, n_, detail::GatherVertexForces<S>{vertex_offsets_.data(), vertex_entries_.data(), forces_.data(), MatrixSpan<S>{g.data(), g.rows(), 3, 3}});
   }
 
   /// slots[16 t + 4 a + b] = H's slot of block (a, b) of tet t (MeshError naming the first tet
@@ -395,7 +381,7 @@ class ElasticEnergy {
   M material_;
   TetRestData<S> rest_;
   std::vector<Element> elements_;
-  std::vector<Eigen::Matrix<S, 4, 3>, Eigen::aligned_allocator<Eigen::Matrix<S, 4, 3>>> D_;
+  std::vector<ShapeGradients<S>, Eigen::aligned_allocator<ShapeGradients<S>>> D_;
   std::vector<Index> vertex_offsets_;
   std::vector<std::int32_t> vertex_entries_;
   // scratch (see the file comment)

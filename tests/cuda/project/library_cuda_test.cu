@@ -1,11 +1,15 @@
 // The library's own kernel bodies under exec::cuda (issue #17 item 5): Embedded::apply's
-// (interp::DeviceEmbedded) and BlockCsr's product (physics::DeviceBlockCsr), the same functors
+// (interp::DeviceEmbedded), BlockCsr's product (physics::DeviceBlockCsr) and the elastic energy
+// and gradient (physics::DeviceElasticEnergy, isotropic and fibre materials), the same functors
 // the host tests run under seq and omp. Compiled by nvcc in the cuda-compile test; where a GPU
 // exists it runs and checks the device results against the host's (to rounding: the device may
 // fuse multiply-adds the host does not).
 #include <simsr/interp/device_embedded.hpp>
 #include <simsr/mesh/generators.hpp>
+#include <simsr/physics/device_elastic_energy.hpp>
 #include <simsr/physics/linear_solvers/device_block_csr.hpp>
+#include <simsr/physics/materials/neo_hookean.hpp>
+#include <simsr/physics/materials/teran_muscle.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -17,6 +21,31 @@ double max_relative(const double* a, const double* b, simsr::Index n) {
   double diff = 0, scale = 0;
   for (simsr::Index i = 0; i < n; ++i) diff = std::max(diff, std::abs(a[i] - b[i])), scale = std::max(scale, std::abs(b[i]));
   return scale > 0 ? diff / scale : diff;
+}
+
+/// The elastic energy and its gradient at random positions, host (exec::seq) against device;
+/// returns the larger relative difference of the two.
+template <class M>
+double elastic_difference(const simsr::TetMesh<double>& mesh, const simsr::Points<double>& x, const M& material,
+                          const std::vector<typename M::Element>& elements) {
+  using namespace simsr;
+  const physics::ElasticEnergy<M> host(mesh, material, elements);
+  Points<double> g_host = Points<double>::Zero(x.rows(), 3), g_device(x.rows(), 3);
+  const double e_host = host.add_energy_gradient(exec::seq, x, g_host);
+  const auto device = physics::to_device(host);
+  DeviceBuffer<double> d_x(Span<const double>{x.data(), x.size()}), d_g(Span<const double>{g_device.setZero().data(), x.size()});
+  const MatrixSpan<const double> xs{d_x.span().data, x.rows(), 3, 3};
+  const MatrixSpan<double> gs{d_g.span().data, x.rows(), 3, 3};
+  const double e_device = device.add_energy_gradient(exec::cuda, xs, gs);
+  d_g.copy_to(Span<double>{g_device.data(), g_device.size()});
+  // the separate energy and gradient bodies too: E twice, g += twice
+  const double e_alone = device.energy(exec::cuda, xs);
+  device.add_gradient(exec::cuda, xs, gs);
+  Points<double> g_twice(x.rows(), 3), g_host_twice = 2 * g_host;
+  d_g.copy_to(Span<double>{g_twice.data(), g_twice.size()});
+  const double de = std::max(std::abs(e_device - e_host), std::abs(e_alone - e_host)) / std::abs(e_host);
+  return std::max({de, max_relative(g_device.data(), g_host.data(), g_host.size()),
+                   max_relative(g_twice.data(), g_host_twice.data(), g_host.size())});
 }
 }  // namespace
 
@@ -50,6 +79,14 @@ int main() {
   for (Index i = 0; i < x.size(); ++i) x[i] = U(rng);
   blocks.multiply(exec::seq, x, y_host);
 
+  // elastic energy: a box perturbed by up to 40 % of a cell (the inverted tets counted and printed);
+  // random muscle fibres and activations
+  const TetMesh<double> body = box_tet_mesh<double>(7, 6, 5, Vec3<>(0, 0, 0), Vec3<>(0.07, 0.06, 0.05));
+  Points<double> deformed = body.V;
+  for (Index i = 0; i < deformed.size(); ++i) deformed.data()[i] += 0.004 * U(rng);
+  std::vector<physics::MuscleFibre<double>> fibres(std::size_t(body.num_tets()));
+  for (auto& f : fibres) f = physics::TeranMuscle<double>::element(Vec3<>(U(rng), U(rng), U(rng)), 0.5 + 0.5 * U(rng));
+
   int devices = 0;
   if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {
     std::printf("no CUDA device: compiled only\n");
@@ -67,6 +104,14 @@ int main() {
   d_blocks.multiply(exec::cuda, d_x.span(), d_y.span());
   d_y.copy_to(Span<double>{y_device.data(), y_device.size()});
   const double e_blocks = max_relative(y_device.data(), y_host.data(), y_host.size());
+  // ElasticEnergy on the device
+  const double e_neo = elastic_difference(body, deformed, physics::NeoHookean<double>::from_young_poisson(3e4, 0.45),
+                                          std::vector<physics::NoElementData>(std::size_t(body.num_tets())));
+  const double e_muscle = elastic_difference(body, deformed, physics::TeranMuscle<double>(), fibres);
   std::printf("Embedded::apply device vs seq: %.3g; BlockCsr product device vs seq: %.3g\n", e_embedded, e_blocks);
-  return e_embedded < 1e-13 && e_blocks < 1e-13 ? 0 : 1;
+  const Index inverted = physics::ElasticEnergy<physics::NeoHookean<double>>(body, physics::NeoHookean<double>::from_young_poisson(3e4, 0.45))
+                             .count_inverted(exec::seq, deformed);
+  std::printf("ElasticEnergy energy+gradient device vs seq: NeoHookean %.3g, TeranMuscle %.3g (%td tets, %td inverted)\n", e_neo,
+              e_muscle, body.num_tets(), inverted);
+  return e_embedded < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 ? 0 : 1;
 }

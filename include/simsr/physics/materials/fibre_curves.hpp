@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../../core/host_device.hpp"
 #include "isotropic.hpp"
 
 namespace simsr::physics {
@@ -28,20 +29,20 @@ struct PassiveFibreCurve {
                             stretch_max, "must be > 1");
   }
 
-  S value(S lambda) const {
+  SIMSR_HOST_DEVICE S value(S lambda) const {
     if (lambda <= S(1)) return S(0);
     if (lambda < stretch_max) return p1 * std::expm1(p2 * (lambda - S(1)));
     return value_max() + slope_max() * (lambda - stretch_max);
   }
 
-  S derivative(S lambda) const {
+  SIMSR_HOST_DEVICE S derivative(S lambda) const {
     if (lambda <= S(1)) return S(0);
     if (lambda < stretch_max) return p1 * p2 * std::exp(p2 * (lambda - S(1)));
     return slope_max();
   }
 
   /// ∫₁^λ value.
-  S energy(S lambda) const {
+  SIMSR_HOST_DEVICE S energy(S lambda) const {
     if (lambda <= S(1)) return S(0);
     const auto exponential = [&](S l) { return p1 * (std::expm1(p2 * (l - S(1))) / p2 - (l - S(1))); };
     if (lambda < stretch_max) return exponential(lambda);
@@ -50,8 +51,8 @@ struct PassiveFibreCurve {
   }
 
  private:
-  S value_max() const { return p1 * std::expm1(p2 * (stretch_max - S(1))); }
-  S slope_max() const { return p1 * p2 * std::exp(p2 * (stretch_max - S(1))); }
+  SIMSR_HOST_DEVICE S value_max() const { return p1 * std::expm1(p2 * (stretch_max - S(1))); }
+  SIMSR_HOST_DEVICE S slope_max() const { return p1 * p2 * std::exp(p2 * (stretch_max - S(1))); }
 };
 
 /// Active force–length curve, x = λ/λ_ofl: 1 − 4(x − 1)² around the optimum and c(x − 0.4)²,
@@ -73,9 +74,9 @@ struct ActiveFibreCurve {
                             "optimal_length", optimal_length, "must be > 0");
   }
 
-  S value(S lambda) const { return normalized_value(lambda / optimal_length); }
+  SIMSR_HOST_DEVICE S value(S lambda) const { return normalized_value(lambda / optimal_length); }
 
-  S derivative(S lambda) const {
+  SIMSR_HOST_DEVICE S derivative(S lambda) const {
     const S x = lambda / optimal_length;
     S d = S(0);
     if (x <= lower || x >= upper)
@@ -90,27 +91,27 @@ struct ActiveFibreCurve {
   }
 
   /// ∫₁^λ value = λ_ofl (G(λ/λ_ofl) − G(1/λ_ofl)) with G(x) = ∫₁^x of the normalized curve.
-  S energy(S lambda) const {
+  SIMSR_HOST_DEVICE S energy(S lambda) const {
     return optimal_length * (antiderivative(lambda / optimal_length) - antiderivative(S(1) / optimal_length));
   }
 
  private:
-  static S normalized_value(S x) {
+  SIMSR_HOST_DEVICE static S normalized_value(S x) {
     if (x <= lower || x >= upper) return S(0);
     if (x < lower_break) return outer * (x - lower) * (x - lower);
     if (x <= upper_break) return S(1) - S(4) * (x - S(1)) * (x - S(1));
     return outer * (x - upper) * (x - upper);
   }
 
-  static S central(S x) { return (x - S(1)) - S(4) / S(3) * (x - S(1)) * (x - S(1)) * (x - S(1)); }
+  SIMSR_HOST_DEVICE static S central(S x) { return (x - S(1)) - S(4) / S(3) * (x - S(1)) * (x - S(1)) * (x - S(1)); }
 
-  static S cube(S x) { return x * x * x; }
+  SIMSR_HOST_DEVICE static S cube(S x) { return x * x * x; }
 
-  static S antiderivative(S x) {
+  SIMSR_HOST_DEVICE static S antiderivative(S x) {
     if (x < lower_break)
-      return central(lower_break) - outer / S(3) * (cube(lower_break - lower) - cube(std::max(x, lower) - lower));
+      return central(lower_break) - outer / S(3) * (cube(lower_break - lower) - cube((x > lower ? x : lower) - lower));
     if (x <= upper_break) return central(x);
-    return central(upper_break) + outer / S(3) * (cube(std::min(x, upper) - upper) - cube(upper_break - upper));
+    return central(upper_break) + outer / S(3) * (cube((x < upper ? x : upper) - upper) - cube(upper_break - upper));
   }
 };
 

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "../../core/error.hpp"
+#include "../../core/host_device.hpp"
 #include "material.hpp"
 #include "signed_svd.hpp"
 
@@ -47,7 +48,7 @@ struct ScalarJet {
 /// f(J) for J ≥ J0, its second-order Taylor polynomial at J0 below (C² at J0). `f` maps a J ≥ J0
 /// to its ScalarJet.
 template <class S, class Fn>
-ScalarJet<S> extend_below(S J, S J0, Fn&& f) {
+SIMSR_HOST_DEVICE ScalarJet<S> extend_below(S J, S J0, Fn&& f) {
   if (J >= J0) return f(J);
   const ScalarJet<S> a = f(J0);
   const S d = J - J0;
@@ -56,13 +57,13 @@ ScalarJet<S> extend_below(S J, S J0, Fn&& f) {
 
 /// ln J, extended below J0 (increasing for every J < J0, so −ln J penalizes inversion).
 template <class S>
-ScalarJet<S> extended_log(S J, S J0) {
+SIMSR_HOST_DEVICE ScalarJet<S> extended_log(S J, S J0) {
   return extend_below(J, J0, [](S x) { return ScalarJet<S>{std::log(x), S(1) / x, S(-1) / (x * x)}; });
 }
 
 /// J^p, extended below J0 (for p < 0: positive and decreasing for every J < J0).
 template <class S>
-ScalarJet<S> extended_power(S J, S p, S J0) {
+SIMSR_HOST_DEVICE ScalarJet<S> extended_power(S J, S p, S J0) {
   return extend_below(J, J0, [p](S x) {
     const S v = std::pow(x, p);
     return ScalarJet<S>{v, p * v / x, p * (p - S(1)) * v / (x * x)};
@@ -186,7 +187,7 @@ struct Invariants {
 
 /// Invariants from F (no SVD).
 template <class S>
-Invariants<S> invariants(const Mat3<S>& F) {
+SIMSR_HOST_DEVICE Invariants<S> invariants(const Mat3<S>& F) {
   const Mat3<S> C = F.transpose() * F;
   const S I1 = C.trace();
   return {I1, S(0.5) * (I1 * I1 - C.squaredNorm()), F.determinant()};
@@ -210,7 +211,7 @@ struct InvariantPartials {
 
 /// cof F = J F⁻ᵀ = ∂J/∂F, valid for singular F too.
 template <class S>
-Mat3<S> cofactor(const Mat3<S>& F) {
+SIMSR_HOST_DEVICE Mat3<S> cofactor(const Mat3<S>& F) {
   Mat3<S> c;
   c.col(0) = F.col(1).cross(F.col(2));
   c.col(1) = F.col(2).cross(F.col(0));
@@ -220,7 +221,7 @@ Mat3<S> cofactor(const Mat3<S>& F) {
 
 /// P = 2Ψ_1 F + Ψ_2 (2 I1 F − 2 F FᵀF) + Ψ_J cof F, straight from F (no SVD).
 template <class S>
-Mat3<S> invariant_stress(const Mat3<S>& F, const Invariants<S>& inv, const Vec3<S>& d) {
+SIMSR_HOST_DEVICE Mat3<S> invariant_stress(const Mat3<S>& F, const Invariants<S>& inv, const Vec3<S>& d) {
   return (S(2) * d(0) + S(2) * d(1) * inv.I1) * F - S(2) * d(1) * (F * F.transpose() * F) + d(2) * cofactor(F);
 }
 
@@ -262,9 +263,9 @@ class InvariantMaterial {
   using scalar_type = S;
   using Element = NoElementData;
 
-  S energy(const Mat3<S>& F, const Element& = {}) const { return self().partials(invariants(F)).psi; }
+  SIMSR_HOST_DEVICE S energy(const Mat3<S>& F, const Element& = {}) const { return self().partials(invariants(F)).psi; }
 
-  Mat3<S> stress(const Mat3<S>& F, const Element& = {}) const {
+  SIMSR_HOST_DEVICE Mat3<S> stress(const Mat3<S>& F, const Element& = {}) const {
     const Invariants<S> inv = invariants(F);
     return invariant_stress(F, inv, self().partials(inv).d);
   }
@@ -290,7 +291,7 @@ class InvariantMaterial {
   }
 
  private:
-  const Derived& self() const { return static_cast<const Derived&>(*this); }
+  SIMSR_HOST_DEVICE const Derived& self() const { return static_cast<const Derived&>(*this); }
 };
 
 }  // namespace simsr::physics

@@ -12,6 +12,7 @@
 /// vec() is column-major (Eigen's storage of Mat3): vec(F)[i + 3j] = F(i, j).
 
 #include <concepts>
+#include <type_traits>
 
 #include <Eigen/Core>
 
@@ -81,6 +82,24 @@ constexpr bool assert_material() {
   static_assert(lacks != 1, "this type is not a physics::Material: it lacks energy(const Mat3& F, const Element&) const -> scalar_type (psi)");
   static_assert(lacks != 2, "this type is not a physics::Material: it lacks stress(const Mat3& F, const Element&) const -> Mat3 (P = dpsi/dF)");
   static_assert(lacks != 3, "this type is not a physics::Material: it lacks stress_derivative(const Mat3& F, const Element&, Definiteness) const -> Mat9");
+  return true;
+}
+
+/// A Material whose energy and stress are SIMSR_HOST_DEVICE, so that DeviceElasticEnergy can call
+/// them in a CUDA kernel: it says so with `static constexpr bool device_callable = true;`
+/// (NeoHookean, MooneyRivlin, TeranMuscle). An opt-in, since a C++ concept cannot see whether a
+/// function is callable on the device; its element data must be plain bytes (copied as such).
+template <class M>
+concept DeviceMaterial = Material<M> && std::is_trivially_destructible_v<typename M::Element> && requires {
+  requires M::device_callable;
+};
+
+/// `static_assert(assert_device_material<M>())`: one sentence where M is not a DeviceMaterial.
+template <class M>
+constexpr bool assert_device_material() {
+  static_assert(DeviceMaterial<M>,
+                "this material is not a physics::DeviceMaterial: its energy and stress must be SIMSR_HOST_DEVICE and it must declare "
+                "static constexpr bool device_callable = true");
   return true;
 }
 

@@ -15,6 +15,8 @@ namespace simsr::physics {
 template <class S = Scalar>
 class MooneyRivlin : public InvariantMaterial<MooneyRivlin<S>, S> {
  public:
+  /// Energy and stress run in CUDA kernels too (DeviceMaterial).
+  static constexpr bool device_callable = true;
 
   /// Defaults: PhysBAM's face flesh μ10 = 6e4 Pa, μ01 = 2e4 Pa (μ = 1.6e5 Pa); κ = 1.6e6 Pa = 10μ,
   /// i.e. small-strain Poisson ratio ν = (3κ − 2μ)/(6κ + 2μ) ≈ 0.452: nearly incompressible
@@ -37,7 +39,7 @@ class MooneyRivlin : public InvariantMaterial<MooneyRivlin<S>, S> {
   S inversion_threshold() const { return j0_; }
 
   /// Ψ(I1, I2, J) and its partials.
-  InvariantPartials<S> partials(const Invariants<S>& inv) const {
+  SIMSR_HOST_DEVICE InvariantPartials<S> partials(const Invariants<S>& inv) const {
     const ScalarJet<S> a = extended_power(inv.J, S(-2) / S(3), j0_);
     const ScalarJet<S> b = extended_power(inv.J, S(-4) / S(3), j0_);
     const ScalarJet<S> L = extended_log(inv.J, j0_);

@@ -13,6 +13,8 @@ namespace simsr::physics {
 template <class S = Scalar>
 class NeoHookean : public InvariantMaterial<NeoHookean<S>, S> {
  public:
+  /// Energy and stress run in CUDA kernels too (DeviceMaterial).
+  static constexpr bool device_callable = true;
 
   /// Default inversion threshold J0: the exact law holds down to 10 % of the rest volume, far
   /// beyond any physical compression of nearly incompressible flesh, while the extension's
@@ -36,7 +38,7 @@ class NeoHookean : public InvariantMaterial<NeoHookean<S>, S> {
   S inversion_threshold() const { return j0_; }
 
   /// Ψ(I1, I2, J) and its partials.
-  InvariantPartials<S> partials(const Invariants<S>& inv) const {
+  SIMSR_HOST_DEVICE InvariantPartials<S> partials(const Invariants<S>& inv) const {
     const ScalarJet<S> L = extended_log(inv.J, j0_);
     const S dJ = (lambda_ * L.value - mu_) * L.first;
     InvariantPartials<S> p;

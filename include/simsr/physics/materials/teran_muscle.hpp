@@ -33,6 +33,8 @@ class TeranMuscle {
  public:
   using scalar_type = S;
   using Element = MuscleFibre<S>;
+  /// Energy and stress run in CUDA kernels too (DeviceMaterial).
+  static constexpr bool device_callable = true;
 
   /// σ_max = 3e5 Pa: Teran et al. 2003's maximum isometric muscle stress (0.3 MPa).
   explicit TeranMuscle(MooneyRivlin<S> isotropic = MooneyRivlin<S>(), S max_stress = S(3e5),
@@ -69,12 +71,12 @@ class TeranMuscle {
     return e;
   }
 
-  S energy(const Mat3<S>& F, const Element& e) const {
+  SIMSR_HOST_DEVICE S energy(const Mat3<S>& F, const Element& e) const {
     const S lambda = (F * e.fibre).norm();
     return iso_.energy(F) + max_stress_ * (passive_.energy(lambda) + e.activation * active_.energy(lambda));
   }
 
-  Mat3<S> stress(const Mat3<S>& F, const Element& e) const {
+  SIMSR_HOST_DEVICE Mat3<S> stress(const Mat3<S>& F, const Element& e) const {
     Mat3<S> P = iso_.stress(F);
     const Vec3<S> Fa = F * e.fibre;
     const S lambda = Fa.norm();
@@ -117,7 +119,7 @@ class TeranMuscle {
   }
 
   /// ψ_f'(λ) = σ_max (f_p(λ) + α f_a(λ)), the fibre's first Piola stress magnitude [Pa].
-  S fibre_stress(S lambda, S activation) const {
+  SIMSR_HOST_DEVICE S fibre_stress(S lambda, S activation) const {
     return max_stress_ * (passive_.value(lambda) + activation * active_.value(lambda));
   }
 
@@ -143,7 +145,7 @@ class TeranMuscle {
   }
 
   /// Below this stretch both fibre curves vanish identically.
-  S flat_below() const { return std::min(S(1), ActiveFibreCurve<S>::lower * active_.optimal_length); }
+  SIMSR_HOST_DEVICE S flat_below() const { return std::min(S(1), ActiveFibreCurve<S>::lower * active_.optimal_length); }
 
   MooneyRivlin<S> iso_;
   S max_stress_;
