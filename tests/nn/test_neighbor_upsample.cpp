@@ -1,3 +1,4 @@
+#include <simsr/nn/device_neighbor_upsample.hpp>  // the host compiler sees the header, not the class (nvcc only)
 #include <simsr/nn/neighbor_upsample.hpp>
 
 #include "gradient_check.hpp"
@@ -115,4 +116,43 @@ TEST_CASE("nn::NeighborUpsample: seq == omp bitwise; warm calls allocate nothing
   up.apply(exec::seq, up.weights(), z, o1);
   SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before);
   CHECK(o1.data() == p);
+}
+
+TEST_CASE("nn::NeighborUpsample: the gather's body over MatrixSpan (DeviceNeighborUpsample's accessor), row by row and entry by entry, equals apply, bitwise, under seq and omp") {
+  std::mt19937_64 rng(94);
+  for (int t = 0; t < 24; ++t) {
+    const Index B = 1 + Index(rng() % 4), N = 1 + Index(rng() % 40), M = 1 + Index(rng() % 90), K = 1 + Index(rng() % 24),
+                C = 1 + Index(rng() % 70), pad = Index(rng() % 3);
+    const bool shared = t % 2 == 0;
+    INFO("B " << B << ", N " << N << ", M " << M << ", upK " << K << ", C " << C << ", shared " << shared << ", padding " << pad);
+    nn::NeighborUpsample<float> up(random_indices(rng, M, N, K), N);
+    // z and the weights as column blocks of wider matrices: row strides beyond their columns
+    const Matrix<float> z_wide = random_matrix(rng, B * N, C + pad).cast<float>();
+    const Matrix<float> logits = random_matrix(rng, shared ? M : B * M, K + pad, -3, 3).cast<float>();
+    Matrix<float> w_wide;
+    nn::NeighborUpsample<float>::softmax_rows(exec::seq, logits, w_wide);
+    const nn::ConstView<float> z = z_wide.leftCols(C), w = w_wide.leftCols(K);
+    Matrix<float> ref;
+    up.apply(exec::seq, w, z, ref);
+    const MatrixSpan<const float> zs{z.data(), z.rows(), z.cols(), z.outerStride()}, ws{w.data(), w.rows(), w.cols(), w.outerStride()};
+    for (bool omp : {false, true}) {
+      Matrix<float> out = Matrix<float>::Constant(B * M, C + pad, 7.0f);
+      const nn::detail::UpsampleGather<float> body{up.indices().data(), M, N, ws, zs, MatrixSpan<float>{out.data(), out.rows(), C, out.cols()}};
+      if (omp)
+        exec::parallel_for(exec::omp, B * M, body);
+      else
+        exec::parallel_for(exec::seq, B * M, body);
+      CHECK(test::bitwise_equal(Matrix<float>(out.leftCols(C)), ref));
+      CHECK((out.rightCols(pad).array() == 7.0f).all());  // the padding untouched
+      // entry by entry (the device's launch: one index an entry), the same sums
+      out.setConstant(7.0f);
+      const nn::detail::UpsampleGatherEntries<float> entries{body};
+      if (omp)
+        exec::parallel_for(exec::omp, B * M * C, entries);
+      else
+        exec::parallel_for(exec::seq, B * M * C, entries);
+      CHECK(test::bitwise_equal(Matrix<float>(out.leftCols(C)), ref));
+      CHECK((out.rightCols(pad).array() == 7.0f).all());
+    }
+  }
 }

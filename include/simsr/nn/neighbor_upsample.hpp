@@ -15,6 +15,7 @@
 #include <string>
 
 #include "batch_split.hpp"
+#include "detail/neighbor_gather.hpp"
 #include "graph_features.hpp"
 #include "layer.hpp"
 
@@ -25,7 +26,8 @@ namespace simsr::nn {
 /// only), or B·M rows, one block of M per item. Row b·M + j of the output is HR vertex j of item b;
 /// row b·N + n of z is LR point n of item b. Backward gathers per LR point over a reverse
 /// adjacency and sums shared-weight gradients over items in order: exec::seq and exec::omp agree
-/// bitwise. Warm calls allocate nothing.
+/// bitwise. Warm calls allocate nothing. The gather is detail::UpsampleGather, the body
+/// DeviceNeighborUpsample (device_neighbor_upsample.hpp) runs under exec::cuda.
 template <class S = float>
 class NeighborUpsample {
  public:
@@ -79,12 +81,12 @@ class NeighborUpsample {
   template <exec::HostPolicy Policy>
   void apply(Policy policy, const ConstView<S>& weights, const ConstView<S>& z, Matrix<S>& out) const {
     const Index B = check_z(z), M = idx_.rows();
-    const bool shared = check_weights("weights", weights, B);
+    check_weights("weights", weights, B);
     ensure_shape(out, B * M, z.cols());
     const Index rows = B * M;
     const Index nc = exec::chunk_count(rows, product_chunks), workers = exec::worker_count(policy, nc);
     exec::for_chunks(policy, rows, nc, workers,
-                     [&](Index, Index, Index b, Index e) { gather_rows(weights, shared, z, b, e, out.data() + b * out.cols(), out.cols()); });
+                     [&](Index, Index, Index b, Index e) { gather_rows(weights, z, b, e, out.data() + b * out.cols(), out.cols()); });
   }
 
   /// apply's rows [begin, end) alone, written to `out` (row-major, leading dimension ld_out ≥
@@ -94,12 +96,12 @@ class NeighborUpsample {
   /// that apply would refuse.
   void apply_rows(const ConstView<S>& weights, const ConstView<S>& z, Index begin, Index end, S* out, Index ld_out) const {
     const Index B = check_z(z);
-    const bool shared = check_weights("weights", weights, B);
+    check_weights("weights", weights, B);
     if (begin < 0 || end < begin || end > B * idx_.rows() || ld_out < z.cols())
       throw ArgumentError("nn::NeighborUpsample::apply_rows: rows [" + std::to_string(begin) + ", " + std::to_string(end) + ") of " +
                           std::to_string(B * idx_.rows()) + " with leading dimension " + std::to_string(ld_out) + " for " +
                           std::to_string(z.cols()) + " columns");
-    gather_rows(weights, shared, z, begin, end, out, ld_out);
+    gather_rows(weights, z, begin, end, out, ld_out);
   }
 
   /// After forward(policy, logits, z, …): d_logits (shape of the logits) = w ⊙ (dw − Σ_i w dw) with
@@ -187,15 +189,17 @@ class NeighborUpsample {
     });
   }
 
-  /// Rows [b, e) of the gather into out (row b first, leading dimension ld_out).
-  void gather_rows(const ConstView<S>& weights, bool shared, const ConstView<S>& z, Index b, Index e, S* out, Index ld_out) const {
-    const Index M = idx_.rows(), K = idx_.cols(), C = z.cols();
-    for (Index r = b; r < e; ++r) {
-      const Index item = r / M, j = r % M, wr = shared ? j : r;
-      Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> o(out + (r - b) * ld_out, C);
-      o.setZero();
-      for (Index i = 0; i < K; ++i) o += weights(wr, i) * z.row(item * n_ + idx_(j, i));
-    }
+  /// Rows [b, e) of the gather into out (row b first, leading dimension ld_out), shapes checked:
+  /// the device twin's body, row by row.
+  void gather_rows(const ConstView<S>& weights, const ConstView<S>& z, Index b, Index e, S* out, Index ld_out) const {
+    const detail::UpsampleGather<S> body{idx_.data(),
+                                         idx_.rows(),
+                                         n_,
+                                         {weights.data(), weights.rows(), weights.cols(), weights.outerStride()},
+                                         {z.data(), z.rows(), z.cols(), z.outerStride()},
+                                         {out, e - b, z.cols(), ld_out},
+                                         b};
+    for (Index r = b; r < e; ++r) body(r);
   }
 
   /// Number of batch items B of z ((B·N)×C); ShapeError otherwise.

@@ -1,11 +1,13 @@
 // The library's own kernel bodies under exec::cuda (issue #17 item 5): Embedded::apply's
-// (interp::DeviceEmbedded), BlockCsr's product (physics::DeviceBlockCsr) and the elastic energy
-// and gradient (physics::DeviceElasticEnergy, isotropic and fibre materials), the same functors
-// the host tests run under seq and omp. Compiled by nvcc in the cuda-compile test; where a GPU
+// (interp::DeviceEmbedded), BlockCsr's product (physics::DeviceBlockCsr), the elastic energy and
+// gradient (physics::DeviceElasticEnergy, isotropic and fibre materials) and the network's
+// upsampling gather (nn::DeviceNeighborUpsample): the same functors the host tests run under seq
+// and omp. Compiled by nvcc in the cuda-compile test; where a GPU
 // exists it runs and checks the device results against the host's (to rounding: the device may
 // fuse multiply-adds the host does not).
 #include <simsr/interp/device_embedded.hpp>
 #include <simsr/mesh/generators.hpp>
+#include <simsr/nn/device_neighbor_upsample.hpp>
 #include <simsr/physics/device_elastic_energy.hpp>
 #include <simsr/physics/linear_solvers/device_block_csr.hpp>
 #include <simsr/physics/materials/neo_hookean.hpp>
@@ -46,6 +48,36 @@ double elastic_difference(const simsr::TetMesh<double>& mesh, const simsr::Point
   const double de = std::max(std::abs(e_device - e_host), std::abs(e_alone - e_host)) / std::abs(e_host);
   return std::max({de, max_relative(g_device.data(), g_host.data(), g_host.size()),
                    max_relative(g_twice.data(), g_host_twice.data(), g_host.size())});
+}
+
+/// NeighborUpsample's inference gather (float) at a network's size, host (exec::seq) against its
+/// device twin (nn::DeviceNeighborUpsample), shared and per-item weights: the larger max relative
+/// difference of the two.
+double neighbor_upsample_difference(std::mt19937& rng) {
+  using namespace simsr;
+  const Index M = 3000, N = 1000, K = 20, C = 64, B = 2;
+  std::uniform_real_distribution<float> U(-1, 1);
+  nn::GraphIndices idx(M, K);
+  for (Index i = 0; i < idx.size(); ++i) idx.data()[i] = VIndex(rng() % std::uint32_t(N));
+  const nn::NeighborUpsample<float> up(idx, N);
+  nn::Matrix<float> z(B * N, C);
+  for (Index i = 0; i < z.size(); ++i) z.data()[i] = U(rng);
+  DeviceBuffer<float> d_z(Span<const float>{z.data(), z.size()}), d_out(B * M * C);
+  double worst = 0;
+  for (const Index weight_rows : {M, B * M}) {  // shared by the items, one block per item
+    nn::Matrix<float> logits(weight_rows, K), w, host, device(B * M, C);
+    for (Index i = 0; i < logits.size(); ++i) logits.data()[i] = 3 * U(rng);
+    nn::NeighborUpsample<float>::softmax_rows(exec::seq, logits, w);
+    up.apply(exec::seq, w, z, host);
+    const auto d_up = nn::to_device(up, w);
+    d_up.apply(exec::cuda, MatrixSpan<const float>{d_z.span().data, B * N, C, C}, MatrixSpan<float>{d_out.span().data, B * M, C, C});
+    d_out.copy_to(Span<float>{device.data(), device.size()});
+    double diff = 0, scale = 0;
+    for (Index i = 0; i < host.size(); ++i)
+      diff = std::max(diff, double(std::abs(device.data()[i] - host.data()[i]))), scale = std::max(scale, double(std::abs(host.data()[i])));
+    worst = std::max(worst, scale > 0 ? diff / scale : diff);
+  }
+  return worst;
 }
 }  // namespace
 
@@ -108,10 +140,12 @@ int main() {
   const double e_neo = elastic_difference(body, deformed, physics::NeoHookean<double>::from_young_poisson(3e4, 0.45),
                                           std::vector<physics::NoElementData>(std::size_t(body.num_tets())));
   const double e_muscle = elastic_difference(body, deformed, physics::TeranMuscle<double>(), fibres);
+  const double e_upsample = neighbor_upsample_difference(rng);
   std::printf("Embedded::apply device vs seq: %.3g; BlockCsr product device vs seq: %.3g\n", e_embedded, e_blocks);
   const Index inverted = physics::ElasticEnergy<physics::NeoHookean<double>>(body, physics::NeoHookean<double>::from_young_poisson(3e4, 0.45))
                              .count_inverted(exec::seq, deformed);
   std::printf("ElasticEnergy energy+gradient device vs seq: NeoHookean %.3g, TeranMuscle %.3g (%td tets, %td inverted)\n", e_neo,
               e_muscle, body.num_tets(), inverted);
-  return e_embedded < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 ? 0 : 1;
+  std::printf("NeighborUpsample::apply (float) device vs seq: %.3g\n", e_upsample);
+  return e_embedded < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && e_upsample < 1e-5 ? 0 : 1;
 }
