@@ -43,8 +43,8 @@
 //       forcing, each Newton system solved to η_k instead of kCgTolerance) with Kelley's safeguard
 //       η_k ≥ ½ τ/‖g_k‖ (forcing_safeguard, default); `_unguarded` without it (the baseline);
 //       `_jacobi_svd` with the element Hessians on Eigen's Jacobi SVD (JacobiSvdMuscle, the
-//       baseline of signed_svd_from_eigen); `_coloured` with HessianAssembly::coloured (the default
-//       gather its baseline)
+//       baseline of signed_svd_from_eigen); `_coloured` with HessianAssembly::coloured (the library's
+//       default since 2026-12-04; every other row sets the gather, its baseline)
 //   BM_frame_73k/<linear>_extrapolated/omp   the same frame from the face simulator's warm start:
 //       2 x_A − x_before, with x_before the frame before A (jaw 0.08 rad, activation 0.05, targets
 //       −0.5 mm: the same step back), solved once at setup from x_A

@@ -105,7 +105,7 @@ TEST_CASE("ElasticEnergy: the assembled Hessian is the sum of the element Hessia
   const auto mesh = box_tet_mesh<double>(3, 2, 2);
   const Points<> x = perturbed(mesh.V, 0.1, 7);
   ElasticEnergy<simsr_test::StVK> E(mesh, {});
-  CHECK(E.hessian_assembly() == HessianAssembly::gather);
+  CHECK(E.hessian_assembly() == HessianAssembly::coloured);
   CHECK(E.tets_per_chunk() == ElasticEnergy<simsr_test::StVK>::kDefaultTetsPerChunk);
   CHECK_THROWS_AS(E.set_hessian_assembly(HessianAssembly::coloured, 0), ArgumentError);
   for (const auto& setting : {std::pair{HessianAssembly::coloured, Index(1)}, std::pair{HessianAssembly::coloured, Index(5)},

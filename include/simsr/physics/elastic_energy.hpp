@@ -64,14 +64,15 @@ concept HasProjectiveStiffness = requires(const M& m) { { m.projective_stiffness
 /// are deterministic (seq == omp bitwise) and differ only in rounding: the order of each block's
 /// sum.
 enum class HessianAssembly {
-  /// The default: every tet's upper blocks to a per-tet buffer in parallel, then every block sums
-  /// its tets' in tet order.
+  /// Every tet's upper blocks to a per-tet buffer in parallel, then every block sums its tets' in
+  /// tet order (the default until 2026-12-04; the coloured one's baseline).
   gather,
-  /// The tets cut into chunks of consecutive tets, the chunks coloured once (greedy_colouring: no
-  /// two chunks of a colour share a vertex); colour by colour, chunks on any thread, each chunk's
-  /// tets' stiffnesses computed and added straight into their 16 blocks in turn. No per-tet
-  /// buffer (on the 73k-tet lattice 53 MB written and read again every assembly): 1.2× (one
-  /// thread) to 1.4× (two) the gather's speed there (README, "Physics at the paper's LR size").
+  /// The default. The tets cut into chunks of consecutive tets, the chunks coloured once
+  /// (greedy_colouring: no two chunks of a colour share a vertex); colour by colour, chunks on any
+  /// thread, each chunk's tets' stiffnesses computed and added straight into their 16 blocks in
+  /// turn. No per-tet buffer (on the 73k-tet lattice 53 MB written and read again every
+  /// assembly): 1.2× (one thread) to 1.4× (two) the gather's speed there (README, "Physics at the
+  /// paper's LR size").
   coloured,
 };
 
@@ -121,7 +122,7 @@ class ElasticEnergy {
   const std::vector<std::int32_t>& force_gather_entries() const { return vertex_entries_; }
   HessianAssembly hessian_assembly() const { return assembly_; }
   Index tets_per_chunk() const { return chunk_; }
-  /// Chooses add_hessian's assembly (HessianAssembly; gather by default) and, for the coloured
+  /// Chooses add_hessian's assembly (HessianAssembly; coloured by default) and, for the coloured
   /// one, the tets per chunk (ArgumentError below 1).
   void set_hessian_assembly(HessianAssembly assembly, Index tets_per_chunk = kDefaultTetsPerChunk) {
     if (tets_per_chunk < 1) throw ArgumentError("ElasticEnergy::set_hessian_assembly: tets per chunk " + std::to_string(tets_per_chunk) + " < 1");
@@ -390,7 +391,7 @@ class ElasticEnergy {
   mutable std::vector<Index> gather_offsets_;
   mutable std::vector<std::int64_t> gather_entries_;
   mutable std::uint64_t gather_version_ = 0;
-  HessianAssembly assembly_ = HessianAssembly::gather;
+  HessianAssembly assembly_ = HessianAssembly::coloured;
   Index chunk_ = kDefaultTetsPerChunk;
   mutable ElementColouring colouring_;         // of the chunks, built on the first coloured assembly
   mutable std::vector<Index> colour_slots_;    // 16 per tet, in tet order
