@@ -44,7 +44,8 @@
 //       η_k ≥ ½ τ/‖g_k‖ (forcing_safeguard, default); `_unguarded` without it (the baseline);
 //       `_jacobi_svd` with the element Hessians on Eigen's Jacobi SVD (JacobiSvdMuscle, the
 //       baseline of signed_svd_from_eigen); `_coloured` with HessianAssembly::coloured (the library's
-//       default since 2026-12-04; every other row sets the gather, its baseline)
+//       default since 2026-12-04; every other row sets the gather, its baseline); `_chebyshev2` the V-cycle
+//       smoothed by MultigridOptions::Smoother::chebyshev of degree 2 (one Jacobi sweep its baseline)
 //   BM_frame_73k/<linear>_extrapolated/omp   the same frame from the face simulator's warm start:
 //       2 x_A − x_before, with x_before the frame before A (jaw 0.08 rad, activation 0.05, targets
 //       −0.5 mm: the same step back), solved once at setup from x_A
@@ -291,11 +292,16 @@ using Storage = MultigridOptions::Storage;
 /// levels here, once per mesh like the gather lists: not timed). `coarse_refresh_every`,
 /// `storage`: the multigrid's MultigridOptions (ignored by the other solvers); Storage::csr also
 /// runs PCG's own products on the scalar CSR (ConjugateGradientOptions::block_products = false):
-/// the baseline of every 3×3-block product.
+/// the baseline of every 3×3-block product. `chebyshev_degree` > 0: the Chebyshev smoother of that
+/// degree (MultigridOptions::Smoother), else one damped block-Jacobi sweep.
 template <class Linear>
-Linear make_linear(int coarse_refresh_every = 1, Storage storage = Storage::block) {
-  return make_linear_solver<Linear>(exec::omp, scene().mesh, {.tolerance = kCgTolerance, .block_products = storage != Storage::csr}, {},
-                                    {.coarse_refresh_every = coarse_refresh_every, .storage = storage});
+Linear make_linear(int coarse_refresh_every = 1, Storage storage = Storage::block, int chebyshev_degree = 0) {
+  return make_linear_solver<Linear>(
+      exec::omp, scene().mesh, {.tolerance = kCgTolerance, .block_products = storage != Storage::csr}, {},
+      {.coarse_refresh_every = coarse_refresh_every,
+       .storage = storage,
+       .smoother = chebyshev_degree > 0 ? MultigridOptions::Smoother::chebyshev : MultigridOptions::Smoother::jacobi,
+       .chebyshev_degree = std::max(chebyshev_degree, 1)});
 }
 
 /// The baseline of the element Hessians: M without its own element_stiffness, so ElasticEnergy
@@ -341,7 +347,7 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 /// as the face simulator's warm start), not from x_A.
 template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
           NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block, bool Extrapolate = false,
-          bool ForcingSafeguard = true, HessianAssembly Assembly = HessianAssembly::gather>
+          bool ForcingSafeguard = true, HessianAssembly Assembly = HessianAssembly::gather, int ChebyshevDegree = 0>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
@@ -350,7 +356,7 @@ void BM_frame(benchmark::State& state) {
   NewtonOptions options;
   options.forcing = Forcing;
   options.forcing_safeguard = ForcingSafeguard;
-  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage));
+  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage, ChebyshevDegree));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
   const auto frame = [&] {
@@ -424,6 +430,7 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, Newton
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, false)->Name("BM_frame_73k/pcg_multigrid_inexact_unguarded_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 // the same with the element Hessians' SVD on Eigen's Jacobi sweeps (the baseline of signed_svd_from_eigen)
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, 2)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, JacobiSvdMuscle, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_jacobi_svd_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)
 BENCHMARK_TEMPLATE(BM_frame, CholmodCholesky<>, exec::omp_t)->Name("BM_frame_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);

@@ -11,6 +11,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <limits>
 #include <random>
 
 #include "stiffness_system.hpp"
@@ -245,12 +246,77 @@ TEST_CASE("Newton with multigrid PCG reaches Cholesky's equilibrium (hanging neo
   CHECK(x_mg == x_mg_seq);  // the whole Newton solve, multigrid included: seq == omp bitwise
 }
 
+TEST_CASE("Multigrid, Chebyshev smoother: degree 1 is damped Jacobi with omega = 2 / (lo + hi); every degree gives a symmetric positive definite V-cycle, seq == omp bitwise, and PCG reaches LDLT's solution") {
+  auto s = stiffness_system(16, 4, 7);
+  const SparseMatrix<>& A = s.A();
+  const Index n = A.rows();
+  // one smoothed level (the second is the coarsest, solved directly): the Jacobi V-cycle with the
+  // same lambda estimate and omega = 2 / (lambda / ratio + lambda) is the degree-1 polynomial
+  const auto two_levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40, .max_levels = 1}).prolongations;
+  REQUIRE(two_levels.size() == 1);
+  Multigrid<> jacobi_probe(two_levels);
+  jacobi_probe.compute(exec::seq, A);
+  const double lambda = 4.0 / (3.0 * jacobi_probe.damping(0));
+  const double ratio = 7;
+  Multigrid<> cheb1(two_levels, {.smoother = MultigridOptions::Smoother::chebyshev, .chebyshev_degree = 1, .chebyshev_ratio = ratio});
+  Multigrid<> jac(two_levels, {.damping = 2.0 / (lambda / ratio + lambda)});
+  cheb1.compute(exec::seq, A);
+  jac.compute(exec::seq, A);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> N;
+  VecX<> r(n), z_cheb, z_jac;
+  for (Index i = 0; i < n; ++i) r[i] = N(rng);
+  cheb1.apply(exec::seq, r, z_cheb);
+  jac.apply(exec::seq, r, z_jac);
+  CHECK((z_cheb - z_jac).norm() <= 1e-12 * z_jac.norm());
+
+  const Eigen::SimplicialLDLT<SparseMatrix<>> ldlt(A);
+  REQUIRE(ldlt.info() == Eigen::Success);
+  const VecX<> ref = ldlt.solve(s.b);
+  const auto levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
+  for (const int degree : {1, 2, 3, 4}) {
+    for (const double chebyshev_ratio : {4.0, 10.0, 30.0}) {
+      CAPTURE(degree);
+      CAPTURE(chebyshev_ratio);
+      const MultigridOptions options{.smoother = MultigridOptions::Smoother::chebyshev, .chebyshev_degree = degree, .chebyshev_ratio = chebyshev_ratio};
+      Multigrid<> mg(levels, options), mg_omp(levels, options);
+      mg.compute(exec::seq, A);
+      mg_omp.compute(exec::omp, A);
+      for (int trial = 0; trial < 8; ++trial) {
+        VecX<> a(n), b(n), Ma, Mb;
+        for (Index i = 0; i < n; ++i) a[i] = N(rng), b[i] = N(rng);
+        mg.apply(exec::seq, a, Ma);
+        mg.apply(exec::seq, b, Mb);
+        CHECK(std::abs(a.dot(Mb) - b.dot(Ma)) <= 1e-10 * a.norm() * Mb.norm());
+        CHECK(a.dot(Ma) > 0);
+        VecX<> Ma_omp;
+        mg_omp.apply(exec::omp, a, Ma_omp);
+        CHECK(Ma == Ma_omp);
+      }
+      ConjugateGradient<Multigrid<>> pcg({.tolerance = 1e-10}, Multigrid<>(levels, options));
+      pcg.compute(exec::omp, A);
+      VecX<> x;
+      const auto report = pcg.solve(exec::omp, s.b, x);
+      CHECK(report.converged);
+      CHECK((x - ref).norm() <= 1e-8 * ref.norm());
+      if (chebyshev_ratio == 10.0) MESSAGE("beam 16x4x4: PCG iterations with Chebyshev degree ", degree, ": ", report.iterations);
+    }
+  }
+  ConjugateGradient<Multigrid<>> pcg_jacobi({.tolerance = 1e-10}, Multigrid<>(levels));
+  pcg_jacobi.compute(exec::omp, A);
+  VecX<> x;
+  MESSAGE("beam 16x4x4: PCG iterations with one damped block-Jacobi sweep: ", pcg_jacobi.solve(exec::omp, s.b, x).iterations);
+}
+
 TEST_CASE("Multigrid: bad input is a typed error") {
   auto s = stiffness_system(8, 2, 1);
   auto P = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 10}).prolongations;
   REQUIRE(P.size() >= 1);
   CHECK_THROWS_AS(Multigrid<>(P, {.smoothing_sweeps = 0}), ArgumentError);
   CHECK_THROWS_AS(Multigrid<>(P, {.damping = 2.5}), ArgumentError);
+  CHECK_THROWS_AS(Multigrid<>(P, {.smoother = MultigridOptions::Smoother::chebyshev, .chebyshev_degree = 0}), ArgumentError);
+  CHECK_THROWS_AS(Multigrid<>(P, {.smoother = MultigridOptions::Smoother::chebyshev, .chebyshev_ratio = 1}), ArgumentError);
+  CHECK_THROWS_AS(Multigrid<>(P, {.chebyshev_ratio = std::numeric_limits<double>::infinity()}), ArgumentError);
   if (P.size() >= 2) {
     auto swapped = P;
     std::swap(swapped[0], swapped[1]);

@@ -16,7 +16,8 @@
 /// - Smoothing is damped block-Jacobi, x ← x + ω B⁻¹(b − A x) with B the 3×3 vertex blocks and
 ///   ω = 4 / (3 λ_max(B⁻¹A)) from a few power iterations per level (the usual safe choice: ω·λ_max
 ///   = 4/3 < 2 keeps every sweep a contraction in the A-norm). Pre- and post-smoothing use the same
-///   sweep count, so the V-cycle is a symmetric positive definite operator, as PCG requires.
+///   sweep count, so the V-cycle is a symmetric positive definite operator, as PCG requires. Or
+///   (MultigridOptions::Smoother::chebyshev) a Chebyshev polynomial in B⁻¹A on [λ_max/ratio, λ_max].
 /// - The coarsest level is solved exactly (Eigen's sparse LDLᵀ).
 /// - The smoothing and residual products run on 3×3 block copies of the level matrices
 ///   (BlockCsr: a third fewer bytes per product than the scalar CSR, the same sums to rounding), or
@@ -164,6 +165,18 @@ struct MultigridOptions {
   /// rounded matrices).
   enum class Storage { csr, block, block_single };
   Storage storage = Storage::block;
+  /// The smoother before and after each coarse correction: `jacobi`, `smoothing_sweeps` damped
+  /// block-Jacobi sweeps (ω above); or `chebyshev`, the Chebyshev polynomial in B⁻¹A of degree
+  /// `chebyshev_degree` that is smallest on [λ/chebyshev_ratio, λ], λ the padded estimate of
+  /// λ_max(B⁻¹A) (Adams, Brezina, Hu & Tuminaro 2003, "Parallel multigrid smoothing: polynomial
+  /// versus Gauss–Seidel", the recurrence of their §2). The same polynomial before and after keeps
+  /// the V-cycle symmetric positive definite (its error factor lies in (−1, 1) on
+  /// (0, λ (1 + 1/ratio))). Degree d costs d − 1 products of the level's matrix per smoothing
+  /// beyond the residual's, where `smoothing_sweeps` Jacobi sweeps cost one each.
+  enum class Smoother { jacobi, chebyshev };
+  Smoother smoother = Smoother::jacobi;
+  int chebyshev_degree = 2;
+  double chebyshev_ratio = 10;
 };
 
 /// The V-cycle preconditioner (see the file comment). Movable; keeps its buffers between calls.
@@ -179,6 +192,9 @@ class Multigrid {
       throw ArgumentError("Multigrid: power_iterations and warm_power_iterations must be at least 1");
     if (options.damping < 0 || !(options.damping < 2)) throw ArgumentError("Multigrid: damping must be in [0, 2) (0: automatic)");
     if (options.coarse_refresh_every < 1) throw ArgumentError("Multigrid: coarse_refresh_every must be at least 1");
+    if (options.chebyshev_degree < 1) throw ArgumentError("Multigrid: chebyshev_degree must be at least 1");
+    if (!(options.chebyshev_ratio > 1) || !std::isfinite(options.chebyshev_ratio))
+      throw ArgumentError("Multigrid: chebyshev_ratio must be a finite number above 1");
     for (std::size_t l = 0; l < prolongations.size(); ++l) {
       if (prolongations[l].rows() % 3 || prolongations[l].cols() % 3)
         throw ShapeError("Multigrid: prolongation " + std::to_string(l) + " (3 DOFs per vertex)", {-1, -1},
@@ -249,7 +265,7 @@ class Multigrid {
       Level& L = levels_[0];
       store_blocks(policy, L, false);
       L.smoother.compute(policy, A);
-      L.omega = options_.damping > 0 ? options_.damping : 4.0 / (3.0 * lambda_max(policy, L));
+      set_spectrum(policy, L);
       return;
     }
     computes_since_refresh_ = 0;
@@ -270,7 +286,7 @@ class Multigrid {
       }
       store_blocks(policy, L, true);
       L.smoother.compute(policy, Al);
-      L.omega = options_.damping > 0 ? options_.damping : 4.0 / (3.0 * lambda_max(policy, L));
+      set_spectrum(policy, L);
       galerkin(policy, l);
     }
   }
@@ -304,7 +320,9 @@ class Multigrid {
     const BlockCsr<S, S>* given_blocks = nullptr;  ///< level 0: the caller's block copy of A, if it gave one
     const BlockCsr<S, S>& blocks() const { return given_blocks ? *given_blocks : block; }
     double omega = 1;
+    double lambda = 1;  ///< the padded estimate of λ_max(B⁻¹A) (the Chebyshev smoother's interval)
     VecX<S> b, x, r, t, v;  ///< v: the power iteration's vector, kept as the next compute's start
+    VecX<S> d;              ///< the Chebyshev smoother's direction
     const SparseMatrix<S>& matrix() const { return A_ref ? *A_ref : *A_coarse; }
   };
 
@@ -417,6 +435,47 @@ class Multigrid {
     return std::max(1.0, 1.1 * lambda);
   }
 
+  /// ω (Jacobi) and λ (Chebyshev) of a level whose smoother was just computed. A given damping
+  /// skips the power iteration only where Jacobi alone uses it.
+  template <exec::HostPolicy P>
+  void set_spectrum(P policy, Level& L) {
+    const bool chebyshev = options_.smoother == MultigridOptions::Smoother::chebyshev;
+    if (options_.damping > 0 && !chebyshev) {
+      L.omega = options_.damping;
+      return;
+    }
+    L.lambda = lambda_max(policy, L);
+    L.omega = options_.damping > 0 ? options_.damping : 4.0 / (3.0 * L.lambda);
+  }
+
+  /// x ← x + p(B⁻¹A) B⁻¹ (b − A x): the Chebyshev smoother (MultigridOptions::Smoother), from
+  /// x = 0 (`from_zero`: the residual is b, no product) or from the current x.
+  template <exec::HostPolicy P>
+  void chebyshev_smooth(P policy, Level& L, bool from_zero) {
+    const S hi = S(L.lambda), lo = S(L.lambda / options_.chebyshev_ratio);
+    const S theta = S(0.5) * (hi + lo), delta = S(0.5) * (hi - lo), sigma = theta / delta;
+    if (from_zero)
+      L.r = L.b;
+    else
+      residual(policy, L);
+    L.d.resize(L.x.size());
+    L.smoother.apply(policy, L.r, L.t);
+    const S inv_theta = S(1) / theta;
+    exec::parallel_for(policy, L.x.size(), [&](Index i) { L.d[i] = inv_theta * L.t[i]; });
+    S rho = S(1) / sigma;
+    for (int k = 1;; ++k) {
+      exec::parallel_for(policy, L.x.size(), [&](Index i) { L.x[i] += L.d[i]; });
+      if (k == options_.chebyshev_degree) break;
+      multiply(policy, L, L.d, L.t);
+      exec::parallel_for(policy, L.x.size(), [&](Index i) { L.r[i] -= L.t[i]; });
+      L.smoother.apply(policy, L.r, L.t);
+      const S rho_next = S(1) / (S(2) * sigma - rho);
+      const S keep = rho_next * rho, step = S(2) * rho_next / delta;
+      exec::parallel_for(policy, L.x.size(), [&](Index i) { L.d[i] = keep * L.d[i] + step * L.t[i]; });
+      rho = rho_next;
+    }
+  }
+
   /// One V-cycle from level l: x_l ≈ A_l⁻¹ b_l, starting from x_l = 0.
   template <exec::HostPolicy P>
   void cycle(P policy, std::size_t l) {
@@ -427,6 +486,7 @@ class Multigrid {
     }
     L.x.setZero();
     auto smooth = [&](bool first) {
+      if (options_.smoother == MultigridOptions::Smoother::chebyshev) return chebyshev_smooth(policy, L, first);
       if (first)
         L.r = L.b;
       else
@@ -435,14 +495,15 @@ class Multigrid {
       const S w = S(L.omega);
       exec::parallel_for(policy, L.x.size(), [&](Index i) { L.x[i] += w * L.t[i]; });
     };
-    for (int s = 0; s < options_.smoothing_sweeps; ++s) smooth(s == 0);
+    const int sweeps = options_.smoother == MultigridOptions::Smoother::chebyshev ? 1 : options_.smoothing_sweeps;
+    for (int s = 0; s < sweeps; ++s) smooth(s == 0);
     residual(policy, L);
     Level& C = levels_[l + 1];
     sparse_multiply(policy, L.Pt, L.r, C.b);
     cycle(policy, l + 1);
     sparse_multiply(policy, L.P, C.x, L.t);
     exec::parallel_for(policy, L.x.size(), [&](Index i) { L.x[i] += L.t[i]; });
-    for (int s = 0; s < options_.smoothing_sweeps; ++s) smooth(false);
+    for (int s = 0; s < sweeps; ++s) smooth(false);
   }
 
   /// L.r = L.b − A L.x
