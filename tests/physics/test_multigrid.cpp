@@ -57,6 +57,22 @@ TEST_CASE("lattice_hierarchy: levels shrink, weights sum to 1 and reproduce affi
   CHECK_THROWS_AS(lattice_hierarchy(exec::seq, box_tet_mesh<double>(2, 2, 2), {.h = -1}), ArgumentError);
 }
 
+/// Checks that `mg` (computed) is symmetric and positive on `trials` pairs of random vectors: PCG's
+/// requirement of a preconditioner.
+template <class Rng>
+void check_symmetric_positive(Multigrid<>& mg, Index n, Rng& rng, int trials) {
+  std::normal_distribution<double> N;
+  for (int trial = 0; trial < trials; ++trial) {
+    VecX<> a(n), b(n), Ma, Mb;
+    for (Index i = 0; i < n; ++i) a[i] = N(rng), b[i] = N(rng);
+    mg.apply(exec::seq, a, Ma);
+    mg.apply(exec::seq, b, Mb);
+    CHECK(std::abs(a.dot(Mb) - b.dot(Ma)) <= 1e-10 * a.norm() * Mb.norm());
+    CHECK(a.dot(Ma) > 0);
+    CHECK(b.dot(Mb) > 0);
+  }
+}
+
 TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG's requirement); seq == omp bitwise") {
   auto s = stiffness_system(16, 4, 3);
   const SparseMatrix<>& A = s.A();
@@ -68,17 +84,8 @@ TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG
     CHECK(mg.damping(l) < 4.0 / 3.0);
   }
   std::mt19937 rng(11);
-  std::normal_distribution<double> N;
   const Index n = A.rows();
-  for (int trial = 0; trial < 20; ++trial) {
-    VecX<> a(n), b(n), Ma, Mb;
-    for (Index i = 0; i < n; ++i) a[i] = N(rng), b[i] = N(rng);
-    mg.apply(exec::seq, a, Ma);
-    mg.apply(exec::seq, b, Mb);
-    CHECK(std::abs(a.dot(Mb) - b.dot(Ma)) <= 1e-10 * a.norm() * Mb.norm());
-    CHECK(a.dot(Ma) > 0);
-    CHECK(b.dot(Mb) > 0);
-  }
+  check_symmetric_positive(mg, n, rng, 20);
   const auto levels_omp = lattice_hierarchy(exec::omp, s.mesh, {.max_coarse_vertices = 40});
   Multigrid<> mg_omp(levels_omp.prolongations);
   mg_omp.compute(exec::omp, A);
@@ -282,17 +289,12 @@ TEST_CASE("Multigrid, Chebyshev smoother: degree 1 is damped Jacobi with omega =
       Multigrid<> mg(levels, options), mg_omp(levels, options);
       mg.compute(exec::seq, A);
       mg_omp.compute(exec::omp, A);
-      for (int trial = 0; trial < 8; ++trial) {
-        VecX<> a(n), b(n), Ma, Mb;
-        for (Index i = 0; i < n; ++i) a[i] = N(rng), b[i] = N(rng);
-        mg.apply(exec::seq, a, Ma);
-        mg.apply(exec::seq, b, Mb);
-        CHECK(std::abs(a.dot(Mb) - b.dot(Ma)) <= 1e-10 * a.norm() * Mb.norm());
-        CHECK(a.dot(Ma) > 0);
-        VecX<> Ma_omp;
-        mg_omp.apply(exec::omp, a, Ma_omp);
-        CHECK(Ma == Ma_omp);
-      }
+      check_symmetric_positive(mg, n, rng, 8);
+      VecX<> a(n), Ma, Ma_omp;
+      for (Index i = 0; i < n; ++i) a[i] = N(rng);
+      mg.apply(exec::seq, a, Ma);
+      mg_omp.apply(exec::omp, a, Ma_omp);
+      CHECK(Ma == Ma_omp);
       ConjugateGradient<Multigrid<>> pcg({.tolerance = 1e-10}, Multigrid<>(levels, options));
       pcg.compute(exec::omp, A);
       VecX<> x;

@@ -163,7 +163,7 @@ class ElasticEnergy {
   template <exec::HostPolicy P>
   S energy(P policy, const Points<S>& x) const {
     physics::detail::require_positions("ElasticEnergy::energy: x", x, n_);
-    return exec::parallel_reduce(policy, T_.rows(), S(0), element_body<detail::ElementOutput::energy>(x), [](S a, S b) { return a + b; });
+    return exec::parallel_reduce(policy, T_.rows(), S(0), element_body<detail::ElementOutput::energy>(x), detail::Sum<S>{});
   }
 
   /// g += ∂E/∂x (#V×3, N).
@@ -183,7 +183,7 @@ class ElasticEnergy {
     physics::detail::require_positions("ElasticEnergy::add_energy_gradient: x", x, n_);
     physics::detail::require_positions("ElasticEnergy::add_energy_gradient: g", g, n_);
     forces_.resize(3, 4 * T_.rows());
-    const S e = exec::parallel_reduce(policy, T_.rows(), S(0), element_body<detail::ElementOutput::energy_and_forces>(x), [](S a, S b) { return a + b; });
+    const S e = exec::parallel_reduce(policy, T_.rows(), S(0), element_body<detail::ElementOutput::energy_and_forces>(x), detail::Sum<S>{});
     gather_forces(policy, g);
     return e;
   }

@@ -278,6 +278,7 @@ class Multigrid {
         L.x.setZero(n);
         L.r.setZero(n);
         L.t.setZero(n);
+        if (options_.smoother == MultigridOptions::Smoother::chebyshev) L.d.setZero(n);
         L.v.resize(0);
       }
       if (l + 1 == levels_.size()) {
@@ -458,7 +459,6 @@ class Multigrid {
       L.r = L.b;
     else
       residual(policy, L);
-    L.d.resize(L.x.size());
     L.smoother.apply(policy, L.r, L.t);
     const S inv_theta = S(1) / theta;
     exec::parallel_for(policy, L.x.size(), [&](Index i) { L.d[i] = inv_theta * L.t[i]; });
