@@ -195,10 +195,24 @@ TeamRun run_team(Index chunks, int threads, Chunk&& chunk) {
   return run;
 }
 
+/// Makes this thread's OpenMP ICVs its own now, once per thread. libgomp keeps a thread's ICVs in
+/// a task it mallocs at the thread's first write of one (omp_set_num_threads: EigenSingleThreaded,
+/// on the serial path below); left to that moment, the first loop that happens to run on the
+/// caller instead of forking — a timing decision — would allocate, and a warm call would not be
+/// allocation-free (tests/core/test_allocation.cpp).
+inline void own_thread_icvs() {
+  thread_local const bool owned = [] {
+    omp_set_num_threads(omp_get_max_threads());
+    return true;
+  }();
+  (void)owned;
+}
+
 /// Runs `serial()` or `parallel(threads)` (a TeamRun) as fork_decision says and records what it
 /// measured. The serial path keeps Eigen single-threaded, as it is inside a region.
 template <class Site, class Serial, class Parallel>
 void dispatch(Index n, Serial&& serial, Parallel&& parallel) {
+  own_thread_icvs();
   SiteCost& site = site_cost<Site>;
   const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
   const int decision = fork_decision(site, n, threads);
