@@ -45,7 +45,11 @@
 //       `_jacobi_svd` with the element Hessians on Eigen's Jacobi SVD (JacobiSvdMuscle, the
 //       baseline of signed_svd_from_eigen); `_coloured` with HessianAssembly::coloured (the library's
 //       default since 2026-12-04; every other row sets the gather, its baseline); `_chebyshev2` the V-cycle
-//       smoothed by MultigridOptions::Smoother::chebyshev of degree 2 (one Jacobi sweep its baseline)
+//       smoothed by MultigridOptions::Smoother::chebyshev of degree 2 (one Jacobi sweep its baseline);
+//       `_gauss_seidel` the V-cycle smoothed by one multicolour block Gauss–Seidel sweep
+//       (Smoother::gauss_seidel; one Jacobi sweep its baseline);
+//       `_chord` with NewtonOptions::chord_below = 0.01 (an iteration whose ‖g‖ fell 100× reuses the
+//       previous Hessian and multigrid; counter `chord`: such iterations), `_coloured` its baseline
 //   BM_frame_73k/<linear>_extrapolated/omp   the same frame from the face simulator's warm start:
 //       2 x_A − x_before, with x_before the frame before A (jaw 0.08 rad, activation 0.05, targets
 //       −0.5 mm: the same step back), solved once at setup from x_A
@@ -293,14 +297,17 @@ using Storage = MultigridOptions::Storage;
 /// `storage`: the multigrid's MultigridOptions (ignored by the other solvers); Storage::csr also
 /// runs PCG's own products on the scalar CSR (ConjugateGradientOptions::block_products = false):
 /// the baseline of every 3×3-block product. `chebyshev_degree` > 0: the Chebyshev smoother of that
-/// degree (MultigridOptions::Smoother), else one damped block-Jacobi sweep.
+/// degree (MultigridOptions::Smoother); < 0: one multicolour block Gauss–Seidel sweep; else one
+/// damped block-Jacobi sweep.
 template <class Linear>
 Linear make_linear(int coarse_refresh_every = 1, Storage storage = Storage::block, int chebyshev_degree = 0) {
   return make_linear_solver<Linear>(
       exec::omp, scene().mesh, {.tolerance = kCgTolerance, .block_products = storage != Storage::csr}, {},
       {.coarse_refresh_every = coarse_refresh_every,
        .storage = storage,
-       .smoother = chebyshev_degree > 0 ? MultigridOptions::Smoother::chebyshev : MultigridOptions::Smoother::jacobi,
+       .smoother = chebyshev_degree > 0   ? MultigridOptions::Smoother::chebyshev
+                   : chebyshev_degree < 0 ? MultigridOptions::Smoother::gauss_seidel
+                                          : MultigridOptions::Smoother::jacobi,
        .chebyshev_degree = std::max(chebyshev_degree, 1)});
 }
 
@@ -347,7 +354,7 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 /// as the face simulator's warm start), not from x_A.
 template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
           NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block, bool Extrapolate = false,
-          bool ForcingSafeguard = true, HessianAssembly Assembly = HessianAssembly::gather, int ChebyshevDegree = 0>
+          bool ForcingSafeguard = true, HessianAssembly Assembly = HessianAssembly::gather, int ChebyshevDegree = 0, int ChordDrop = 0>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
@@ -356,6 +363,7 @@ void BM_frame(benchmark::State& state) {
   NewtonOptions options;
   options.forcing = Forcing;
   options.forcing_safeguard = ForcingSafeguard;
+  options.chord_below = ChordDrop > 0 ? 1.0 / ChordDrop : 0.0;  // a chord step after a ChordDrop-fold drop of ‖g‖
   QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage, ChebyshevDegree));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
@@ -385,13 +393,14 @@ void BM_frame(benchmark::State& state) {
   state.counters["newton_iterations"] = double(report.iterations);
   state.counters["linear_iterations"] = double(report.linear_iterations);
   state.counters["projected"] = double(std::count_if(report.history.begin(), report.history.end(), [](const NewtonIteration& it) { return it.projected; }));
+  state.counters["chord"] = double(std::count_if(report.history.begin(), report.history.end(), [](const NewtonIteration& it) { return it.chord; }));
   state.counters["fps"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
   multigrid_counters(state, newton.linear_solver());
   if (std::getenv("SIMSR_BENCH_NEWTON_HISTORY"))  // the last frame's Newton iterations, on stderr
     for (const NewtonIteration& it : report.history)
-      std::fprintf(stderr, "BM_frame (%s, coarse levels every %d, forcing %s): iteration %lld |g| %.3e step %.3g backtracks %lld PCG %lld\n",
+      std::fprintf(stderr, "BM_frame (%s, coarse levels every %d, forcing %s): iteration %lld |g| %.3e step %.3g backtracks %lld PCG %lld eta %.3g%s\n",
                    typeid(Linear).name(), CoarseRefreshEvery, Forcing == NewtonOptions::Forcing::adaptive ? "adaptive" : "fixed", (long long)it.iteration,
-                   it.gradient_norm, it.step_length, (long long)it.backtracks, (long long)it.linear_iterations);
+                   it.gradient_norm, it.step_length, (long long)it.backtracks, (long long)it.linear_iterations, it.linear_tolerance, it.chord ? " chord" : "");
 }
 
 using Cholesky = SparseCholesky<>;
@@ -431,6 +440,8 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, Newton
 // the same with the element Hessians' SVD on Eigen's Jacobi sweeps (the baseline of signed_svd_from_eigen)
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, 2)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, 0, 100)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chord_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, -1)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_gauss_seidel_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, JacobiSvdMuscle, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_jacobi_svd_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)
 BENCHMARK_TEMPLATE(BM_frame, CholmodCholesky<>, exec::omp_t)->Name("BM_frame_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);

@@ -153,4 +153,61 @@ TEST_CASE("greedy_element_colouring: out-of-range and repeated vertices are Mesh
   CHECK_THROWS_AS(greedy_element_colouring(Tets(0, 4), -1), ArgumentError);
 }
 
+TEST_CASE("greedy_graph_colouring: random symmetric graphs (self-loops listed or not) are coloured first-fit with no adjacent pair alike; one-sided or out-of-range entries refused") {
+  std::mt19937 rng(41);
+  for (int trial = 0; trial < 60; ++trial) {
+    const Index n = Index(rng() % 200);
+    const double p = std::uniform_real_distribution<double>(0, 0.2)(rng);
+    std::vector<std::vector<int>> adj(static_cast<std::size_t>(n));
+    std::vector<std::vector<char>> edge(static_cast<std::size_t>(n), std::vector<char>(static_cast<std::size_t>(n), 0));
+    for (Index i = 0; i < n; ++i) {
+      if (trial % 2) adj[std::size_t(i)].push_back(int(i));  // a matrix pattern lists the diagonal
+      for (Index j = i + 1; j < n; ++j)
+        if (std::bernoulli_distribution(p)(rng)) {
+          adj[std::size_t(i)].push_back(int(j)), adj[std::size_t(j)].push_back(int(i));
+          edge[std::size_t(i)][std::size_t(j)] = edge[std::size_t(j)][std::size_t(i)] = 1;
+        }
+    }
+    std::vector<int> offsets{0}, flat;
+    for (auto& a : adj) {
+      std::shuffle(a.begin(), a.end(), rng);
+      flat.insert(flat.end(), a.begin(), a.end());
+      offsets.push_back(int(flat.size()));
+    }
+    const ElementColouring c = greedy_graph_colouring(offsets.data(), flat.data(), n);
+    REQUIRE(c.num_elements() == n);
+    std::vector<int> seen(std::size_t(n), 0);
+    for (Index k = 0; k < c.num_colours(); ++k) {
+      CHECK(c.size(k) > 0);
+      for (Index i = 0; i < c.size(k); ++i) {
+        const Index v = c.element(k, i);
+        ++seen[std::size_t(v)];
+        CHECK(c.colour_of[std::size_t(v)] == k);
+        if (i > 0) CHECK(c.element(k, i - 1) < v);
+      }
+    }
+    for (Index v = 0; v < n; ++v) {
+      CHECK(seen[std::size_t(v)] == 1);
+      // first fit: the smallest colour no earlier neighbour has (brute force)
+      Index expected = 0;
+      const auto taken = [&](Index colour) {
+        for (Index w = 0; w < v; ++w)
+          if (edge[std::size_t(v)][std::size_t(w)] && c.colour_of[std::size_t(w)] == colour) return true;
+        return false;
+      };
+      while (taken(expected)) ++expected;
+      CHECK(c.colour_of[std::size_t(v)] == expected);
+      for (Index w = 0; w < n; ++w)
+        if (edge[std::size_t(v)][std::size_t(w)]) CHECK(c.colour_of[std::size_t(v)] != c.colour_of[std::size_t(w)]);
+    }
+  }
+  // 0 → 1 listed, 1 → 0 not: refused (they would share colour 0)
+  const std::vector<int> one_sided_offsets{0, 1, 1}, one_sided{1};
+  CHECK_THROWS_AS(greedy_graph_colouring(one_sided_offsets.data(), one_sided.data(), 2), ArgumentError);
+  const std::vector<int> out_offsets{0, 1}, out_of_range{3};
+  CHECK_THROWS_AS(greedy_graph_colouring(out_offsets.data(), out_of_range.data(), 1), ArgumentError);
+  const std::vector<int> bad_offsets{0, 2, 1}, two{1, 0};
+  CHECK_THROWS_AS(greedy_graph_colouring(bad_offsets.data(), two.data(), 2), ArgumentError);
+}
+
 }  // namespace mesh_test_element_colouring

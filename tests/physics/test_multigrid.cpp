@@ -310,6 +310,95 @@ TEST_CASE("Multigrid, Chebyshev smoother: degree 1 is damped Jacobi with omega =
   MESSAGE("beam 16x4x4: PCG iterations with one damped block-Jacobi sweep: ", pcg_jacobi.solve(exec::omp, s.b, x).iterations);
 }
 
+TEST_CASE("Multigrid, Gauss-Seidel smoother: the V-cycle equals a dense multicolour block Gauss-Seidel two-level cycle; symmetric positive definite, seq == omp bitwise; PCG reaches LDLT's solution in fewer iterations than with Jacobi") {
+  auto s = stiffness_system(16, 4, 7);
+  const SparseMatrix<>& A = s.A();
+  const Index n = A.rows(), nv = n / 3;
+  std::mt19937 rng(8);
+  std::normal_distribution<double> N;
+  // two levels, the second solved directly: the cycle written out with dense matrices
+  const auto two_levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40, .max_levels = 1}).prolongations;
+  REQUIRE(two_levels.size() == 1);
+  for (const int sweeps : {1, 2}) {
+    CAPTURE(sweeps);
+    Multigrid<> mg(two_levels, {.smoothing_sweeps = sweeps, .smoother = MultigridOptions::Smoother::gauss_seidel});
+    mg.compute(exec::seq, A);
+    VecX<> r(n), z;
+    for (Index i = 0; i < n; ++i) r[i] = N(rng);
+    mg.apply(exec::seq, r, z);
+    // the reference: the vertex colours of A's block pattern, vertices updated one at a time
+    BlockCsr<> blocks;
+    blocks.assign(exec::seq, A);
+    const ElementColouring colours = greedy_graph_colouring(blocks.block_outer(), blocks.block_inner(), nv);
+    for (Index v = 0; v < nv; ++v)  // a proper colouring of the coupling: no block between two vertices of a colour
+      for (Index w = 0; w < nv; ++w)
+        if (v != w && colours.colour_of[std::size_t(v)] == colours.colour_of[std::size_t(w)]) REQUIRE(blocks.block(v, w).isZero(0));
+    const Eigen::MatrixXd Ad = Eigen::MatrixXd(A);
+    const auto sweep = [&](VecX<>& x, bool forward) {
+      for (int k = 0; k < sweeps; ++k)
+        for (Index q = 0; q < colours.num_colours(); ++q) {
+          const Index c = forward ? q : colours.num_colours() - 1 - q;
+          for (Index i = 0; i < colours.size(c); ++i) {
+            const Index v = colours.element(c, i);
+            const Vec3<> res = r.segment<3>(3 * v) - Ad.middleRows(3 * v, 3) * x;
+            x.segment<3>(3 * v) += Ad.block(3 * v, 3 * v, 3, 3).inverse() * res;
+          }
+        }
+    };
+    VecX<> x = VecX<>::Zero(n);
+    sweep(x, true);
+    // the coarse correction: P with the rows of decoupled DOFs (no off-diagonal entry: the identity
+    // rows of fixed DOFs) zeroed, PᵀAP solved
+    Eigen::MatrixXd P = Eigen::MatrixXd(two_levels[0]);
+    for (Index i = 0; i < n; ++i) {
+      Eigen::RowVectorXd off = Ad.row(i);
+      off[i] = 0;
+      if (off.isZero(0)) P.row(i).setZero();
+    }
+    Eigen::MatrixXd Ac = P.transpose() * Ad * P;
+    for (Index i = 0; i < Ac.rows(); ++i)
+      if (Ac.row(i).isZero(0)) Ac(i, i) = 1;
+    Ac.diagonal().array() += 1e-10 * Ac.diagonal().cwiseAbs().maxCoeff();  // the coarsest level's shift (Multigrid::factorize_coarsest)
+    x += P * Ac.ldlt().solve(P.transpose() * (r - Ad * x));
+    sweep(x, false);
+    MESSAGE("sweeps ", sweeps, ": the V-cycle against the dense reference, relative difference ", (z - x).norm() / x.norm());
+    CHECK((z - x).norm() <= 1e-10 * x.norm());
+  }
+
+  const Eigen::SimplicialLDLT<SparseMatrix<>> ldlt(A);
+  REQUIRE(ldlt.info() == Eigen::Success);
+  const VecX<> ref = ldlt.solve(s.b);
+  const auto levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
+  REQUIRE(levels.size() >= 2);
+  ConjugateGradient<Multigrid<>> pcg_jacobi({.tolerance = 1e-10}, Multigrid<>(levels));
+  pcg_jacobi.compute(exec::omp, A);
+  VecX<> x;
+  const Index jacobi_iterations = pcg_jacobi.solve(exec::omp, s.b, x).iterations;
+  for (const auto storage : {MultigridOptions::Storage::block, MultigridOptions::Storage::block_single}) {
+    const MultigridOptions options{.storage = storage, .smoother = MultigridOptions::Smoother::gauss_seidel};
+    Multigrid<> mg(levels, options), mg_omp(levels, options);
+    mg.compute(exec::seq, A);
+    mg_omp.compute(exec::omp, A);
+    check_symmetric_positive(mg, n, rng, 8);
+    VecX<> a(n), Ma, Ma_omp;
+    for (Index i = 0; i < n; ++i) a[i] = N(rng);
+    mg.apply(exec::seq, a, Ma);
+    mg_omp.apply(exec::omp, a, Ma_omp);
+    CHECK(Ma == Ma_omp);
+    ConjugateGradient<Multigrid<>> pcg({.tolerance = 1e-10}, Multigrid<>(levels, options));
+    pcg.compute(exec::omp, A);
+    const auto report = pcg.solve(exec::omp, s.b, x);
+    CHECK(report.converged);
+    CHECK((x - ref).norm() <= 1e-8 * ref.norm());
+    MESSAGE("beam 16x4x4: PCG iterations with one Gauss-Seidel sweep (", storage == MultigridOptions::Storage::block ? "double" : "single",
+            " blocks): ", report.iterations, ", with one damped block-Jacobi sweep: ", jacobi_iterations);
+    CHECK(report.iterations < jacobi_iterations);
+  }
+  // the csr storage has no blocks to sweep
+  CHECK_THROWS_AS(Multigrid<>(levels, {.storage = MultigridOptions::Storage::csr, .smoother = MultigridOptions::Smoother::gauss_seidel}),
+                  ArgumentError);
+}
+
 TEST_CASE("Multigrid: bad input is a typed error") {
   auto s = stiffness_system(8, 2, 1);
   auto P = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 10}).prolongations;

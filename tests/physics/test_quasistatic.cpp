@@ -406,3 +406,87 @@ TEST_CASE("Hessian::regularized: where the exact Hessian is indefinite it is shi
   CHECK(ra.iterations == rr.iterations);
   CHECK(xa == xr);
 }
+
+namespace {
+/// Gravity that counts its add_hessian calls: how many Hessians a Newton solve assembled.
+struct CountedGravity {
+  const Gravity<>* gravity;
+  mutable int hessians = 0;
+  template <class P>
+  double energy(P p, const Points<>& x) const { return gravity->energy(p, x); }
+  template <class P>
+  void add_gradient(P p, const Points<>& x, Points<>& g) const { gravity->add_gradient(p, x, g); }
+  template <class P>
+  void add_hessian(P p, const Points<>& x, BlockHessian<>& H, Definiteness d) const {
+    ++hessians;
+    gravity->add_hessian(p, x, H, d);
+  }
+};
+}  // namespace
+
+TEST_CASE("NewtonOptions::chord_below: after a 100x drop of the gradient the old Hessian is reused; the same equilibrium, fewer Hessians; PCG and Cholesky") {
+  // the muscle block of the safeguard case (Newton's contraction limited by the fibre curve's kink),
+  // random end loadings
+  const auto box = box_tet_mesh<double>(2, 2, 6, Vec3<>(0, 0, 0), Vec3<>(0.1, 0.1, 0.3));
+  const TetMesh<double> mesh = discretize::bcc_lattice(box, 0.025).mesh;
+  std::vector<MuscleFibre<>> fibres(std::size_t(mesh.num_tets()), MuscleFibre<>{Vec3<>::UnitZ(), 0.3});
+  ElasticEnergy<TeranMuscle<>> flesh(mesh, TeranMuscle<>(), fibres);
+  Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int chords = 0, hessians_newton = 0, hessians_chord = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    BoneAttachments<> ends(mesh.V);
+    ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
+    ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
+    ends.set_transform("bottom", RigidTransform<>{Eigen::AngleAxisd(0.4 * u(rng), Vec3<>::UnitZ()).toRotationMatrix(),
+                                                  Vec3<>(0.03 * u(rng), 0.03 * u(rng), 0.03 * u(rng))});
+    const auto solve = [&]<class Linear>(Linear linear, double chord_below, auto policy) {
+      NewtonOptions o;
+      o.relative_tolerance = 1e-9;
+      o.forcing = NewtonOptions::Forcing::adaptive;
+      o.chord_below = chord_below;
+      QuasistaticSolver<Linear> newton(mesh.num_vertices(), mesh.T, o, std::move(linear));
+      CountedGravity counted{&gravity};
+      Points<> x = mesh.V;
+      const NewtonReport r = newton.solve(policy, x, ends.boundary(), flesh, counted);
+      CHECK(r.converged);
+      int chord_iterations = 0;
+      for (std::size_t k = 0; k < r.history.size(); ++k)
+        if (r.history[k].chord) {
+          ++chord_iterations;
+          REQUIRE(k > 0);
+          // only after a 100× drop of ‖g‖ (the previous iteration's ‖g‖ against this one's)
+          CHECK(r.history[k].gradient_norm <= chord_below * r.history[k - 1].gradient_norm);
+          CHECK(r.history[k].projected == r.history[k - 1].projected);
+        }
+      // every iteration that is no chord step assembles one Hessian (two where it projects after trying the exact one)
+      const auto full = std::count_if(r.history.begin(), r.history.end(), [](const NewtonIteration& it) { return !it.chord; });
+      CHECK(counted.hessians >= full);
+      return std::make_tuple(x, r, chord_iterations, counted.hessians);
+    };
+    using Pcg = ConjugateGradient<BlockJacobi<>>;
+    const auto [x_newton, r_newton, no_chords, h_newton] = solve(Pcg({.tolerance = 1e-10}), 0.0, exec::omp);
+    const auto [x_chord, r_chord, chord_iterations, h_chord] = solve(Pcg({.tolerance = 1e-10}), 0.01, exec::omp);
+    CHECK(no_chords == 0);
+    const double moved = (x_newton - mesh.V).cwiseAbs().maxCoeff();
+    REQUIRE(moved > 1e-3);
+    CHECK((x_chord - x_newton).cwiseAbs().maxCoeff() <= 1e-5 * moved);
+    CHECK(h_chord + chord_iterations <= h_newton + 2);  // a chord iteration saves its Hessian (one more iteration may be taken)
+    // seq == omp bitwise with chord steps as without
+    const auto [x_seq, r_seq, chord_seq, h_seq] = solve(Pcg({.tolerance = 1e-10}), 0.01, exec::seq);
+    CHECK((x_seq - x_chord).cwiseAbs().maxCoeff() == 0);
+    CHECK(chord_seq == chord_iterations);
+    // a direct solver reuses its factorization
+    const auto [x_direct, r_direct, chord_direct, h_direct] = solve(SparseCholesky<>{}, 0.01, exec::omp);
+    const auto [x_direct_newton, r_direct_newton, no_chords_direct, h_direct_newton] = solve(SparseCholesky<>{}, 0.0, exec::omp);
+    CHECK((x_direct - x_direct_newton).cwiseAbs().maxCoeff() <= 1e-5 * moved);
+    CHECK(h_direct + chord_direct <= h_direct_newton + 2);
+    chords += chord_iterations + chord_direct;
+    hessians_newton += h_newton;
+    hessians_chord += h_chord;
+  }
+  MESSAGE("8 random loadings: chord steps (PCG and LDLT) ", chords, "; Hessians assembled (PCG) full Newton ", hessians_newton, ", with chords ", hessians_chord);
+  CHECK(chords > 0);
+  CHECK(hessians_chord < hessians_newton);
+}

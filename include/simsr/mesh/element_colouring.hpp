@@ -119,4 +119,45 @@ ElementColouring greedy_element_colouring(const Eigen::MatrixBase<DC>& cells, In
   return greedy_colouring(offsets, vertices, num_vertices);
 }
 
+/// First-fit greedy colouring of the nodes of a graph given as adjacency lists in CSR (node i's
+/// neighbours are adjacent[offsets[i], offsets[i+1]); i itself may be listed, it is skipped): no
+/// two adjacent nodes share a colour (distance-1, where greedy_colouring's cells conflict through a
+/// shared vertex). For a symmetric sparsity pattern, its rows: the rows of one colour couple to
+/// none of the others, so a Gauss–Seidel sweep updates them side by side (physics::Multigrid's
+/// Smoother::gauss_seidel). The adjacency must be symmetric (j lists i where i lists j): an
+/// entry without its mirror is an ArgumentError, as is an index out of range or bad offsets.
+inline ElementColouring greedy_graph_colouring(const int* offsets, const int* adjacent, Index num_nodes) {
+  if (num_nodes < 0) throw ArgumentError("greedy_graph_colouring: negative node count " + std::to_string(num_nodes));
+  if (offsets[0] != 0) throw ArgumentError("greedy_graph_colouring: offsets must start at 0");
+  ElementColouring out;
+  out.colour_of.assign(std::size_t(num_nodes), -1);
+  std::vector<Index> forbidden;  // forbidden[colour] == i + 1: a neighbour of node i has that colour
+  Index colours = 0;
+  for (Index i = 0; i < num_nodes; ++i) {
+    if (offsets[i + 1] < offsets[i]) throw ArgumentError("greedy_graph_colouring: offsets decrease at node " + std::to_string(i));
+    for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+      const Index j = adjacent[k];
+      if (j < 0 || j >= num_nodes)
+        throw ArgumentError("greedy_graph_colouring: node " + std::to_string(i) + " lists neighbour " + std::to_string(j) + " outside [0, " +
+                            std::to_string(num_nodes) + ")");
+      if (j < i && out.colour_of[std::size_t(j)] >= 0) forbidden[std::size_t(out.colour_of[std::size_t(j)])] = i + 1;
+    }
+    Index c = 0;
+    while (c < colours && forbidden[std::size_t(c)] == i + 1) ++c;
+    if (c == colours) forbidden.push_back(0), ++colours;
+    out.colour_of[std::size_t(i)] = c;
+  }
+  // symmetry: every listed pair is listed both ways (a one-sided entry would let two coupled nodes share a colour)
+  for (Index i = 0; i < num_nodes; ++i)
+    for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+      const Index j = adjacent[k];
+      if (j == i || out.colour_of[std::size_t(i)] != out.colour_of[std::size_t(j)]) continue;
+      throw ArgumentError("greedy_graph_colouring: node " + std::to_string(i) + " lists " + std::to_string(j) + " but not the other way round: the adjacency must be symmetric");
+    }
+  std::vector<Index> first;
+  detail::bucket_by_key(num_nodes, colours, [&](Index i) { return out.colour_of[std::size_t(i)]; }, first, out.elements);
+  out.offsets = std::move(first);
+  return out;
+}
+
 }  // namespace simsr

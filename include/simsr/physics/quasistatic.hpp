@@ -49,6 +49,7 @@ struct NewtonIteration {
   double tolerance = 0;           ///< the gradient norm that counts as converged at this iteration (N)
   bool projected = false;         ///< the definiteness-fixed Hessian was used
   double shift = 0;               ///< Hessian::regularized: the τ of H + τ·mean|diag H|·I used (0: H itself)
+  bool chord = false;             ///< NewtonOptions::chord_below: solved with the previous iteration's Hessian
 };
 
 /// Options of QuasistaticSolver.
@@ -108,6 +109,17 @@ struct NewtonOptions {
   /// iterations instead of a full solve to the solver's tolerance (bench_physics,
   /// BM_frame_73k/…_inexact…). false: Eisenstat–Walker's choice alone (the baseline).
   bool forcing_safeguard = true;
+  /// Chord steps (Shamanskii's modified Newton; Kelley 1995 §5.4.3 / Kelley 2003 §2.3): an
+  /// iteration whose gradient norm is at most chord_below × the previous iteration's solves with
+  /// the previous iteration's Hessian and linear-solver setup (factorization, multigrid levels)
+  /// instead of assembling and setting up anew. A gradient that fell that much says Newton is in
+  /// its fast local phase, where the iterate moved little and the Hessian with it: the old one
+  /// still gives a step that contracts by about ‖H_old⁻¹(H − H_old)‖, enough for a last step that
+  /// only has to reach the tolerance, for the price of a solve. It is adaptive by construction:
+  /// a chord step that contracts less than chord_below makes the next iteration a full Newton one,
+  /// and the line search still guards every step. Only after a converged linear solve. 0: off
+  /// (every iteration assembles its Hessian: the baseline).
+  double chord_below = 0;
   /// Called after every iteration (progress lines for long runs).
   std::function<void(const NewtonIteration&)> progress;
 };
@@ -179,6 +191,8 @@ class QuasistaticSolver {
     const double size = double((x.colwise().maxCoeff() - x.colwise().minCoeff()).norm());
     last_shift_ = 0;
     double accepted = std::numeric_limits<double>::quiet_NaN();  // the energy of the last accepted step's x
+    double last_gnorm = 0;                 // ‖g‖ of the previous iteration (NewtonOptions::chord_below)
+    bool last_setup_reusable = false;      // the linear solver still holds that iteration's converged setup
     for (Index it = 0;; ++it) {
       // the line search evaluated the energy at this x already (the same sum of the same terms:
       // the same bits), so an iteration after the first does not evaluate it again
@@ -209,7 +223,21 @@ class QuasistaticSolver {
       const bool regularized = options_.hessian == NewtonOptions::Hessian::regularized;
       // after an iteration that needed τ > 10⁻³ the exact Hessian is not tried: the search starts at τ/10
       const bool warm = regularized && last_shift_ > 1e-3 * (1 + 1e-9);
-      if (!projected) {
+      bool chord = last_setup_reusable && options_.chord_below > 0 && gnorm <= options_.chord_below * last_gnorm;
+      if (chord) {
+        // the previous iteration's matrix and setup (NewtonOptions::chord_below); a solve that does
+        // not converge or does not descend makes this a full Newton iteration after all
+        info = linear_.solve(policy, rhs_, d_);
+        slope = double(g_.dot(d_));
+        if (info.converged && slope < 0 && d_.allFinite()) {
+          projected = last_projected_;
+          shift = last_shift_;
+        } else {
+          chord = false;
+          info = {.iterations = info.iterations};
+        }
+      }
+      if (!chord && !projected) {
         if (warm) {
           assemble_hessian(policy, x, Definiteness::exact, terms...);
           projected = true;
@@ -228,11 +256,14 @@ class QuasistaticSolver {
           }
         }
       }
-      last_shift_ = shift;
-      if (projected) {
+      if (!chord) last_shift_ = shift;
+      if (projected && !chord) {
         newton_direction(policy, x, Definiteness::project, info, terms...);
         slope = double(g_.dot(d_));
       }
+      last_projected_ = projected;
+      last_setup_reusable = info.converged;
+      last_gnorm = gnorm;
       if (!(slope < 0) || !d_.allFinite()) {  // still no descent (an unconverged iterative solve): fall back to −g
         d_ = -g_;
         slope = -double(g_.squaredNorm());
@@ -270,7 +301,8 @@ class QuasistaticSolver {
                                    .linear_tolerance = forcing.linear_tolerance(),
                                    .tolerance = tolerance,
                                    .projected = projected,
-                                   .shift = shift};
+                                   .shift = shift,
+                                   .chord = chord};
       report.history.push_back(record);
       if (options_.progress) options_.progress(record);
     }
@@ -414,6 +446,7 @@ class QuasistaticSolver {
   std::vector<std::pair<S*, S>> shifted_diagonal_;  ///< its free diagonal entries and their exact values
   double magnitude_ = 0;
   double last_shift_ = 0;  ///< Hessian::regularized: the τ of the last iteration (0: unshifted), reset by each solve
+  bool last_projected_ = false;  ///< the last iteration used the projected Hessian (what a chord step reuses)
 };
 
 }  // namespace simsr::physics

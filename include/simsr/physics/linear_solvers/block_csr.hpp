@@ -20,6 +20,7 @@
 ///     B.multiply(exec::omp, x, y);     // y = A x
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -113,6 +114,9 @@ class BlockCsr {
   Index rows() const { return 3 * block_rows_; }
   Index cols() const { return 3 * block_cols_; }
   Index num_blocks() const { return Index(inner_.size()); }
+  /// Changes whenever assign() analysed a new block pattern (unique over all BlockCsr objects:
+  /// what a colouring or ordering computed from the pattern is checked against).
+  std::uint64_t pattern_version() const { return version_; }
   /// Bytes the product streams for the matrix (values and block indices).
   std::size_t matrix_bytes() const { return values_.size() * sizeof(Value) + (inner_.size() + outer_.size()) * sizeof(int); }
   /// Block (i, j) as a dense 3×3 (zero where none is stored), for checks.
@@ -157,6 +161,8 @@ class BlockCsr {
       throw ArgumentError("BlockCsr: " + std::to_string(inner_.size()) + " blocks are more than 32-bit slots can address");
     values_.assign(9 * inner_.size(), Value(0));
     source_.remember(A);
+    static std::atomic<std::uint64_t> versions{0};
+    version_ = ++versions;
   }
 
   Index block_rows_ = 0, block_cols_ = 0;
@@ -164,6 +170,7 @@ class BlockCsr {
   std::vector<Value> values_;           ///< 9 per block, row-major
   std::vector<std::uint32_t> slot_;     ///< CSR entry k → its index in values_
   detail::CsrPattern<int> source_;      ///< the pattern analysed (compared at every assign)
+  std::uint64_t version_ = 0;           ///< pattern_version()
 };
 
 }  // namespace simsr::physics

@@ -76,6 +76,8 @@ class BlockJacobi {
   void apply(P policy, const VecX<S>& r, VecX<S>& z) const {
     exec::parallel_for(policy, Index(inv_.size()), [&](Index v) { z.template segment<3>(3 * v).noalias() = inv_[std::size_t(v)] * r.template segment<3>(3 * v); });
   }
+  /// The inverse of vertex v's 3×3 diagonal block (as apply uses it), after compute().
+  const Mat3<S>& inverse_block(Index v) const { return inv_[std::size_t(v)]; }
 
  private:
   std::vector<Mat3<S>, Eigen::aligned_allocator<Mat3<S>>> inv_;

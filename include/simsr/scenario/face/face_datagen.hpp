@@ -227,6 +227,10 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
   // the products' storage changes frames to rounding, the lagged levels by PCG's tolerance
   f.add(std::int64_t(o.linear.block_products)).add(std::int64_t(o.multigrid.storage)).add(std::int64_t(o.multigrid.coarse_refresh_every));
   f.add(std::int64_t(o.multigrid.smoothing_sweeps)).add(o.multigrid.damping).add(std::int64_t(o.multigrid.power_iterations)).add(std::int64_t(o.multigrid.warm_power_iterations));
+  // the smoother and Newton's schedule (forcing, Hessian fallback, chord steps) change frames by PCG's tolerance
+  f.add(std::int64_t(o.multigrid.smoother)).add(std::int64_t(o.multigrid.chebyshev_degree)).add(o.multigrid.chebyshev_ratio);
+  f.add(std::int64_t(o.newton.forcing)).add(o.newton.forcing_max).add(std::int64_t(o.newton.forcing_safeguard)).add(std::int64_t(o.newton.hessian));
+  f.add(o.newton.chord_below).add(o.newton.step_tolerance).add(o.newton.reference_force);
   if (p) {
     f.add(p->weights);
     for (const auto& n : p->names) f.add_bytes(n.data(), n.size());
