@@ -73,6 +73,31 @@ void check_symmetric_positive(Multigrid<>& mg, Index n, Rng& rng, int trials) {
   }
 }
 
+/// A smoother's checks on the system A x = b whose solution is `ref`: the V-cycle with `options`
+/// symmetric positive, seq == omp bitwise, and PCG to 1e-10 reaching ref. Returns PCG's iterations.
+template <class Rng>
+Index check_smoother(const std::vector<SparseMatrix<>>& levels, const MultigridOptions& options, const SparseMatrix<>& A, const VecX<>& b,
+                     const VecX<>& ref, Rng& rng) {
+  const Index n = A.rows();
+  std::normal_distribution<double> N;
+  Multigrid<> mg(levels, options), mg_omp(levels, options);
+  mg.compute(exec::seq, A);
+  mg_omp.compute(exec::omp, A);
+  check_symmetric_positive(mg, n, rng, 8);
+  VecX<> a(n), Ma, Ma_omp;
+  for (Index i = 0; i < n; ++i) a[i] = N(rng);
+  mg.apply(exec::seq, a, Ma);
+  mg_omp.apply(exec::omp, a, Ma_omp);
+  CHECK(Ma == Ma_omp);
+  ConjugateGradient<Multigrid<>> pcg({.tolerance = 1e-10}, Multigrid<>(levels, options));
+  pcg.compute(exec::omp, A);
+  VecX<> x;
+  const auto report = pcg.solve(exec::omp, b, x);
+  CHECK(report.converged);
+  CHECK((x - ref).norm() <= 1e-8 * ref.norm());
+  return report.iterations;
+}
+
 TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG's requirement); seq == omp bitwise") {
   auto s = stiffness_system(16, 4, 3);
   const SparseMatrix<>& A = s.A();
@@ -286,22 +311,8 @@ TEST_CASE("Multigrid, Chebyshev smoother: degree 1 is damped Jacobi with omega =
       CAPTURE(degree);
       CAPTURE(chebyshev_ratio);
       const MultigridOptions options{.smoother = MultigridOptions::Smoother::chebyshev, .chebyshev_degree = degree, .chebyshev_ratio = chebyshev_ratio};
-      Multigrid<> mg(levels, options), mg_omp(levels, options);
-      mg.compute(exec::seq, A);
-      mg_omp.compute(exec::omp, A);
-      check_symmetric_positive(mg, n, rng, 8);
-      VecX<> a(n), Ma, Ma_omp;
-      for (Index i = 0; i < n; ++i) a[i] = N(rng);
-      mg.apply(exec::seq, a, Ma);
-      mg_omp.apply(exec::omp, a, Ma_omp);
-      CHECK(Ma == Ma_omp);
-      ConjugateGradient<Multigrid<>> pcg({.tolerance = 1e-10}, Multigrid<>(levels, options));
-      pcg.compute(exec::omp, A);
-      VecX<> x;
-      const auto report = pcg.solve(exec::omp, s.b, x);
-      CHECK(report.converged);
-      CHECK((x - ref).norm() <= 1e-8 * ref.norm());
-      if (chebyshev_ratio == 10.0) MESSAGE("beam 16x4x4: PCG iterations with Chebyshev degree ", degree, ": ", report.iterations);
+      const Index iterations = check_smoother(levels, options, A, s.b, ref, rng);
+      if (chebyshev_ratio == 10.0) MESSAGE("beam 16x4x4: PCG iterations with Chebyshev degree ", degree, ": ", iterations);
     }
   }
   ConjugateGradient<Multigrid<>> pcg_jacobi({.tolerance = 1e-10}, Multigrid<>(levels));
@@ -376,23 +387,10 @@ TEST_CASE("Multigrid, Gauss-Seidel smoother: the V-cycle equals a dense multicol
   const Index jacobi_iterations = pcg_jacobi.solve(exec::omp, s.b, x).iterations;
   for (const auto storage : {MultigridOptions::Storage::block, MultigridOptions::Storage::block_single}) {
     const MultigridOptions options{.storage = storage, .smoother = MultigridOptions::Smoother::gauss_seidel};
-    Multigrid<> mg(levels, options), mg_omp(levels, options);
-    mg.compute(exec::seq, A);
-    mg_omp.compute(exec::omp, A);
-    check_symmetric_positive(mg, n, rng, 8);
-    VecX<> a(n), Ma, Ma_omp;
-    for (Index i = 0; i < n; ++i) a[i] = N(rng);
-    mg.apply(exec::seq, a, Ma);
-    mg_omp.apply(exec::omp, a, Ma_omp);
-    CHECK(Ma == Ma_omp);
-    ConjugateGradient<Multigrid<>> pcg({.tolerance = 1e-10}, Multigrid<>(levels, options));
-    pcg.compute(exec::omp, A);
-    const auto report = pcg.solve(exec::omp, s.b, x);
-    CHECK(report.converged);
-    CHECK((x - ref).norm() <= 1e-8 * ref.norm());
+    const Index iterations = check_smoother(levels, options, A, s.b, ref, rng);
     MESSAGE("beam 16x4x4: PCG iterations with one Gauss-Seidel sweep (", storage == MultigridOptions::Storage::block ? "double" : "single",
-            " blocks): ", report.iterations, ", with one damped block-Jacobi sweep: ", jacobi_iterations);
-    CHECK(report.iterations < jacobi_iterations);
+            " blocks): ", iterations, ", with one damped block-Jacobi sweep: ", jacobi_iterations);
+    CHECK(iterations < jacobi_iterations);
   }
   // the csr storage has no blocks to sweep
   CHECK_THROWS_AS(Multigrid<>(levels, {.storage = MultigridOptions::Storage::csr, .smoother = MultigridOptions::Smoother::gauss_seidel}),

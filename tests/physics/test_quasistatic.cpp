@@ -253,24 +253,38 @@ TEST_CASE("Forcing::adaptive (inexact Newton): the same equilibrium to the toler
   CHECK((x - x_fixed).cwiseAbs().maxCoeff() <= 1e-6 * moved);
 }
 
-TEST_CASE("Forcing::adaptive's safeguard (Kelley): no linear solve asked for much below the Newton tolerance, the same equilibrium in fewer PCG iterations") {
-  // a muscle block (Teran: its passive fibre curve's slope jumps at λ = 1, so Newton's contraction
-  // is limited) on a BCC lattice, its ends turned and pulled by random amounts
-  const auto box = box_tet_mesh<double>(2, 2, 6, Vec3<>(0, 0, 0), Vec3<>(0.1, 0.1, 0.3));
-  const TetMesh<double> mesh = discretize::bcc_lattice(box, 0.025).mesh;
-  std::vector<MuscleFibre<>> fibres(std::size_t(mesh.num_tets()), MuscleFibre<>{Vec3<>::UnitZ(), 0.3});
-  ElasticEnergy<TeranMuscle<>> flesh(mesh, TeranMuscle<>(), fibres);
-  Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
-  using Pcg = ConjugateGradient<BlockJacobi<>>;
-  std::mt19937 rng(17);
-  std::uniform_real_distribution<double> u(-1, 1);
-  Index linear_safeguarded = 0, linear_eisenstat_walker = 0;
-  for (int trial = 0; trial < 6; ++trial) {
+namespace {
+/// A muscle block (Teran: its passive fibre curve's slope jumps at λ = 1, so Newton's contraction
+/// is limited) on a BCC lattice, hanging in gravity, for the Newton schedule's cases.
+struct MuscleBlock {
+  TetMesh<double> mesh = discretize::bcc_lattice(box_tet_mesh<double>(2, 2, 6, Vec3<>(0, 0, 0), Vec3<>(0.1, 0.1, 0.3)), 0.025).mesh;
+  ElasticEnergy<TeranMuscle<>> flesh{mesh, TeranMuscle<>(), std::vector<MuscleFibre<>>(std::size_t(mesh.num_tets()), MuscleFibre<>{Vec3<>::UnitZ(), 0.3})};
+  Gravity<> gravity{mesh, 1000.0, Vec3<>(0, 0, -9.81)};
+  /// Both ends held, the bottom one turned and pulled by random amounts (u: uniform on [−1, 1]).
+  template <class Rng>
+  BoneAttachments<> random_ends(Rng& rng) const {
+    std::uniform_real_distribution<double> u(-1, 1);
     BoneAttachments<> ends(mesh.V);
     ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
     ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
     ends.set_transform("bottom", RigidTransform<>{Eigen::AngleAxisd(0.4 * u(rng), Vec3<>::UnitZ()).toRotationMatrix(),
                                                   Vec3<>(0.03 * u(rng), 0.03 * u(rng), 0.03 * u(rng))});
+    return ends;
+  }
+};
+}  // namespace
+
+TEST_CASE("Forcing::adaptive's safeguard (Kelley): no linear solve asked for much below the Newton tolerance, the same equilibrium in fewer PCG iterations") {
+  // the muscle block, its ends turned and pulled by random amounts
+  const MuscleBlock block;
+  const TetMesh<double>& mesh = block.mesh;
+  const auto& flesh = block.flesh;
+  const auto& gravity = block.gravity;
+  using Pcg = ConjugateGradient<BlockJacobi<>>;
+  std::mt19937 rng(17);
+  Index linear_safeguarded = 0, linear_eisenstat_walker = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    const BoneAttachments<> ends = block.random_ends(rng);
     const double relative = trial % 2 ? 1e-9 : 1e-10;
     const auto solve = [&](bool safeguard, std::vector<NewtonIteration>& seen) {
       NewtonOptions o;
@@ -427,27 +441,20 @@ struct CountedGravity {
 TEST_CASE("NewtonOptions::chord_below: after a 100x drop of the gradient the old Hessian is reused; the same equilibrium, fewer Hessians; PCG and Cholesky") {
   // the muscle block of the safeguard case (Newton's contraction limited by the fibre curve's kink),
   // random end loadings
-  const auto box = box_tet_mesh<double>(2, 2, 6, Vec3<>(0, 0, 0), Vec3<>(0.1, 0.1, 0.3));
-  const TetMesh<double> mesh = discretize::bcc_lattice(box, 0.025).mesh;
-  std::vector<MuscleFibre<>> fibres(std::size_t(mesh.num_tets()), MuscleFibre<>{Vec3<>::UnitZ(), 0.3});
-  ElasticEnergy<TeranMuscle<>> flesh(mesh, TeranMuscle<>(), fibres);
-  Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
+  const MuscleBlock block;
+  const TetMesh<double>& mesh = block.mesh;
+  const auto& flesh = block.flesh;
   std::mt19937 rng(23);
-  std::uniform_real_distribution<double> u(-1, 1);
   int chords = 0, hessians_newton = 0, hessians_chord = 0;
   for (int trial = 0; trial < 8; ++trial) {
-    BoneAttachments<> ends(mesh.V);
-    ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
-    ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
-    ends.set_transform("bottom", RigidTransform<>{Eigen::AngleAxisd(0.4 * u(rng), Vec3<>::UnitZ()).toRotationMatrix(),
-                                                  Vec3<>(0.03 * u(rng), 0.03 * u(rng), 0.03 * u(rng))});
+    const BoneAttachments<> ends = block.random_ends(rng);
     const auto solve = [&]<class Linear>(Linear linear, double chord_below, auto policy) {
       NewtonOptions o;
       o.relative_tolerance = 1e-9;
       o.forcing = NewtonOptions::Forcing::adaptive;
       o.chord_below = chord_below;
       QuasistaticSolver<Linear> newton(mesh.num_vertices(), mesh.T, o, std::move(linear));
-      CountedGravity counted{&gravity};
+      CountedGravity counted{&block.gravity};
       Points<> x = mesh.V;
       const NewtonReport r = newton.solve(policy, x, ends.boundary(), flesh, counted);
       CHECK(r.converged);
