@@ -291,24 +291,22 @@ void scene_counters(benchmark::State& state) {
 }
 
 using Storage = MultigridOptions::Storage;
+using Smoother = MultigridOptions::Smoother;
 
 /// The case's linear solver, built for the scene's mesh (PCG + multigrid builds its lattice
 /// levels here, once per mesh like the gather lists: not timed). `coarse_refresh_every`,
 /// `storage`: the multigrid's MultigridOptions (ignored by the other solvers); Storage::csr also
 /// runs PCG's own products on the scalar CSR (ConjugateGradientOptions::block_products = false):
-/// the baseline of every 3×3-block product. `chebyshev_degree` > 0: the Chebyshev smoother of that
-/// degree (MultigridOptions::Smoother); < 0: one multicolour block Gauss–Seidel sweep; else one
-/// damped block-Jacobi sweep.
+/// the baseline of every 3×3-block product. `smoother`, `chebyshev_degree`: the V-cycle's smoother
+/// (MultigridOptions::Smoother; the degree for the Chebyshev one).
 template <class Linear>
-Linear make_linear(int coarse_refresh_every = 1, Storage storage = Storage::block, int chebyshev_degree = 0) {
+Linear make_linear(int coarse_refresh_every = 1, Storage storage = Storage::block, Smoother smoother = Smoother::jacobi, int chebyshev_degree = 2) {
   return make_linear_solver<Linear>(
       exec::omp, scene().mesh, {.tolerance = kCgTolerance, .block_products = storage != Storage::csr}, {},
       {.coarse_refresh_every = coarse_refresh_every,
        .storage = storage,
-       .smoother = chebyshev_degree > 0   ? MultigridOptions::Smoother::chebyshev
-                   : chebyshev_degree < 0 ? MultigridOptions::Smoother::gauss_seidel
-                                          : MultigridOptions::Smoother::jacobi,
-       .chebyshev_degree = std::max(chebyshev_degree, 1)});
+       .smoother = smoother,
+       .chebyshev_degree = chebyshev_degree});
 }
 
 /// The baseline of the element Hessians: M without its own element_stiffness, so ElasticEnergy
@@ -354,7 +352,7 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 /// as the face simulator's warm start), not from x_A.
 template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
           NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block, bool Extrapolate = false,
-          bool ForcingSafeguard = true, HessianAssembly Assembly = HessianAssembly::gather, int ChebyshevDegree = 0, int ChordDrop = 0>
+          bool ForcingSafeguard = true, HessianAssembly Assembly = HessianAssembly::gather, Smoother FrameSmoother = Smoother::jacobi, int ChebyshevDegree = 2, int ChordDrop = 0>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
@@ -364,7 +362,7 @@ void BM_frame(benchmark::State& state) {
   options.forcing = Forcing;
   options.forcing_safeguard = ForcingSafeguard;
   options.chord_below = ChordDrop > 0 ? 1.0 / ChordDrop : 0.0;  // a chord step after a ChordDrop-fold drop of ‖g‖
-  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage, ChebyshevDegree));
+  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage, FrameSmoother, ChebyshevDegree));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
   const auto frame = [&] {
@@ -439,9 +437,9 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, Newton
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, false)->Name("BM_frame_73k/pcg_multigrid_inexact_unguarded_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 // the same with the element Hessians' SVD on Eigen's Jacobi sweeps (the baseline of signed_svd_from_eigen)
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, 2)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, 0, 100)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chord_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, -1)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_gauss_seidel_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::chebyshev, 2)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::jacobi, 2, 100)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chord_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::gauss_seidel)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_gauss_seidel_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, JacobiSvdMuscle, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_jacobi_svd_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)
 BENCHMARK_TEMPLATE(BM_frame, CholmodCholesky<>, exec::omp_t)->Name("BM_frame_73k/cholmod/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);

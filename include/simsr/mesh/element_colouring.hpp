@@ -37,6 +37,15 @@ void bucket_by_key(Index n, Index num_keys, Key key, std::vector<Index>& offsets
   std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
   for (Index i = 0; i < n; ++i) items[std::size_t(fill[std::size_t(key(i))]++)] = i;
 }
+
+/// First fit: the smallest colour that forbidden[colour] does not stamp with `stamp` (a neighbour
+/// of the item being coloured has it), a new one where all are stamped.
+inline Index first_free_colour(std::vector<Index>& forbidden, Index stamp) {
+  Index colour = 0;
+  while (colour < Index(forbidden.size()) && forbidden[std::size_t(colour)] == stamp) ++colour;
+  if (colour == Index(forbidden.size())) forbidden.push_back(0);
+  return colour;
+}
 }  // namespace detail
 
 /// The elements of each colour, colour by colour, each colour's in increasing element order.
@@ -94,10 +103,7 @@ inline ElementColouring greedy_colouring(const std::vector<Index>& offsets, cons
         if (col >= 0) forbidden[std::size_t(col)] = c + 1;
       }
     }
-    Index col = 0;
-    while (col < Index(forbidden.size()) && forbidden[std::size_t(col)] == c + 1) ++col;
-    if (col == Index(forbidden.size())) forbidden.push_back(0);
-    out.colour_of[std::size_t(c)] = col;
+    out.colour_of[std::size_t(c)] = detail::first_free_colour(forbidden, c + 1);
   }
   detail::bucket_by_key(nc, Index(forbidden.size()), [&](Index c) { return out.colour_of[std::size_t(c)]; }, out.offsets, out.elements);
   return out;
@@ -132,7 +138,6 @@ inline ElementColouring greedy_graph_colouring(const int* offsets, const int* ad
   ElementColouring out;
   out.colour_of.assign(std::size_t(num_nodes), -1);
   std::vector<Index> forbidden;  // forbidden[colour] == i + 1: a neighbour of node i has that colour
-  Index colours = 0;
   for (Index i = 0; i < num_nodes; ++i) {
     if (offsets[i + 1] < offsets[i]) throw ArgumentError("greedy_graph_colouring: offsets decrease at node " + std::to_string(i));
     for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
@@ -142,10 +147,7 @@ inline ElementColouring greedy_graph_colouring(const int* offsets, const int* ad
                             std::to_string(num_nodes) + ")");
       if (j < i && out.colour_of[std::size_t(j)] >= 0) forbidden[std::size_t(out.colour_of[std::size_t(j)])] = i + 1;
     }
-    Index c = 0;
-    while (c < colours && forbidden[std::size_t(c)] == i + 1) ++c;
-    if (c == colours) forbidden.push_back(0), ++colours;
-    out.colour_of[std::size_t(i)] = c;
+    out.colour_of[std::size_t(i)] = detail::first_free_colour(forbidden, i + 1);
   }
   // symmetry: every listed pair is listed both ways (a one-sided entry would let two coupled nodes share a colour)
   for (Index i = 0; i < num_nodes; ++i)
@@ -154,9 +156,7 @@ inline ElementColouring greedy_graph_colouring(const int* offsets, const int* ad
       if (j == i || out.colour_of[std::size_t(i)] != out.colour_of[std::size_t(j)]) continue;
       throw ArgumentError("greedy_graph_colouring: node " + std::to_string(i) + " lists " + std::to_string(j) + " but not the other way round: the adjacency must be symmetric");
     }
-  std::vector<Index> first;
-  detail::bucket_by_key(num_nodes, colours, [&](Index i) { return out.colour_of[std::size_t(i)]; }, first, out.elements);
-  out.offsets = std::move(first);
+  detail::bucket_by_key(num_nodes, Index(forbidden.size()), [&](Index i) { return out.colour_of[std::size_t(i)]; }, out.offsets, out.elements);
   return out;
 }
 

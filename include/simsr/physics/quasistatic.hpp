@@ -193,6 +193,7 @@ class QuasistaticSolver {
     double accepted = std::numeric_limits<double>::quiet_NaN();  // the energy of the last accepted step's x
     double last_gnorm = 0;                 // ‖g‖ of the previous iteration (NewtonOptions::chord_below)
     bool last_setup_reusable = false;      // the linear solver still holds that iteration's converged setup
+    bool last_projected = false;           // … made from the projected Hessian (what a chord step reuses)
     for (Index it = 0;; ++it) {
       // the line search evaluated the energy at this x already (the same sum of the same terms:
       // the same bits), so an iteration after the first does not evaluate it again
@@ -230,7 +231,7 @@ class QuasistaticSolver {
         info = linear_.solve(policy, rhs_, d_);
         slope = double(g_.dot(d_));
         if (info.converged && slope < 0 && d_.allFinite()) {
-          projected = last_projected_;
+          projected = last_projected;
           shift = last_shift_;
         } else {
           chord = false;
@@ -261,7 +262,7 @@ class QuasistaticSolver {
         newton_direction(policy, x, Definiteness::project, info, terms...);
         slope = double(g_.dot(d_));
       }
-      last_projected_ = projected;
+      last_projected = projected;
       last_setup_reusable = info.converged;
       last_gnorm = gnorm;
       if (!(slope < 0) || !d_.allFinite()) {  // still no descent (an unconverged iterative solve): fall back to −g
@@ -446,7 +447,6 @@ class QuasistaticSolver {
   std::vector<std::pair<S*, S>> shifted_diagonal_;  ///< its free diagonal entries and their exact values
   double magnitude_ = 0;
   double last_shift_ = 0;  ///< Hessian::regularized: the τ of the last iteration (0: unshifted), reset by each solve
-  bool last_projected_ = false;  ///< the last iteration used the projected Hessian (what a chord step reuses)
 };
 
 }  // namespace simsr::physics

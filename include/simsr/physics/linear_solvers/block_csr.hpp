@@ -37,6 +37,26 @@
 namespace simsr::physics {
 
 namespace detail {
+/// s0..s2 += (block row b of A)·x, one term at a time in column order (the file comment's
+/// rounding): BlockCsrProduct's row, and the row product of the multigrid's Gauss–Seidel sweep.
+template <class S, class Value>
+SIMSR_HOST_DEVICE void add_block_row(const int* outer, const int* inner, const Value* values, const S* x, Index b, S& s0, S& s1, S& s2) {
+  for (int k = outer[b]; k < outer[b + 1]; ++k) {
+    const Value* a = values + 9 * std::size_t(k);
+    const S* xb = x + 3 * std::size_t(inner[k]);
+    const S x0 = xb[0], x1 = xb[1], x2 = xb[2];
+    s0 += S(a[0]) * x0;
+    s0 += S(a[1]) * x1;
+    s0 += S(a[2]) * x2;
+    s1 += S(a[3]) * x0;
+    s1 += S(a[4]) * x1;
+    s1 += S(a[5]) * x2;
+    s2 += S(a[6]) * x0;
+    s2 += S(a[7]) * x1;
+    s2 += S(a[8]) * x2;
+  }
+}
+
 /// y(3b..3b+2) = Σ over block row b's blocks of A_bk · x(3k..3k+2): BlockCsr's product, one
 /// functor for exec::seq, exec::omp (host arrays) and exec::cuda (DeviceBlockCsr's device arrays).
 template <class S, class Value>
@@ -48,21 +68,7 @@ struct BlockCsrProduct {
   S* y;
   SIMSR_HOST_DEVICE void operator()(Index b) const {
     S s0 = 0, s1 = 0, s2 = 0;
-    for (int k = outer[b]; k < outer[b + 1]; ++k) {
-      const Value* a = values + 9 * std::size_t(k);
-      const S* xb = x + 3 * std::size_t(inner[k]);
-      const S x0 = xb[0], x1 = xb[1], x2 = xb[2];
-      // one term at a time, in column order (file comment)
-      s0 += S(a[0]) * x0;
-      s0 += S(a[1]) * x1;
-      s0 += S(a[2]) * x2;
-      s1 += S(a[3]) * x0;
-      s1 += S(a[4]) * x1;
-      s1 += S(a[5]) * x2;
-      s2 += S(a[6]) * x0;
-      s2 += S(a[7]) * x1;
-      s2 += S(a[8]) * x2;
-    }
+    add_block_row(outer, inner, values, x, b, s0, s1, s2);
     y[3 * b] = s0;
     y[3 * b + 1] = s1;
     y[3 * b + 2] = s2;

@@ -339,8 +339,7 @@ class Multigrid {
     VecX<S> b, x, r, t, v;  ///< v: the power iteration's vector, kept as the next compute's start
     VecX<S> d;              ///< the Chebyshev smoother's direction
     ElementColouring colours;  ///< the Gauss–Seidel smoother's vertex colours (greedy_graph_colouring of the blocks)
-    const void* coloured_blocks = nullptr;  ///< … of these blocks
-    std::uint64_t coloured_version = 0;     ///< … at this pattern_version
+    std::uint64_t coloured_version = 0;  ///< … of the blocks of this BlockCsr::pattern_version (0: none yet)
     const SparseMatrix<S>& matrix() const { return A_ref ? *A_ref : *A_coarse; }
   };
 
@@ -551,10 +550,10 @@ class Multigrid {
     if (options_.storage == block_single) L.block_single.assign(policy, L.matrix());
     if (options_.smoother == MultigridOptions::Smoother::gauss_seidel) {
       // the colours of the blocks the sweeps read, made again only when their pattern changed
+      // (pattern versions are unique over all BlockCsr objects: the version alone names the pattern)
       const auto colour = [&](const auto& blocks) {
-        if (L.coloured_blocks == static_cast<const void*>(&blocks) && L.coloured_version == blocks.pattern_version()) return;
+        if (L.coloured_version == blocks.pattern_version()) return;
         L.colours = greedy_graph_colouring(blocks.block_outer(), blocks.block_inner(), blocks.rows() / 3);
-        L.coloured_blocks = &blocks;
         L.coloured_version = blocks.pattern_version();
       };
       if (options_.storage == block_single)
@@ -582,15 +581,9 @@ class Multigrid {
         const Index* rows = c.elements.data() + c.offsets[std::size_t(k)];
         exec::parallel_for(policy, c.size(k), [&, rows](Index i) {
           const Index v = rows[i];
-          S r0 = b[3 * v], r1 = b[3 * v + 1], r2 = b[3 * v + 2];
-          for (int e = outer[v]; e < outer[v + 1]; ++e) {
-            const Value* a = values + 9 * std::size_t(e);
-            const S* xb = x + 3 * std::size_t(inner[e]);
-            const S x0 = xb[0], x1 = xb[1], x2 = xb[2];
-            r0 -= S(a[0]) * x0 + S(a[1]) * x1 + S(a[2]) * x2;
-            r1 -= S(a[3]) * x0 + S(a[4]) * x1 + S(a[5]) * x2;
-            r2 -= S(a[6]) * x0 + S(a[7]) * x1 + S(a[8]) * x2;
-          }
+          S ax0 = 0, ax1 = 0, ax2 = 0;
+          detail::add_block_row(outer, inner, values, x, v, ax0, ax1, ax2);
+          const S r0 = b[3 * v] - ax0, r1 = b[3 * v + 1] - ax1, r2 = b[3 * v + 2] - ax2;
           const Mat3<S>& D = L.smoother.inverse_block(v);
           x[3 * v] += D(0, 0) * r0 + D(0, 1) * r1 + D(0, 2) * r2;
           x[3 * v + 1] += D(1, 0) * r0 + D(1, 1) * r1 + D(1, 2) * r2;
