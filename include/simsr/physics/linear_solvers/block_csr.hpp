@@ -37,10 +37,19 @@
 namespace simsr::physics {
 
 namespace detail {
-/// s0..s2 += (block row b of A)·x, one term at a time in column order (the file comment's
+/// The three sums of one block row.
+template <class S>
+struct BlockRowSum {
+  S s0, s1, s2;
+};
+
+/// (block row b of A)·x, summed from zero one term at a time in column order (the file comment's
 /// rounding): BlockCsrProduct's row, and the row product of the multigrid's Gauss–Seidel sweep.
+/// The sums are locals returned by value: accumulators passed by reference may alias x (both S),
+/// which forced a store after every term wherever the compiler kept the function out of line.
 template <class S, class Value>
-SIMSR_HOST_DEVICE void add_block_row(const int* outer, const int* inner, const Value* values, const S* x, Index b, S& s0, S& s1, S& s2) {
+SIMSR_HOST_DEVICE inline BlockRowSum<S> block_row_sum(const int* outer, const int* inner, const Value* values, const S* x, Index b) {
+  S s0 = 0, s1 = 0, s2 = 0;
   for (int k = outer[b]; k < outer[b + 1]; ++k) {
     const Value* a = values + 9 * std::size_t(k);
     const S* xb = x + 3 * std::size_t(inner[k]);
@@ -55,6 +64,7 @@ SIMSR_HOST_DEVICE void add_block_row(const int* outer, const int* inner, const V
     s2 += S(a[7]) * x1;
     s2 += S(a[8]) * x2;
   }
+  return {s0, s1, s2};
 }
 
 /// y(3b..3b+2) = Σ over block row b's blocks of A_bk · x(3k..3k+2): BlockCsr's product, one
@@ -67,11 +77,10 @@ struct BlockCsrProduct {
   const S* x;
   S* y;
   SIMSR_HOST_DEVICE void operator()(Index b) const {
-    S s0 = 0, s1 = 0, s2 = 0;
-    add_block_row(outer, inner, values, x, b, s0, s1, s2);
-    y[3 * b] = s0;
-    y[3 * b + 1] = s1;
-    y[3 * b + 2] = s2;
+    const BlockRowSum<S> s = block_row_sum(outer, inner, values, x, b);
+    y[3 * b] = s.s0;
+    y[3 * b + 1] = s.s1;
+    y[3 * b + 2] = s.s2;
   }
 };
 }  // namespace detail

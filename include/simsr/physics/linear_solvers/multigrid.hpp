@@ -581,9 +581,8 @@ class Multigrid {
         const Index* rows = c.elements.data() + c.offsets[std::size_t(k)];
         exec::parallel_for(policy, c.size(k), [&, rows](Index i) {
           const Index v = rows[i];
-          S ax0 = 0, ax1 = 0, ax2 = 0;
-          detail::add_block_row(outer, inner, values, x, v, ax0, ax1, ax2);
-          const S r0 = b[3 * v] - ax0, r1 = b[3 * v + 1] - ax1, r2 = b[3 * v + 2] - ax2;
+          const detail::BlockRowSum<S> ax = detail::block_row_sum(outer, inner, values, x, v);
+          const S r0 = b[3 * v] - ax.s0, r1 = b[3 * v + 1] - ax.s1, r2 = b[3 * v + 2] - ax.s2;
           const Mat3<S>& D = L.smoother.inverse_block(v);
           x[3 * v] += D(0, 0) * r0 + D(0, 1) * r1 + D(0, 2) * r2;
           x[3 * v + 1] += D(1, 0) * r0 + D(1, 1) * r1 + D(1, 2) * r2;
