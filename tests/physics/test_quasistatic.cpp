@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <random>
+#include <stdexcept>
 
 #include "stvk_material.hpp"
 
@@ -496,4 +497,111 @@ TEST_CASE("NewtonOptions::chord_below: after a 100x drop of the gradient the old
   MESSAGE("8 random loadings: chord steps (PCG and LDLT) ", chords, "; Hessians assembled (PCG) full Newton ", hessians_newton, ", with chords ", hessians_chord);
   CHECK(chords > 0);
   CHECK(hessians_chord < hessians_newton);
+}
+
+namespace {
+/// CountedGravity whose add_hessian throws while `fail` is set (a setup lost part-way).
+struct FailingGravity : CountedGravity {
+  mutable bool fail = false;
+  template <class P>
+  void add_hessian(P p, const Points<>& x, BlockHessian<>& H, Definiteness d) const {
+    if (fail) throw std::runtime_error("FailingGravity: Hessian refused");
+    CountedGravity::add_hessian(p, x, H, d);
+  }
+};
+}  // namespace
+
+TEST_CASE("NewtonOptions::chord_first: frames in a sequence start from the previous frame's last Hessian; the same equilibria, fewer Hessians; guarded by the fixed DOFs and by a lost setup") {
+  // the muscle block in random sequences of 6 frames: the bottom end turned and pulled a little
+  // further each frame (a random rate per sequence), each frame warm-started from the last
+  const MuscleBlock block;
+  const TetMesh<double>& mesh = block.mesh;
+  const auto& flesh = block.flesh;
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int carried = 0, refused = 0, hessians_newton = 0, hessians_carried = 0;
+  for (int sequence = 0; sequence < 4; ++sequence) {
+    const double turn = 0.08 * u(rng), pull = 0.006 * u(rng), shear = 0.006 * u(rng);
+    BoneAttachments<> ends(mesh.V);
+    ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
+    ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
+    const auto run = [&]<class Linear>(Linear linear, bool chord_first, auto policy) {
+      NewtonOptions o;
+      o.relative_tolerance = 1e-9;
+      o.forcing = NewtonOptions::Forcing::adaptive;
+      o.chord_first = chord_first;
+      QuasistaticSolver<Linear> newton(mesh.num_vertices(), mesh.T, o, std::move(linear));
+      CountedGravity counted{&block.gravity};
+      Points<> x = mesh.V;
+      std::vector<Points<>> frames;
+      std::vector<char> first_chord;
+      for (int f = 1; f <= 6; ++f) {
+        ends.set_transform("bottom", RigidTransform<>{Eigen::AngleAxisd(turn * f, Vec3<>::UnitZ()).toRotationMatrix(), Vec3<>(shear * f, 0, pull * f)});
+        const NewtonReport r = newton.solve(policy, x, ends.boundary(), flesh, counted);
+        CHECK(r.converged);
+        REQUIRE(!r.history.empty());
+        for (std::size_t k = 1; k < r.history.size(); ++k) CHECK_FALSE(r.history[k].chord);  // chord_below is off
+        if (f == 1 || !chord_first) CHECK_FALSE(r.history[0].chord);  // nothing to carry
+        first_chord.push_back(r.history[0].chord);
+        frames.push_back(x);
+      }
+      return std::make_tuple(frames, first_chord, counted.hessians);
+    };
+    using Pcg = ConjugateGradient<BlockJacobi<>>;
+    const auto [x_newton, no_chords, h_newton] = run(Pcg({.tolerance = 1e-10}), false, exec::omp);
+    const auto [x_carried, chords, h_carried] = run(Pcg({.tolerance = 1e-10}), true, exec::omp);
+    for (std::size_t f = 0; f < x_newton.size(); ++f) {
+      const double moved = (x_newton[f] - mesh.V).cwiseAbs().maxCoeff();
+      REQUIRE(moved > 1e-4);
+      CHECK((x_carried[f] - x_newton[f]).cwiseAbs().maxCoeff() <= 1e-5 * moved);
+    }
+    const int n_chords = int(std::count(chords.begin(), chords.end(), char(1)));
+    carried += n_chords;
+    refused += 5 - n_chords;  // frames 2–6 whose carried step the guards turned down
+    hessians_newton += h_newton;
+    hessians_carried += h_carried;
+    // seq == omp bitwise
+    const auto [x_seq, chords_seq, h_seq] = run(Pcg({.tolerance = 1e-10}), true, exec::seq);
+    for (std::size_t f = 0; f < x_seq.size(); ++f) CHECK((x_seq[f] - x_carried[f]).cwiseAbs().maxCoeff() == 0);
+    CHECK(chords_seq == chords);
+    // a direct solver carries its factorization the same way
+    const auto [x_direct, chords_direct, h_direct] = run(SparseCholesky<>{}, true, exec::omp);
+    for (std::size_t f = 0; f < x_direct.size(); ++f)
+      CHECK((x_direct[f] - x_newton[f]).cwiseAbs().maxCoeff() <= 1e-5 * (x_newton[f] - mesh.V).cwiseAbs().maxCoeff());
+    CHECK(std::count(chords_direct.begin(), chords_direct.end(), char(1)) > 0);
+  }
+  MESSAGE("4 sequences of 6 frames: first steps on the carried Hessian ", carried, " (turned down ", refused, "); Hessians assembled ",
+          hessians_carried, " against ", hessians_newton, " without");
+  CHECK(carried > 0);
+  CHECK(hessians_carried < hessians_newton);
+
+  // the guards: other fixed DOFs, and a setup lost to a throw, carry nothing
+  NewtonOptions o;
+  o.relative_tolerance = 1e-9;
+  o.forcing = NewtonOptions::Forcing::adaptive;
+  o.chord_first = true;
+  using Pcg = ConjugateGradient<BlockJacobi<>>;
+  QuasistaticSolver<Pcg> newton(mesh.num_vertices(), mesh.T, o, Pcg({.tolerance = 1e-10}));
+  FailingGravity failing;
+  failing.gravity = &block.gravity;
+  BoneAttachments<> both(mesh.V), top_only(mesh.V);
+  both.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
+  both.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
+  top_only.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
+  both.set_transform("bottom", RigidTransform<>{Mat3<>::Identity(), Vec3<>(0, 0, 0.01)});
+  Points<> x = mesh.V;
+  CHECK_FALSE(newton.solve(exec::omp, x, both.boundary(), flesh, failing).history.at(0).chord);
+  both.set_transform("bottom", RigidTransform<>{Mat3<>::Identity(), Vec3<>(0, 0, 0.012)});
+  CHECK(newton.solve(exec::omp, x, both.boundary(), flesh, failing).history.at(0).chord);  // carried
+  Points<> y = x;
+  CHECK_FALSE(newton.solve(exec::omp, y, top_only.boundary(), flesh, failing).history.at(0).chord);  // other fixed DOFs
+  top_only.set_transform("top", RigidTransform<>{Mat3<>::Identity(), Vec3<>(0.002, 0, 0)});
+  CHECK(newton.solve(exec::omp, y, top_only.boundary(), flesh, failing).history.at(0).chord);  // the same ones again
+  // a Hessian that throws part-way: the next solve starts afresh (the linear solver's setup is not trusted)
+  failing.fail = true;
+  y = mesh.V;
+  CHECK_THROWS_AS(newton.solve(exec::omp, y, both.boundary(), flesh, failing), std::runtime_error);
+  failing.fail = false;
+  x = mesh.V;
+  CHECK_FALSE(newton.solve(exec::omp, x, both.boundary(), flesh, failing).history.at(0).chord);
 }

@@ -120,6 +120,18 @@ struct NewtonOptions {
   /// and the line search still guards every step. Only after a converged linear solve. 0: off
   /// (every iteration assembles its Hessian: the baseline).
   double chord_below = 0;
+  /// A chord step across solves: the first iteration of a solve solves with the Hessian and
+  /// linear-solver setup of the previous solve's last iteration, when that setup is still held
+  /// (its linear solve converged, nothing threw since) and the Dirichlet DOFs are the same ones.
+  /// In a sequence of quasistatic frames the previous solve is the previous frame, whose last
+  /// Hessian was assembled near its solution: one frame step away from this frame's warm start,
+  /// so the first step (solved loosely anyway under Forcing::adaptive) costs a solve instead of a
+  /// Hessian and a multigrid setup. The same guards as chord_below: a solve that does not converge
+  /// or does not descend makes it a full Newton iteration, and the line search guards the step.
+  /// The caller vouches that the terms are the same kind of terms as in the previous solve (a
+  /// changed material constant only makes the reused matrix a worse preconditioned model; the
+  /// gradient, and so the equilibrium, is always this solve's). false: off (the baseline).
+  bool chord_first = false;
   /// Called after every iteration (progress lines for long runs).
   std::function<void(const NewtonIteration&)> progress;
 };
@@ -192,8 +204,8 @@ class QuasistaticSolver {
     last_shift_ = 0;
     double accepted = std::numeric_limits<double>::quiet_NaN();  // the energy of the last accepted step's x
     double last_gnorm = 0;                 // ‖g‖ of the previous iteration (NewtonOptions::chord_below)
-    bool last_setup_reusable = false;      // the linear solver still holds that iteration's converged setup
-    bool last_projected = false;           // … made from the projected Hessian (what a chord step reuses)
+    // NewtonOptions::chord_first: the previous solve's last setup, made with these fixed DOFs
+    const bool carried = setup_valid_ && options_.chord_first && setup_fixed_ == fixed_;
     for (Index it = 0;; ++it) {
       // the line search evaluated the energy at this x already (the same sum of the same terms:
       // the same bits), so an iteration after the first does not evaluate it again
@@ -224,15 +236,19 @@ class QuasistaticSolver {
       const bool regularized = options_.hessian == NewtonOptions::Hessian::regularized;
       // after an iteration that needed τ > 10⁻³ the exact Hessian is not tried: the search starts at τ/10
       const bool warm = regularized && last_shift_ > 1e-3 * (1 + 1e-9);
-      bool chord = last_setup_reusable && options_.chord_below > 0 && gnorm <= options_.chord_below * last_gnorm;
+      // the setup held now is the one a chord step would reuse; it counts as lost until this
+      // iteration ends (a setup that throws part-way leaves the linear solver in no state to reuse)
+      const bool reusable = setup_valid_;
+      setup_valid_ = false;
+      bool chord = reusable && (it == 0 ? carried : options_.chord_below > 0 && gnorm <= options_.chord_below * last_gnorm);
       if (chord) {
         // the previous iteration's matrix and setup (NewtonOptions::chord_below); a solve that does
         // not converge or does not descend makes this a full Newton iteration after all
         info = linear_.solve(policy, rhs_, d_);
         slope = double(g_.dot(d_));
         if (info.converged && slope < 0 && d_.allFinite()) {
-          projected = last_projected;
-          shift = last_shift_;
+          projected = setup_projected_;
+          shift = setup_shift_;
         } else {
           chord = false;
           info = {.iterations = info.iterations};
@@ -262,8 +278,10 @@ class QuasistaticSolver {
         newton_direction(policy, x, Definiteness::project, info, terms...);
         slope = double(g_.dot(d_));
       }
-      last_projected = projected;
-      last_setup_reusable = info.converged;
+      setup_valid_ = info.converged;
+      setup_projected_ = projected;
+      setup_shift_ = shift;
+      if (!chord) setup_fixed_ = fixed_;
       last_gnorm = gnorm;
       if (!(slope < 0) || !d_.allFinite()) {  // still no descent (an unconverged iterative solve): fall back to −g
         d_ = -g_;
@@ -447,6 +465,11 @@ class QuasistaticSolver {
   std::vector<std::pair<S*, S>> shifted_diagonal_;  ///< its free diagonal entries and their exact values
   double magnitude_ = 0;
   double last_shift_ = 0;  ///< Hessian::regularized: the τ of the last iteration (0: unshifted), reset by each solve
+  // The linear solver's current setup, for chord steps (NewtonOptions::chord_below, chord_first):
+  bool setup_valid_ = false;       ///< it holds a setup whose solve converged, and nothing threw since
+  bool setup_projected_ = false;   ///< made from the projected Hessian
+  double setup_shift_ = 0;         ///< made from H + τ m I with this τ (Hessian::regularized; 0: none)
+  std::vector<char> setup_fixed_;  ///< with these fixed DOFs (identity rows)
 };
 
 }  // namespace simsr::physics
