@@ -49,7 +49,12 @@
 //       `_gauss_seidel` the V-cycle smoothed by one multicolour block Gauss–Seidel sweep
 //       (Smoother::gauss_seidel; one Jacobi sweep its baseline);
 //       `_chord` with NewtonOptions::chord_below = 0.01 (an iteration whose ‖g‖ fell 100× reuses the
-//       previous Hessian and multigrid; counter `chord`: such iterations), `_coloured` its baseline
+//       previous Hessian and multigrid; counter `chord`: such iterations), `_coloured` its baseline;
+//       `…_after_a` rows solve frame A (from the frame before it, untimed) before each timed frame B,
+//       as in a sequence of frames, so what the solver carries into B (the lagged coarse levels, a
+//       chord_first setup) is A's; `_chord_first` with NewtonOptions::chord_first (B's first
+//       iteration solves with A's last Hessian and multigrid), the `…_after_a` row without it its
+//       baseline
 //   BM_frame_73k/<linear>_extrapolated/omp   the same frame from the face simulator's warm start:
 //       2 x_A − x_before, with x_before the frame before A (jaw 0.08 rad, activation 0.05, targets
 //       −0.5 mm: the same step back), solved once at setup from x_A
@@ -455,10 +460,13 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, Newton
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::chebyshev, 2)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::jacobi, 2, 100)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chord_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-// in a sequence (frame A solved untimed before each timed B), with and without chord_first
+// in a sequence (frame A solved untimed before each timed B: what the solver carries into B is
+// A's), with and without NewtonOptions::chord_first, with one Jacobi sweep or Chebyshev degree 2
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::jacobi, 2, 0, true)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_single_coarse_every_4_extrapolated_after_a/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::jacobi, 2, 0, true, true)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chord_first_single_coarse_every_4_extrapolated_after_a/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::jacobi, 2, 100, true, true)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chord_first_chord_single_coarse_every_4_extrapolated_after_a/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::chebyshev, 2, 0, true)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_single_coarse_every_4_extrapolated_after_a/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::chebyshev, 2, 0, true, true)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_chord_first_single_coarse_every_4_extrapolated_after_a/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::gauss_seidel)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_gauss_seidel_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, JacobiSvdMuscle, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_jacobi_svd_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)
