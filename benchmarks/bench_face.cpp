@@ -7,6 +7,15 @@
 //                                       baseline of the 3×3-block products, issue #17 item 1)
 //   BM_face_frame/lr_paper_size_single  … with the multigrid's level matrices in single precision
 //   BM_face_frame/hr_default      the HR tetgen mesh of the default model (~135k tets, lip contact)
+//   BM_face_frame/lr_paper_size_…_sequence   frame 60 solved (untimed) before each timed frame 61,
+//       as in a run: `single` the defaults with single-precision levels (the baseline),
+//       `inexact_chebyshev2` Eisenstat–Walker forcing + coarse levels every 4th setup + Chebyshev
+//       degree 2 (bench_physics's fastest frame), `…_chord_first` that with NewtonOptions::chord_first
+//   BM_face_performance/lr_paper_size_…   the whole 120-frame amazement performance at the paper's
+//       LR size, stepped as `simsr datagen` does, timed as one (counter ms_per_frame), with the
+//       same three solver settings; counters diff_vs_defaults_* and diff_vs_converged_* (max and
+//       mean vertex distance over all frames, mm) against the defaults' frames and against the
+//       frames converged to ‖g‖ ≤ 1e-9 × the forces' scale (both solved untimed first)
 //
 // Scene: the ICT face from the bundled kit (data_dir()/ict_face), the model built once per
 // resolution case (tetgen, lattice, muscles; untimed). A frame is what `simsr datagen` does for
@@ -50,23 +59,52 @@ const scenario::FaceModel& face_model(const std::string& preset) {
   return *slot;
 }
 
+/// How a case sets the Newton and multigrid options beyond the defaults.
+enum class Solver {
+  defaults,  ///< FaceSimulationOptions as they are (with `storage`)
+  /// the fastest configuration of bench_physics's frame (issue #17 item 1): Eisenstat–Walker
+  /// forcing, coarse levels every 4th setup, Chebyshev degree 2, single-precision levels
+  inexact_chebyshev,
+  inexact_chebyshev_chord_first,  ///< … and NewtonOptions::chord_first
+};
+
+/// FaceSimulationOptions for `solver` (with the multigrid's `storage`; csr also runs PCG's own
+/// products on the scalar CSR).
+scenario::FaceSimulationOptions solver_options(Solver solver, physics::MultigridOptions::Storage storage) {
+  scenario::FaceSimulationOptions options;
+  options.multigrid.storage = storage;
+  options.linear.block_products = storage != physics::MultigridOptions::Storage::csr;
+  if (solver != Solver::defaults) {
+    options.newton.forcing = physics::NewtonOptions::Forcing::adaptive;
+    options.multigrid.coarse_refresh_every = 4;
+    options.multigrid.smoother = physics::MultigridOptions::Smoother::chebyshev;
+    options.multigrid.chebyshev_degree = 2;
+    options.newton.chord_first = solver == Solver::inexact_chebyshev_chord_first;
+  }
+  return options;
+}
+
 /// `storage`: the multigrid's level storage (MultigridOptions::Storage); csr also runs PCG's own
-/// products on the scalar CSR (the baseline of the 3×3-block products).
+/// products on the scalar CSR (the baseline of the 3×3-block products). `sequence`: frame 60 is
+/// solved (untimed, from 59) before each timed frame 61, as in a run, so what the solver carries
+/// into 61 (lagged coarse levels, a chord_first setup) is frame 60's, not the last timed 61's.
 void BM_face_frame(benchmark::State& state, const std::string& preset, scenario::FaceResolution res,
-                   physics::MultigridOptions::Storage storage = physics::MultigridOptions::Storage::block) {
+                   physics::MultigridOptions::Storage storage = physics::MultigridOptions::Storage::block, Solver solver = Solver::defaults,
+                   bool sequence = false) {
   if (!std::filesystem::exists(data_dir() / "ict_face" / "full_neutral.obj")) {
     state.SkipWithError("the ICT kit is not in data_dir()/ict_face");
     return;
   }
   const auto& face = face_model(preset);
   const auto perf = scenario::builtin_performance("amazement", face.expression_names, 1);
-  scenario::FaceSimulationOptions options;
-  options.multigrid.storage = storage;
-  options.linear.block_products = storage != physics::MultigridOptions::Storage::csr;
-  scenario::FaceSimulator<> sim(exec::omp, face, res, options);
+  scenario::FaceSimulator<> sim(exec::omp, face, res, solver_options(solver, storage));
   sim.set_controls(scenario::neutral_controls(face));
   sim.step(exec::omp);
-  const auto c59 = scenario::face_controls(perf, 59, face), c60 = scenario::face_controls(perf, 60, face), c61 = scenario::face_controls(perf, 61, face);
+  const auto c58 = scenario::face_controls(perf, 58, face), c59 = scenario::face_controls(perf, 59, face), c60 = scenario::face_controls(perf, 60, face),
+             c61 = scenario::face_controls(perf, 61, face);
+  sim.set_controls(c58);
+  sim.step(exec::omp);
+  const Points<> x58 = sim.positions();
   sim.set_controls(c59);
   sim.step(exec::omp);
   const Points<> x59 = sim.positions();
@@ -75,8 +113,17 @@ void BM_face_frame(benchmark::State& state, const std::string& preset, scenario:
   const Points<> x60 = sim.positions();
   physics::NewtonReport r;
   for (auto _ : state) {
-    sim.set_controls(c60);
-    sim.set_positions(x59, c59, x60);
+    if (sequence) {
+      state.PauseTiming();
+      sim.set_controls(c59);
+      sim.set_positions(x58, c58, x59);
+      sim.set_controls(c60);
+      sim.step(exec::omp);
+      state.ResumeTiming();
+    } else {
+      sim.set_controls(c60);
+      sim.set_positions(x59, c59, x60);
+    }
     sim.set_controls(c61);
     r = sim.step(exec::omp);
     benchmark::DoNotOptimize(sim.positions().data());
@@ -89,7 +136,89 @@ void BM_face_frame(benchmark::State& state, const std::string& preset, scenario:
   state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
+/// A whole built-in performance (amazement, seed 1, 120 frames) from the settled neutral, as
+/// `simsr datagen` steps it, timed as one: counters ms_per_frame, the Newton and PCG iterations
+/// summed over the frames, and how far each frame's vertices lie from the same frame solved with
+/// Solver::defaults and from the same frame converged far below the default tolerances (max and
+/// mean over frames and vertices, mm: the spread the default tolerances allow, and the error).
+void BM_face_performance(benchmark::State& state, const std::string& preset, Solver solver) {
+  if (!std::filesystem::exists(data_dir() / "ict_face" / "full_neutral.obj")) {
+    state.SkipWithError("the ICT kit is not in data_dir()/ict_face");
+    return;
+  }
+  const auto& face = face_model(preset);
+  const auto perf = scenario::builtin_performance("amazement", face.expression_names, 1);
+  // per preset, untimed: Solver::defaults' frames, and the frames converged far below the default
+  // tolerances (‖g‖ ≤ 1e-9 × the forces' scale, PCG to 1e-8), the yardstick of both
+  static std::map<std::string, std::vector<Points<>>> reference, converged;
+  const auto run = [&](Solver which, std::vector<Points<>>& frames, Index& newton, Index& linear, bool tight = false) {
+    scenario::FaceSimulationOptions options = solver_options(which, physics::MultigridOptions::Storage::block_single);
+    if (tight) {
+      options.newton.relative_tolerance = 1e-9;
+      options.newton.absolute_tolerance = 0;
+      options.newton.max_iterations = 100;
+      options.linear.tolerance = 1e-8;
+    }
+    scenario::FaceSimulator<> sim(exec::omp, face, scenario::FaceResolution::low, options);
+    sim.set_controls(scenario::neutral_controls(face));
+    sim.step(exec::omp);
+    frames.clear();
+    newton = linear = 0;
+    for (Index f = 0; f < perf.num_frames(); ++f) {
+      sim.set_controls(scenario::face_controls(perf, f, face));
+      const physics::NewtonReport r = sim.step(exec::omp);
+      newton += r.iterations;
+      linear += r.linear_iterations;
+      frames.push_back(sim.positions());
+    }
+  };
+  if (!reference.count(preset)) {
+    Index n = 0, l = 0;
+    run(Solver::defaults, reference[preset], n, l);
+    run(Solver::defaults, converged[preset], n, l, true);
+  }
+  std::vector<Points<>> frames;
+  Index newton = 0, linear = 0;
+  for (auto _ : state) run(solver, frames, newton, linear);
+  // max and mean over frames and vertices of |x − y| (mm)
+  const auto spread = [&](const std::vector<Points<>>& other, const char* name) {
+    double max_diff = 0, sum_diff = 0;
+    Index count = 0;
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+      const VecX<> d = (frames[f] - other[f]).rowwise().norm();
+      max_diff = std::max(max_diff, d.maxCoeff());
+      sum_diff += d.sum();
+      count += d.size();
+    }
+    state.counters[std::string(name) + "_max_mm"] = 1e3 * max_diff;
+    state.counters[std::string(name) + "_mean_mm"] = 1e3 * sum_diff / double(std::max<Index>(count, 1));
+  };
+  spread(reference[preset], "diff_vs_defaults");
+  spread(converged[preset], "diff_vs_converged");
+  const double F = double(perf.num_frames());
+  state.counters["frames"] = F;
+  state.counters["ms_per_frame"] = benchmark::Counter(F, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["newton_iterations"] = double(newton);
+  state.counters["linear_iterations"] = double(linear);
+}
+
 }  // namespace
+
+BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_single, std::string("paper-lr"), Solver::defaults)
+    ->Name("BM_face_performance/lr_paper_size_single")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_inexact_chebyshev2, std::string("paper-lr"), Solver::inexact_chebyshev)
+    ->Name("BM_face_performance/lr_paper_size_inexact_chebyshev2")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_inexact_chebyshev2_chord_first, std::string("paper-lr"), Solver::inexact_chebyshev_chord_first)
+    ->Name("BM_face_performance/lr_paper_size_inexact_chebyshev2_chord_first")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 BENCHMARK_CAPTURE(BM_face_frame, lr_default, std::string("default"), scenario::FaceResolution::low)
     ->Name("BM_face_frame/lr_default")
@@ -108,6 +237,26 @@ BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_csr, std::string("paper-lr"), sce
     ->Iterations(5);
 BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single, std::string("paper-lr"), scenario::FaceResolution::low, physics::MultigridOptions::Storage::block_single)
     ->Name("BM_face_frame/lr_paper_size_single")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(5);
+// in a sequence (frame 60 solved untimed before each timed 61): the single-precision row, the
+// fastest configuration of bench_physics's frame, and that with chord_first
+BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
+                  physics::MultigridOptions::Storage::block_single, Solver::defaults, true)
+    ->Name("BM_face_frame/lr_paper_size_single_sequence")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(5);
+BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_inexact_chebyshev2_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
+                  physics::MultigridOptions::Storage::block_single, Solver::inexact_chebyshev, true)
+    ->Name("BM_face_frame/lr_paper_size_inexact_chebyshev2_sequence")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(5);
+BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_inexact_chebyshev2_chord_first_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
+                  physics::MultigridOptions::Storage::block_single, Solver::inexact_chebyshev_chord_first, true)
+    ->Name("BM_face_frame/lr_paper_size_inexact_chebyshev2_chord_first_sequence")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
