@@ -597,10 +597,20 @@ TEST_CASE("NewtonOptions::chord_first: frames in a sequence start from the previ
   CHECK_FALSE(newton.solve(exec::omp, y, top_only.boundary(), flesh, failing).history.at(0).chord);  // other fixed DOFs
   top_only.set_transform("top", RigidTransform<>{Mat3<>::Identity(), Vec3<>(0.002, 0, 0)});
   CHECK(newton.solve(exec::omp, y, top_only.boundary(), flesh, failing).history.at(0).chord);  // the same ones again
-  // a Hessian that throws part-way: the next solve starts afresh (the linear solver's setup is not trusted)
+  // a Hessian that throws part-way: the next solve starts afresh (the linear solver's setup is not
+  // trusted). The throwing solve's first iteration is a carried step (both ends held, as the solve
+  // before it), its second assembles and throws: what it leaves held would otherwise pass the
+  // fixed-DOF guard.
+  both.set_transform("bottom", RigidTransform<>{Mat3<>::Identity(), Vec3<>(0, 0, 0.014)});
+  CHECK_FALSE(newton.solve(exec::omp, x, both.boundary(), flesh, failing).history.at(0).chord);  // other fixed DOFs than the last solve's
   failing.fail = true;
+  std::vector<NewtonIteration> seen;
+  newton.options().progress = [&](const NewtonIteration& it) { seen.push_back(it); };
   y = mesh.V;
   CHECK_THROWS_AS(newton.solve(exec::omp, y, both.boundary(), flesh, failing), std::runtime_error);
+  REQUIRE(seen.size() == 1);
+  CHECK(seen[0].chord);  // the carried step went through; the next iteration's Hessian threw
+  newton.options().progress = nullptr;
   failing.fail = false;
   x = mesh.V;
   CHECK_FALSE(newton.solve(exec::omp, x, both.boundary(), flesh, failing).history.at(0).chord);
