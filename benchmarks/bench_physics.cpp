@@ -372,23 +372,25 @@ void BM_frame(benchmark::State& state) {
   QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage, FrameSmoother, ChebyshevDegree));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
+  // x solved under one frame's activations, track targets and jaw (its Dirichlet boundary)
+  const auto solve = [&](const std::vector<MuscleFibre<>>& elements, const Points<>& targets, const DirichletBoundary<>& bc) {
+    elastic.set_elements(elements);
+    springs.set_targets(targets);
+    return newton.solve(Policy{}, x, bc, elastic, *s.gravity, springs);
+  };
   // SolveAFirst: frame A solved (untimed) from the frame before it, just before each frame B, as
   // in a sequence of frames: what the solver carries into B (a chord_first setup, lagged coarse
   // levels) is then A's, not the last timed B's
   const auto frame_a = [&] {
     x = s.x_before_a;
-    elastic.set_elements(s.elements_a);
-    springs.set_targets(s.targets_a);
-    newton.solve(Policy{}, x, s.bc_a, elastic, *s.gravity, springs);
+    solve(s.elements_a, s.targets_a, s.bc_a);
   };
   const auto frame = [&] {
     if constexpr (Extrapolate)
       x = 2 * s.x_a - s.x_before_a;    // the last two frames extrapolated
     else
       x = s.x_a;                       // previous frame's converged solution
-    elastic.set_elements(s.elements_b);  // this frame's activations
-    springs.set_targets(s.targets_b);    // this frame's track targets
-    report = newton.solve(Policy{}, x, s.bc_b, elastic, *s.gravity, springs);  // jaw at this frame's angle
+    report = solve(s.elements_b, s.targets_b, s.bc_b);
   };
   // Warm-up: one Newton iteration of the frame (gather lists, the Cholesky's symbolic analysis,
   // buffers), cut short by max_iterations = 1 (which reports as a ConvergenceError).

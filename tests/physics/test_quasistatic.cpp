@@ -261,13 +261,18 @@ struct MuscleBlock {
   TetMesh<double> mesh = discretize::bcc_lattice(box_tet_mesh<double>(2, 2, 6, Vec3<>(0, 0, 0), Vec3<>(0.1, 0.1, 0.3)), 0.025).mesh;
   ElasticEnergy<TeranMuscle<>> flesh{mesh, TeranMuscle<>(), std::vector<MuscleFibre<>>(std::size_t(mesh.num_tets()), MuscleFibre<>{Vec3<>::UnitZ(), 0.3})};
   Gravity<> gravity{mesh, 1000.0, Vec3<>(0, 0, -9.81)};
+  /// Bones "top" and (with `bottom`) "bottom" on the block's end faces, at rest.
+  BoneAttachments<> held_ends(bool bottom = true) const {
+    BoneAttachments<> ends(mesh.V);
+    ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
+    if (bottom) ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
+    return ends;
+  }
   /// Both ends held, the bottom one turned and pulled by random amounts (u: uniform on [−1, 1]).
   template <class Rng>
   BoneAttachments<> random_ends(Rng& rng) const {
     std::uniform_real_distribution<double> u(-1, 1);
-    BoneAttachments<> ends(mesh.V);
-    ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
-    ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
+    BoneAttachments<> ends = held_ends();
     ends.set_transform("bottom", RigidTransform<>{Eigen::AngleAxisd(0.4 * u(rng), Vec3<>::UnitZ()).toRotationMatrix(),
                                                   Vec3<>(0.03 * u(rng), 0.03 * u(rng), 0.03 * u(rng))});
     return ends;
@@ -519,18 +524,19 @@ TEST_CASE("NewtonOptions::chord_first: frames in a sequence start from the previ
   const auto& flesh = block.flesh;
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> u(-1, 1);
+  const auto options = [](bool chord_first) {
+    NewtonOptions o;
+    o.relative_tolerance = 1e-9;
+    o.forcing = NewtonOptions::Forcing::adaptive;
+    o.chord_first = chord_first;
+    return o;
+  };
   int carried = 0, refused = 0, hessians_newton = 0, hessians_carried = 0;
   for (int sequence = 0; sequence < 4; ++sequence) {
     const double turn = 0.08 * u(rng), pull = 0.006 * u(rng), shear = 0.006 * u(rng);
-    BoneAttachments<> ends(mesh.V);
-    ends.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
-    ends.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
+    BoneAttachments<> ends = block.held_ends();
     const auto run = [&]<class Linear>(Linear linear, bool chord_first, auto policy) {
-      NewtonOptions o;
-      o.relative_tolerance = 1e-9;
-      o.forcing = NewtonOptions::Forcing::adaptive;
-      o.chord_first = chord_first;
-      QuasistaticSolver<Linear> newton(mesh.num_vertices(), mesh.T, o, std::move(linear));
+      QuasistaticSolver<Linear> newton(mesh.num_vertices(), mesh.T, options(chord_first), std::move(linear));
       CountedGravity counted{&block.gravity};
       Points<> x = mesh.V;
       std::vector<Points<>> frames;
@@ -576,18 +582,11 @@ TEST_CASE("NewtonOptions::chord_first: frames in a sequence start from the previ
   CHECK(hessians_carried < hessians_newton);
 
   // the guards: other fixed DOFs, and a setup lost to a throw, carry nothing
-  NewtonOptions o;
-  o.relative_tolerance = 1e-9;
-  o.forcing = NewtonOptions::Forcing::adaptive;
-  o.chord_first = true;
   using Pcg = ConjugateGradient<BlockJacobi<>>;
-  QuasistaticSolver<Pcg> newton(mesh.num_vertices(), mesh.T, o, Pcg({.tolerance = 1e-10}));
+  QuasistaticSolver<Pcg> newton(mesh.num_vertices(), mesh.T, options(true), Pcg({.tolerance = 1e-10}));
   FailingGravity failing;
   failing.gravity = &block.gravity;
-  BoneAttachments<> both(mesh.V), top_only(mesh.V);
-  both.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
-  both.add_bone("bottom", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() < 1e-9; }));
-  top_only.add_bone("top", select_vertices(mesh.V, [&](const Vec3<>& p) { return p.z() > 0.3 - 1e-9; }));
+  BoneAttachments<> both = block.held_ends(), top_only = block.held_ends(false);
   both.set_transform("bottom", RigidTransform<>{Mat3<>::Identity(), Vec3<>(0, 0, 0.01)});
   Points<> x = mesh.V;
   CHECK_FALSE(newton.solve(exec::omp, x, both.boundary(), flesh, failing).history.at(0).chord);
