@@ -8,14 +8,17 @@
 //   BM_face_frame/lr_paper_size_single  … with the multigrid's level matrices in single precision
 //   BM_face_frame/hr_default      the HR tetgen mesh of the default model (~135k tets, lip contact)
 //   BM_face_frame/lr_paper_size_…_sequence   frame 60 solved (untimed) before each timed frame 61,
-//       as in a run: `single` the defaults with single-precision levels (the baseline),
-//       `inexact_chebyshev2` Eisenstat–Walker forcing + coarse levels every 4th setup + Chebyshev
-//       degree 2 (bench_physics's fastest frame), `…_chord_first` that with NewtonOptions::chord_first
+//       as in a run: `single` the defaults before issue #17 item 1 switched them (fixed forcing,
+//       one Jacobi sweep, levels rebuilt at every setup; single-precision levels), the baseline;
+//       `fixed_forcing` today's defaults with each Newton system solved to linear.tolerance;
+//       `defaults` FaceSimulationOptions{} (Eisenstat–Walker forcing at LR, Chebyshev degree 2,
+//       coarse levels kept over 4 setups, single-precision levels)
+//   BM_face_frame/hr_default_{previous,defaults}_sequence   the same at HR (hr_forcing: fixed)
 //   BM_face_performance/lr_paper_size_…   the whole 120-frame amazement performance at the paper's
 //       LR size, stepped as `simsr datagen` does, timed as one (counter ms_per_frame), with the
-//       same three solver settings; counters diff_vs_defaults_* and diff_vs_converged_* (max and
-//       mean vertex distance over all frames, mm) against the defaults' frames and against the
-//       frames converged to ‖g‖ ≤ 1e-9 × the forces' scale (both solved untimed first)
+//       same three settings; counters diff_vs_previous_* and diff_vs_converged_* (max and mean
+//       vertex distance over all frames, mm) against the previous defaults' frames and against
+//       the frames converged to ‖g‖ ≤ 1e-9 × the forces' scale (both solved untimed first)
 //
 // Scene: the ICT face from the bundled kit (data_dir()/ict_face), the model built once per
 // resolution case (tetgen, lattice, muscles; untimed). A frame is what `simsr datagen` does for
@@ -59,13 +62,18 @@ const scenario::FaceModel& face_model(const std::string& preset) {
   return *slot;
 }
 
-/// How a case sets the Newton and multigrid options beyond the defaults.
+/// How a case sets the Newton and multigrid options.
 enum class Solver {
-  defaults,  ///< FaceSimulationOptions as they are (with `storage`)
-  /// the fastest configuration of bench_physics's frame (issue #17 item 1): Eisenstat–Walker
-  /// forcing, coarse levels every 4th setup, Chebyshev degree 2, single-precision levels
-  inexact_chebyshev,
-  inexact_chebyshev_chord_first,  ///< … and NewtonOptions::chord_first
+  /// FaceSimulationOptions' defaults before issue #17 item 1 switched them (2026-12-06), the
+  /// rows' baseline: fixed forcing, one Jacobi sweep, the levels rebuilt at every setup, no
+  /// carried first step
+  previous,
+  /// the defaults with each Newton system solved to linear.tolerance (fixed forcing), the
+  /// Eisenstat–Walker forcing's baseline
+  fixed_forcing,
+  /// FaceSimulationOptions{} as it is: Eisenstat–Walker forcing at LR, a Chebyshev smoother of
+  /// degree 2, coarse levels kept over 4 setups, single-precision levels
+  defaults,
 };
 
 /// FaceSimulationOptions for `solver` (with the multigrid's `storage`; csr also runs PCG's own
@@ -74,12 +82,11 @@ scenario::FaceSimulationOptions solver_options(Solver solver, physics::Multigrid
   scenario::FaceSimulationOptions options;
   options.multigrid.storage = storage;
   options.linear.block_products = storage != physics::MultigridOptions::Storage::csr;
-  if (solver != Solver::defaults) {
-    options.newton.forcing = physics::NewtonOptions::Forcing::adaptive;
-    options.multigrid.coarse_refresh_every = 4;
-    options.multigrid.smoother = physics::MultigridOptions::Smoother::chebyshev;
-    options.multigrid.chebyshev_degree = 2;
-    options.newton.chord_first = solver == Solver::inexact_chebyshev_chord_first;
+  if (solver == Solver::defaults) return options;
+  options.newton.forcing = physics::NewtonOptions::Forcing::fixed;
+  if (solver == Solver::previous) {
+    options.multigrid.coarse_refresh_every = 1;
+    options.multigrid.smoother = physics::MultigridOptions::Smoother::jacobi;
   }
   return options;
 }
@@ -89,7 +96,7 @@ scenario::FaceSimulationOptions solver_options(Solver solver, physics::Multigrid
 /// solved (untimed, from 59) before each timed frame 61, as in a run, so what the solver carries
 /// into 61 (lagged coarse levels, a chord_first setup) is frame 60's, not the last timed 61's.
 void BM_face_frame(benchmark::State& state, const std::string& preset, scenario::FaceResolution res,
-                   physics::MultigridOptions::Storage storage = physics::MultigridOptions::Storage::block, Solver solver = Solver::defaults,
+                   physics::MultigridOptions::Storage storage = physics::MultigridOptions::Storage::block, Solver solver = Solver::previous,
                    bool sequence = false) {
   if (!std::filesystem::exists(data_dir() / "ict_face" / "full_neutral.obj")) {
     state.SkipWithError("the ICT kit is not in data_dir()/ict_face");
@@ -142,7 +149,7 @@ void BM_face_frame(benchmark::State& state, const std::string& preset, scenario:
 /// A whole built-in performance (amazement, seed 1, 120 frames) from the settled neutral, as
 /// `simsr datagen` steps it, timed as one: counters ms_per_frame, the Newton and PCG iterations
 /// summed over the frames, and how far each frame's vertices lie from the same frame solved with
-/// Solver::defaults and from the same frame converged far below the default tolerances (max and
+/// Solver::previous and from the same frame converged far below the default tolerances (max and
 /// mean over frames and vertices, mm: the spread the default tolerances allow, and the error).
 void BM_face_performance(benchmark::State& state, const std::string& preset, Solver solver) {
   if (!std::filesystem::exists(data_dir() / "ict_face" / "full_neutral.obj")) {
@@ -151,7 +158,7 @@ void BM_face_performance(benchmark::State& state, const std::string& preset, Sol
   }
   const auto& face = face_model(preset);
   const auto perf = scenario::builtin_performance("amazement", face.expression_names, 1);
-  // per preset, untimed: Solver::defaults' frames, and the frames converged far below the default
+  // per preset, untimed: Solver::previous' frames, and the frames converged far below the default
   // tolerances (‖g‖ ≤ 1e-9 × the forces' scale, PCG to 1e-8), the yardstick of both
   static std::map<std::string, std::vector<Points<>>> reference, converged;
   const auto run = [&](Solver which, std::vector<Points<>>& frames, Index& newton, Index& linear, bool tight = false) {
@@ -180,8 +187,8 @@ void BM_face_performance(benchmark::State& state, const std::string& preset, Sol
     Index n = 0, l = 0;
     reference[preset] = frame_storage();
     converged[preset] = frame_storage();
-    run(Solver::defaults, reference[preset], n, l);
-    run(Solver::defaults, converged[preset], n, l, true);
+    run(Solver::previous, reference[preset], n, l);
+    run(Solver::previous, converged[preset], n, l, true);
   }
   std::vector<Points<>> frames = frame_storage();
   Index newton = 0, linear = 0;
@@ -199,7 +206,7 @@ void BM_face_performance(benchmark::State& state, const std::string& preset, Sol
     state.counters[std::string(name) + "_max_mm"] = 1e3 * max_diff;
     state.counters[std::string(name) + "_mean_mm"] = 1e3 * sum_diff / double(std::max<Index>(count, 1));
   };
-  spread(reference[preset], "diff_vs_defaults");
+  spread(reference[preset], "diff_vs_previous");
   spread(converged[preset], "diff_vs_converged");
   const double F = double(perf.num_frames());
   state.counters["frames"] = F;
@@ -210,18 +217,18 @@ void BM_face_performance(benchmark::State& state, const std::string& preset, Sol
 
 }  // namespace
 
-BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_single, std::string("paper-lr"), Solver::defaults)
+BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_single, std::string("paper-lr"), Solver::previous)
     ->Name("BM_face_performance/lr_paper_size_single")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
-BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_inexact_chebyshev2, std::string("paper-lr"), Solver::inexact_chebyshev)
-    ->Name("BM_face_performance/lr_paper_size_inexact_chebyshev2")
+BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_fixed_forcing, std::string("paper-lr"), Solver::fixed_forcing)
+    ->Name("BM_face_performance/lr_paper_size_fixed_forcing")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
-BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_inexact_chebyshev2_chord_first, std::string("paper-lr"), Solver::inexact_chebyshev_chord_first)
-    ->Name("BM_face_performance/lr_paper_size_inexact_chebyshev2_chord_first")
+BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_defaults, std::string("paper-lr"), Solver::defaults)
+    ->Name("BM_face_performance/lr_paper_size_defaults")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
@@ -249,25 +256,37 @@ BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single, std::string("paper-lr"), 
 // in a sequence (frame 60 solved untimed before each timed 61): the single-precision row, the
 // fastest configuration of bench_physics's frame, and that with chord_first
 BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
-                  physics::MultigridOptions::Storage::block_single, Solver::defaults, true)
+                  physics::MultigridOptions::Storage::block_single, Solver::previous, true)
     ->Name("BM_face_frame/lr_paper_size_single_sequence")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
-BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_inexact_chebyshev2_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
-                  physics::MultigridOptions::Storage::block_single, Solver::inexact_chebyshev, true)
-    ->Name("BM_face_frame/lr_paper_size_inexact_chebyshev2_sequence")
+BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_fixed_forcing_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
+                  physics::MultigridOptions::Storage::block_single, Solver::fixed_forcing, true)
+    ->Name("BM_face_frame/lr_paper_size_fixed_forcing_sequence")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
-BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_inexact_chebyshev2_chord_first_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
-                  physics::MultigridOptions::Storage::block_single, Solver::inexact_chebyshev_chord_first, true)
-    ->Name("BM_face_frame/lr_paper_size_inexact_chebyshev2_chord_first_sequence")
+BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_defaults_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
+                  physics::MultigridOptions::Storage::block_single, Solver::defaults, true)
+    ->Name("BM_face_frame/lr_paper_size_defaults_sequence")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
 BENCHMARK_CAPTURE(BM_face_frame, hr_default, std::string("default"), scenario::FaceResolution::high)
     ->Name("BM_face_frame/hr_default")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
+BENCHMARK_CAPTURE(BM_face_frame, hr_default_defaults_sequence, std::string("default"), scenario::FaceResolution::high,
+                  physics::MultigridOptions::Storage::block_single, Solver::defaults, true)
+    ->Name("BM_face_frame/hr_default_defaults_sequence")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
+BENCHMARK_CAPTURE(BM_face_frame, hr_default_previous_sequence, std::string("default"), scenario::FaceResolution::high,
+                  physics::MultigridOptions::Storage::block, Solver::previous, true)
+    ->Name("BM_face_frame/hr_default_previous_sequence")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3);
