@@ -253,8 +253,8 @@ BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single, std::string("paper-lr"), 
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
-// in a sequence (frame 60 solved untimed before each timed 61): the single-precision row, the
-// fastest configuration of bench_physics's frame, and that with chord_first
+// in a sequence (frame 60 solved untimed before each timed 61): the previous defaults (with
+// single-precision levels), today's with fixed forcing, today's
 BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
                   physics::MultigridOptions::Storage::block_single, Solver::previous, true)
     ->Name("BM_face_frame/lr_paper_size_single_sequence")
