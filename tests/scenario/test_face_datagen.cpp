@@ -359,7 +359,7 @@ TEST_CASE("face simulator (HR): frames at the default tolerances are within 30 �
   CHECK(s.worst < 3e-5);
 }
 
-TEST_CASE("face simulator: Eisenstat-Walker forcing on the LR mesh, hr_forcing on the HR mesh; hr_forcing is in the run's fingerprint") {
+TEST_CASE("face simulator: newton.forcing (here Eisenstat-Walker) on the LR mesh, hr_forcing on the HR mesh; hr_forcing is in the run's fingerprint") {
   SIMSR_REQUIRE_FACE_INPUTS();
   const auto& face = test::coarse_face();
   const auto first_linear_tolerance = [&](scenario::FaceResolution res, const scenario::FaceSimulationOptions& o) {
@@ -369,8 +369,8 @@ TEST_CASE("face simulator: Eisenstat-Walker forcing on the LR mesh, hr_forcing o
     REQUIRE_FALSE(r.history.empty());
     return r.history.front().linear_tolerance;
   };
-  const scenario::FaceSimulationOptions defaults;
-  REQUIRE(defaults.newton.forcing == physics::NewtonOptions::Forcing::adaptive);
+  scenario::FaceSimulationOptions defaults;
+  defaults.newton.forcing = physics::NewtonOptions::Forcing::adaptive;
   REQUIRE(defaults.hr_forcing == physics::NewtonOptions::Forcing::fixed);
   CHECK(first_linear_tolerance(scenario::FaceResolution::low, defaults) > 10 * defaults.linear.tolerance);  // η₀ = forcing_max
   CHECK(first_linear_tolerance(scenario::FaceResolution::high, defaults) == defaults.linear.tolerance);
@@ -617,7 +617,7 @@ TEST_CASE("face datagen: every frame converged with no inverted tet, mid-lips ap
     // were: the difference is the default tolerance's); each default-tolerance frame lies within the 20 µm
     // of its tight solve that the tolerance case above proves, so the two within 40 µm. At HR
     // (the surface only in the file; each frame within the HR tolerance case's 30 µm of its
-    // tight solve), held to the same 40 µm (17 µm measured with today's defaults).
+    // tight solve), held to the same 40 µm.
     scenario::FaceSimulationOptions tight;
     tight.newton.relative_tolerance = 1e-10;
     tight.newton.absolute_tolerance = 1e-5;
