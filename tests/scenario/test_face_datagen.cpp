@@ -378,6 +378,11 @@ TEST_CASE("face simulator: newton.forcing (here Eisenstat-Walker) on the LR mesh
   adaptive_hr.hr_forcing = physics::NewtonOptions::Forcing::adaptive;
   CHECK(first_linear_tolerance(scenario::FaceResolution::high, adaptive_hr) > 10 * defaults.linear.tolerance);
   CHECK(scenario::detail::face_run_fingerprint(face, adaptive_hr, nullptr) != scenario::detail::face_run_fingerprint(face, defaults, nullptr));
+  // with fixed forcing on the LR mesh too (the defaults), another hr_forcing is another run as well
+  const scenario::FaceSimulationOptions plain;
+  scenario::FaceSimulationOptions plain_other_hr = plain;
+  plain_other_hr.hr_forcing = physics::NewtonOptions::Forcing::adaptive;
+  CHECK(scenario::detail::face_run_fingerprint(face, plain_other_hr, nullptr) != scenario::detail::face_run_fingerprint(face, plain, nullptr));
 }
 #endif
 

@@ -232,7 +232,9 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
   f.add(std::int64_t(o.newton.forcing)).add(o.newton.forcing_max).add(std::int64_t(o.newton.forcing_safeguard)).add(std::int64_t(o.newton.hessian));
   f.add(o.newton.chord_below).add(o.newton.step_tolerance).add(o.newton.reference_force);
   if (o.newton.chord_first) f.add(std::int64_t(1));  // only when on: runs made before the option keep their fingerprint
-  f.add(std::int64_t(o.hr_forcing));
+  // only where the meshes' forcings differ: before the option both used newton.forcing, and a run
+  // where they still agree (the defaults) keeps the fingerprint it had
+  if (o.hr_forcing != o.newton.forcing) f.add(std::int64_t(o.hr_forcing));
   if (p) {
     f.add(p->weights);
     for (const auto& n : p->names) f.add_bytes(n.data(), n.size());

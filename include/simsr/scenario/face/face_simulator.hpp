@@ -114,10 +114,9 @@ struct FaceSimulationOptions {
   physics::NewtonOptions newton = default_newton();
   /// Newton's forcing on the HR mesh, in place of newton.forcing (which the LR mesh uses): fixed
   /// (each system to linear.tolerance). With the lip contact, Eisenstat–Walker's loose systems
-  /// cost Newton steps:
-  /// on the coarse model's 4 HR frames of the HR tolerance case (tests/scenario/test_face_datagen.cpp)
-  /// run with each forcing, 24 Newton steps against 12 and frames 41 µm from tightly solved ones
-  /// against 25.
+  /// cost Newton steps: the HR tolerance case of tests/scenario/test_face_datagen.cpp (the coarse
+  /// model's 4 HR frames), run with each forcing, took 24 Newton steps against 12 and ended 41 µm
+  /// from tightly solved frames against 25.
   physics::NewtonOptions::Forcing hr_forcing = physics::NewtonOptions::Forcing::fixed;
   /// Also try the linear extrapolation of the last two frames (2x₁ − x₀, carried by the jaw) as
   /// the warm start, taken when its total energy is lower than the last frame's: along a smooth
