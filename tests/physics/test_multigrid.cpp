@@ -146,6 +146,96 @@ TEST_CASE("Multigrid: a second compute starts its eigenvalue estimate warm; forg
   CHECK(zu == zf);
 }
 
+/// λ_max(B⁻¹A), B the 3×3 diagonal blocks of A, by a dense generalized eigensolve (the
+/// brute-force reference of the multigrid's estimates).
+double dense_block_jacobi_lambda_max(const SparseMatrix<>& A) {
+  const Eigen::MatrixXd D = Eigen::MatrixXd(A);
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(D.rows(), D.cols());
+  for (Index v = 0; v < D.rows() / 3; ++v) B.block<3, 3>(3 * v, 3 * v) = D.block<3, 3>(3 * v, 3 * v);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(D, B, Eigen::EigenvaluesOnly);
+  REQUIRE(eig.info() == Eigen::Success);
+  return eig.eigenvalues().maxCoeff();
+}
+
+/// Level 1's matrix as Multigrid builds it: Pᵀ A P with the rows of A's decoupled (Dirichlet)
+/// DOFs left out of P, a zero row made an identity row.
+SparseMatrix<> galerkin_level_1(const SparseMatrix<>& A, const SparseMatrix<>& P, const std::vector<char>& fixed) {
+  Eigen::MatrixXd Pd = Eigen::MatrixXd(P);
+  for (Index r = 0; r < Pd.rows(); ++r)
+    if (fixed[std::size_t(r)]) Pd.row(r).setZero();
+  Eigen::MatrixXd C = Pd.transpose() * Eigen::MatrixXd(A) * Pd;
+  for (Index r = 0; r < C.rows(); ++r)
+    if (C.row(r).cwiseAbs().maxCoeff() == 0) C(r, r) = 1;
+  return C.sparseView();
+}
+
+TEST_CASE("Multigrid: the Lanczos estimate of λ_max(B⁻¹A) (the Chebyshev smoother's) is a Ritz value within 10% of the dense eigensolve's on levels 0 and 1, also with a vertex scaled by 1e-20") {
+  int checked = 0;
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    auto s = stiffness_system(5 + seed, 3, seed);
+    const SparseMatrix<> A = s.A();
+    const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 30}).prolongations;
+    REQUIRE(prolongations.size() >= 2);
+    // a vertex whose rows and columns are 1e-20 of the others' (a Galerkin level's DOF that almost no
+    // fine DOF reaches): D A D has B⁻¹A's spectrum (D B D)⁻¹(D A D) = D⁻¹ B⁻¹A D, so the same λ
+    std::mt19937 rng(seed);
+    const Index tiny = Index(rng() % std::uint32_t(s.mesh.num_vertices()));
+    VecX<> d = VecX<>::Ones(A.rows());
+    d.segment<3>(3 * tiny).setConstant(1e-20);
+    const SparseMatrix<> scaled = d.asDiagonal() * A * d.asDiagonal();
+    for (const bool scale : {false, true}) {
+      const SparseMatrix<>& M = scale ? scaled : A;
+      MultigridOptions o;
+      o.smoother = MultigridOptions::Smoother::chebyshev;
+      REQUIRE(o.spectrum == MultigridOptions::Spectrum::automatic);  // Lanczos for Chebyshev
+      Multigrid<> mg(prolongations, o);
+      mg.compute(exec::omp, M);
+      const double truth0 = dense_block_jacobi_lambda_max(M);
+      const double truth1 = dense_block_jacobi_lambda_max(galerkin_level_1(M, prolongations[0], s.fixed));
+      for (const auto& [level, truth] : {std::pair{Index(0), truth0}, std::pair{Index(1), truth1}}) {
+        const double ritz = mg.spectrum_bound(level) / 1.1;
+        CAPTURE(seed);
+        CAPTURE(scale);
+        CAPTURE(level);
+        CHECK(ritz <= truth * (1 + 1e-9));  // a Ritz value: never above λ_max
+        CHECK(ritz >= 0.9 * truth);
+        CHECK(mg.damping(level) == doctest::Approx(4.0 / (3.0 * mg.spectrum_bound(level))));
+        ++checked;
+      }
+      if (scale) CHECK(std::abs(mg.spectrum_bound(0) / 1.1 - truth0) <= 0.1 * truth0);
+    }
+  }
+  CHECK(checked == 16);
+  CHECK_THROWS_AS(Multigrid<>({}, {.lanczos_iterations = 0}), ArgumentError);
+}
+
+TEST_CASE("Multigrid: the Lanczos estimate starts cold at every compute (no history, no forget_estimates needed), seq == omp bitwise") {
+  auto s = stiffness_system(12, 4, 3);
+  const SparseMatrix<>& A = s.A();
+  const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
+  SparseMatrix<> B = A;
+  B *= 1.5;
+  MultigridOptions o;
+  o.spectrum = MultigridOptions::Spectrum::lanczos;  // with the Jacobi smoother too, when asked for
+  Multigrid<> used(prolongations, o), fresh(prolongations, o), serial(prolongations, o);
+  used.compute(exec::omp, A);
+  used.compute(exec::omp, B);
+  fresh.compute(exec::omp, B);
+  serial.compute(exec::seq, B);
+  REQUIRE(used.num_levels() >= 3);
+  for (Index l = 0; l + 1 < used.num_levels(); ++l) {
+    CHECK(used.spectrum_bound(l) == fresh.spectrum_bound(l));
+    CHECK(serial.spectrum_bound(l) == fresh.spectrum_bound(l));
+    CHECK(fresh.spectrum_bound(l) > 1.0);
+  }
+  VecX<> zu, zf, zs;
+  used.apply(exec::omp, s.b, zu);
+  fresh.apply(exec::omp, s.b, zf);
+  serial.apply(exec::seq, s.b, zs);
+  CHECK(zu == zf);
+  CHECK(zs == zf);
+}
+
 TEST_CASE("Multigrid: coarse levels lagged (coarse_refresh_every): SPD and symmetric, PCG converges to the new matrix's solution; rebuilt on schedule, after forget_estimates and when the Dirichlet rows change") {
   auto s = stiffness_system(16, 4, 3);
   const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
@@ -283,16 +373,14 @@ TEST_CASE("Multigrid, Chebyshev smoother: degree 1 is damped Jacobi with omega =
   const SparseMatrix<>& A = s.A();
   const Index n = A.rows();
   // one smoothed level (the second is the coarsest, solved directly): the Jacobi V-cycle with the
-  // same lambda estimate and omega = 2 / (lambda / ratio + lambda) is the degree-1 polynomial
+  // Chebyshev smoother's lambda estimate and omega = 2 / (lambda / ratio + lambda) is the degree-1 polynomial
   const auto two_levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40, .max_levels = 1}).prolongations;
   REQUIRE(two_levels.size() == 1);
-  Multigrid<> jacobi_probe(two_levels);
-  jacobi_probe.compute(exec::seq, A);
-  const double lambda = 4.0 / (3.0 * jacobi_probe.damping(0));
   const double ratio = 7;
   Multigrid<> cheb1(two_levels, {.smoother = MultigridOptions::Smoother::chebyshev, .chebyshev_degree = 1, .chebyshev_ratio = ratio});
-  Multigrid<> jac(two_levels, {.damping = 2.0 / (lambda / ratio + lambda)});
   cheb1.compute(exec::seq, A);
+  const double lambda = cheb1.spectrum_bound(0);
+  Multigrid<> jac(two_levels, {.damping = 2.0 / (lambda / ratio + lambda)});
   jac.compute(exec::seq, A);
   std::mt19937 rng(5);
   std::normal_distribution<double> N;

@@ -45,6 +45,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 
 #include "../../core/error.hpp"
@@ -150,8 +151,26 @@ LatticeHierarchy<S> lattice_hierarchy(Policy policy, const TetMesh<S>& mesh, con
 struct MultigridOptions {
   int smoothing_sweeps = 1;    ///< damped block-Jacobi sweeps before and after each coarse correction
   double damping = 0;          ///< ω; 0: 4 / (3 λ_max(B⁻¹A)) estimated per level at compute()
-  int power_iterations = 12;   ///< for that estimate, at the first compute()
+  /// How λ_max(B⁻¹A) (ω's and the Chebyshev interval's) is estimated at each compute():
+  /// - `power`: power iterations, `power_iterations` at the first compute() and
+  ///   `warm_power_iterations` at later ones, started from the last estimate's vector.
+  /// - `lanczos`: `lanczos_iterations` steps of block-Jacobi-preconditioned CG from a fixed vector,
+  ///   λ the largest eigenvalue of their Lanczos tridiagonal (the estimate PETSc's and hypre's
+  ///   Chebyshev smoothers make). A Krylov space finds an extreme eigenvalue in far fewer products
+  ///   than the power method, whose few warm iterations lag when the matrix changes: on the coarse
+  ///   face model's HR mesh, a frame whose lip contact switched on (one Newton iteration to the
+  ///   next) had its finest level's λ under-estimated 2.0× and the coarse levels' 2.2–2.7× by the
+  ///   power method (against 300 power iterations). The Chebyshev polynomial grows past 1 in
+  ///   magnitude just 10% above its interval, so those modes were amplified, the V-cycle stopped
+  ///   being positive definite, and PCG ran its full iteration count on the Newton system.
+  ///   Starting cold at every compute() also makes a compute independent of the ones before it.
+  /// - `automatic` (the default): `lanczos` for the Chebyshev smoother, `power` for Jacobi (whose
+  ///   ω = 4 / (3λ) contracts up to 1.65× past the padded estimate).
+  enum class Spectrum { automatic, power, lanczos };
+  Spectrum spectrum = Spectrum::automatic;
+  int power_iterations = 12;   ///< for the power estimate, at the first compute()
   int warm_power_iterations = 2;  ///< at later ones, started from the last estimate's vector
+  int lanczos_iterations = 10;  ///< for the Lanczos estimate, at every compute()
   /// The coarse levels (Galerkin products, their smoothers, the coarsest factorization) are
   /// built by one compute() and kept for the next n − 1 (and rebuilt by the first after
   /// forget_estimates() or a change of the Dirichlet rows); between, a
@@ -200,8 +219,8 @@ class Multigrid {
   /// one-level method: a direct solve of A (useful as a check, costly at scale).
   explicit Multigrid(std::vector<SparseMatrix<S>> prolongations, MultigridOptions options = {}) : options_(options) {
     if (options.smoothing_sweeps < 1) throw ArgumentError("Multigrid: smoothing_sweeps must be at least 1");
-    if (options.power_iterations < 1 || options.warm_power_iterations < 1)
-      throw ArgumentError("Multigrid: power_iterations and warm_power_iterations must be at least 1");
+    if (options.power_iterations < 1 || options.warm_power_iterations < 1 || options.lanczos_iterations < 1)
+      throw ArgumentError("Multigrid: power_iterations, warm_power_iterations and lanczos_iterations must be at least 1");
     if (options.damping < 0 || !(options.damping < 2)) throw ArgumentError("Multigrid: damping must be in [0, 2) (0: automatic)");
     if (options.coarse_refresh_every < 1) throw ArgumentError("Multigrid: coarse_refresh_every must be at least 1");
     if (options.chebyshev_degree < 1) throw ArgumentError("Multigrid: chebyshev_degree must be at least 1");
@@ -230,6 +249,9 @@ class Multigrid {
   Index level_size(Index l) const { return Index(levels_.at(std::size_t(l)).b.size()); }
   /// ω used on level ℓ by the last compute().
   double damping(Index l) const { return levels_.at(std::size_t(l)).omega; }
+  /// The padded estimate of λ_max(B⁻¹A) on level ℓ by the last compute() (MultigridOptions::spectrum):
+  /// the Chebyshev smoother's interval ends there.
+  double spectrum_bound(Index l) const { return levels_.at(std::size_t(l)).lambda; }
   /// Forgets the power iterations' vectors: the next compute() starts cold, as the first did. A
   /// run that must not depend on its history (a resumed frame sequence, bitwise) calls it per frame.
   void forget_estimates() {
@@ -452,6 +474,59 @@ class Multigrid {
     return std::max(1.0, 1.1 * lambda);
   }
 
+  /// λ_max(B⁻¹A) by Lanczos (MultigridOptions::Spectrum::lanczos): CG on A y = A u preconditioned
+  /// by B⁻¹, u a fixed vector, whose coefficients α_j, β_j give the Lanczos tridiagonal of B⁻¹A in
+  /// the B-inner product (Saad, "Iterative methods for sparse linear systems", §6.7.3):
+  /// T_jj = 1/α_j + β_{j−1}/α_{j−1}, T_{j,j+1} = √β_j / α_j. Its largest eigenvalue (a Ritz
+  /// value, a lower bound of λ_max) is padded by 1.1 as the power estimate is. A step that meets
+  /// non-positive curvature (A or B not positive definite) ends the estimate with the steps before it.
+  template <exec::HostPolicy P>
+  double lanczos_lambda_max(P policy, Level& L) {
+    const Index n = L.matrix().rows();
+    const int m_max = options_.lanczos_iterations;
+    VecX<S>&r = L.r, &z = L.t, &p = L.v, &q = L.x;
+    r.resize(n);
+    z.resize(n);
+    p.resize(n);
+    q.resize(n);
+    // the start A u, u fixed: a Galerkin level can hold a DOF that almost no fine DOF reaches, whose
+    // row of A and diagonal block are ~1e-40 of the others; there B⁻¹ of a unit vector is ~1e40
+    // and swamps the recurrence (measured: a 1,539-DOF level's first ratio r·z 1e178, one step,
+    // λ 0.9 against 7.3), while B⁻¹(A u) is of the order of u everywhere
+    for (Index i = 0; i < n; ++i) p[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
+    multiply(policy, L, p, r);
+    L.smoother.apply(policy, r, z);
+    p = z;
+    double rz = double(dot(policy, r, z));
+    std::vector<double> alpha, beta;
+    if (rz > 0)
+      for (int j = 0; j < m_max; ++j) {
+        multiply(policy, L, p, q);
+        const double pq = double(dot(policy, p, q));
+        if (!(pq > 0)) break;
+        alpha.push_back(rz / pq);
+        const S a = S(alpha.back());
+        exec::parallel_for(policy, n, [&](Index i) { r[i] -= a * q[i]; });
+        L.smoother.apply(policy, r, z);
+        const double rz_next = double(dot(policy, r, z));
+        if (!(rz_next > 1e-30 * rz) || j + 1 == m_max) break;  // converged (or B indefinite), or the last step
+        beta.push_back(rz_next / rz);
+        rz = rz_next;
+        const S b = S(beta.back());
+        exec::parallel_for(policy, n, [&](Index i) { p[i] = z[i] + b * p[i]; });
+      }
+    const Index m = Index(alpha.size());
+    if (m == 0) return 1.0;
+    Eigen::VectorXd diagonal(m), off(std::max<Index>(m - 1, 0));
+    for (Index j = 0; j < m; ++j) {
+      diagonal[j] = 1 / alpha[std::size_t(j)] + (j > 0 ? beta[std::size_t(j - 1)] / alpha[std::size_t(j - 1)] : 0.0);
+      if (j + 1 < m) off[j] = std::sqrt(beta[std::size_t(j)]) / alpha[std::size_t(j)];
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig;
+    eig.computeFromTridiagonal(diagonal, off, Eigen::EigenvaluesOnly);
+    return std::max(1.0, 1.1 * eig.eigenvalues().maxCoeff());
+  }
+
   /// ω (Jacobi) and λ (Chebyshev) of a level whose smoother was just computed. A given damping
   /// skips the power iteration only where Jacobi alone uses it.
   template <exec::HostPolicy P>
@@ -462,7 +537,8 @@ class Multigrid {
       L.omega = options_.damping;
       return;
     }
-    L.lambda = lambda_max(policy, L);
+    const bool lanczos = options_.spectrum == MultigridOptions::Spectrum::lanczos || (options_.spectrum == MultigridOptions::Spectrum::automatic && chebyshev);
+    L.lambda = lanczos ? lanczos_lambda_max(policy, L) : lambda_max(policy, L);
     L.omega = options_.damping > 0 ? options_.damping : 4.0 / (3.0 * L.lambda);
   }
 
