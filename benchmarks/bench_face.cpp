@@ -8,15 +8,16 @@
 //   BM_face_frame/lr_paper_size_single  … with the multigrid's level matrices in single precision
 //   BM_face_frame/hr_default      the HR tetgen mesh of the default model (~135k tets, lip contact)
 //   BM_face_frame/lr_paper_size_…_sequence   frame 60 solved (untimed) before each timed frame 61,
-//       as in a run: `single` the defaults (fixed forcing, one Jacobi sweep, levels rebuilt at
-//       every setup; single-precision levels), the baseline; `fixed_forcing` Chebyshev degree 2
-//       and coarse levels kept over 4 setups; `candidate` that with Eisenstat–Walker forcing at LR,
-//       the candidate defaults of issue #17 item 1 (not FaceSimulationOptions{}: see the README)
-//   BM_face_frame/hr_default_{previous,candidate}_sequence   the same at HR (hr_forcing: fixed)
+//       as in a run: `single` the defaults before issue #17 item 1 switched them (fixed forcing,
+//       one Jacobi sweep, levels rebuilt at every setup; single-precision levels), the baseline;
+//       `fixed_forcing` today's defaults with each Newton system solved to linear.tolerance;
+//       `defaults` FaceSimulationOptions{} (Eisenstat–Walker forcing at LR, Chebyshev degree 2,
+//       coarse levels kept over 4 setups, single-precision levels)
+//   BM_face_frame/hr_default_{previous,defaults}_sequence   the same at HR (hr_forcing: fixed)
 //   BM_face_performance/lr_paper_size_…   the whole 120-frame amazement performance at the paper's
 //       LR size, stepped as `simsr datagen` does, timed as one (counter ms_per_frame), with the
-//       same three settings; counters diff_vs_defaults_* and diff_vs_converged_* (max and mean
-//       vertex distance over all frames, mm) against the defaults' frames and against
+//       same three settings; counters diff_vs_previous_* and diff_vs_converged_* (max and mean
+//       vertex distance over all frames, mm) against the previous defaults' frames and against
 //       the frames converged to ‖g‖ ≤ 1e-9 × the forces' scale (both solved untimed first)
 //
 // Scene: the ICT face from the bundled kit (data_dir()/ict_face), the model built once per
@@ -63,15 +64,16 @@ const scenario::FaceModel& face_model(const std::string& preset) {
 
 /// How a case sets the Newton and multigrid options.
 enum class Solver {
-  /// FaceSimulationOptions' defaults (fixed forcing, one Jacobi sweep, the levels rebuilt at
-  /// every setup), the rows' baseline
+  /// FaceSimulationOptions' defaults before issue #17 item 1 switched them (2026-12-06), the
+  /// rows' baseline: fixed forcing, one Jacobi sweep, the levels rebuilt at every setup, no
+  /// carried first step
   previous,
-  /// a Chebyshev smoother of degree 2, coarse levels kept over 4 setups, each Newton system
-  /// solved to linear.tolerance (fixed forcing)
+  /// the defaults with each Newton system solved to linear.tolerance (fixed forcing), the
+  /// Eisenstat–Walker forcing's baseline
   fixed_forcing,
-  /// the same with Eisenstat–Walker forcing at LR (hr_forcing stays fixed): the candidate
-  /// defaults of issue #17 item 1
-  candidate,
+  /// FaceSimulationOptions{} as it is: Eisenstat–Walker forcing at LR, a Chebyshev smoother of
+  /// degree 2, coarse levels kept over 4 setups, single-precision levels
+  defaults,
 };
 
 /// FaceSimulationOptions for `solver` (with the multigrid's `storage`; csr also runs PCG's own
@@ -80,11 +82,12 @@ scenario::FaceSimulationOptions solver_options(Solver solver, physics::Multigrid
   scenario::FaceSimulationOptions options;
   options.multigrid.storage = storage;
   options.linear.block_products = storage != physics::MultigridOptions::Storage::csr;
-  if (solver == Solver::previous) return options;
-  options.multigrid.smoother = physics::MultigridOptions::Smoother::chebyshev;
-  options.multigrid.chebyshev_degree = 2;
-  options.multigrid.coarse_refresh_every = 4;
-  if (solver == Solver::candidate) options.newton.forcing = physics::NewtonOptions::Forcing::adaptive;
+  if (solver == Solver::defaults) return options;
+  options.newton.forcing = physics::NewtonOptions::Forcing::fixed;
+  if (solver == Solver::previous) {
+    options.multigrid.coarse_refresh_every = 1;
+    options.multigrid.smoother = physics::MultigridOptions::Smoother::jacobi;
+  }
   return options;
 }
 
@@ -203,7 +206,7 @@ void BM_face_performance(benchmark::State& state, const std::string& preset, Sol
     state.counters[std::string(name) + "_max_mm"] = 1e3 * max_diff;
     state.counters[std::string(name) + "_mean_mm"] = 1e3 * sum_diff / double(std::max<Index>(count, 1));
   };
-  spread(reference[preset], "diff_vs_defaults");
+  spread(reference[preset], "diff_vs_previous");
   spread(converged[preset], "diff_vs_converged");
   const double F = double(perf.num_frames());
   state.counters["frames"] = F;
@@ -224,8 +227,8 @@ BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_fixed_forcing, std::string(
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
-BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_candidate, std::string("paper-lr"), Solver::candidate)
-    ->Name("BM_face_performance/lr_paper_size_candidate")
+BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_defaults, std::string("paper-lr"), Solver::defaults)
+    ->Name("BM_face_performance/lr_paper_size_defaults")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
@@ -250,8 +253,8 @@ BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single, std::string("paper-lr"), 
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
-// in a sequence (frame 60 solved untimed before each timed 61): the defaults (with
-// single-precision levels), Chebyshev + lagged levels with fixed forcing, with Eisenstat–Walker
+// in a sequence (frame 60 solved untimed before each timed 61): the previous defaults (with
+// single-precision levels), today's with fixed forcing, today's
 BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_single_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
                   physics::MultigridOptions::Storage::block_single, Solver::previous, true)
     ->Name("BM_face_frame/lr_paper_size_single_sequence")
@@ -264,9 +267,9 @@ BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_fixed_forcing_sequence, std::stri
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
-BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_candidate_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
-                  physics::MultigridOptions::Storage::block_single, Solver::candidate, true)
-    ->Name("BM_face_frame/lr_paper_size_candidate_sequence")
+BENCHMARK_CAPTURE(BM_face_frame, lr_paper_size_defaults_sequence, std::string("paper-lr"), scenario::FaceResolution::low,
+                  physics::MultigridOptions::Storage::block_single, Solver::defaults, true)
+    ->Name("BM_face_frame/lr_paper_size_defaults_sequence")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
@@ -275,9 +278,9 @@ BENCHMARK_CAPTURE(BM_face_frame, hr_default, std::string("default"), scenario::F
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3);
-BENCHMARK_CAPTURE(BM_face_frame, hr_default_candidate_sequence, std::string("default"), scenario::FaceResolution::high,
-                  physics::MultigridOptions::Storage::block_single, Solver::candidate, true)
-    ->Name("BM_face_frame/hr_default_candidate_sequence")
+BENCHMARK_CAPTURE(BM_face_frame, hr_default_defaults_sequence, std::string("default"), scenario::FaceResolution::high,
+                  physics::MultigridOptions::Storage::block_single, Solver::defaults, true)
+    ->Name("BM_face_frame/hr_default_defaults_sequence")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3);

@@ -229,6 +229,9 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
   f.add(std::int64_t(o.multigrid.smoothing_sweeps)).add(o.multigrid.damping).add(std::int64_t(o.multigrid.power_iterations)).add(std::int64_t(o.multigrid.warm_power_iterations));
   // the smoother and Newton's schedule (forcing, Hessian fallback, chord steps) change frames by PCG's tolerance
   f.add(std::int64_t(o.multigrid.smoother)).add(std::int64_t(o.multigrid.chebyshev_degree)).add(o.multigrid.chebyshev_ratio);
+  // the smoother's spectrum estimate (MultigridOptions::spectrum: Lanczos for Chebyshev since
+  // 2026-12-06, the power method's before) changes frames by PCG's tolerance
+  f.add(std::int64_t(o.multigrid.spectrum)).add(std::int64_t(o.multigrid.lanczos_iterations));
   f.add(std::int64_t(o.newton.forcing)).add(o.newton.forcing_max).add(std::int64_t(o.newton.forcing_safeguard)).add(std::int64_t(o.newton.hessian));
   f.add(o.newton.chord_below).add(o.newton.step_tolerance).add(o.newton.reference_force);
   if (o.newton.chord_first) f.add(std::int64_t(1));  // only when on: runs made before the option keep their fingerprint

@@ -93,7 +93,28 @@ struct FaceSimulationOptions {
     // 1.4 µm on average, from the first frame's ‖g‖ = 17 to full convergence).
     o.absolute_tolerance = 0.1;
     o.max_iterations = 30;  // ordinary frames take 2–7; beyond 30 continuation is cheaper
+    // Eisenstat–Walker: a frame's first systems are solved loosely (issue #17 item 1; bench_face's
+    // BM_face_performance, 120 frames at the paper's LR size: 254 PCG iterations against 1,004
+    // with PCG to 1e-4 in every system, ~0.75× the time, as close to tightly converged frames as
+    // the tolerance allows). The HR mesh keeps `hr_forcing` below.
+    o.forcing = physics::NewtonOptions::Forcing::adaptive;
     return o;
+  }
+  /// The V-cycle's defaults (issue #17 item 1, the same measurement: 1,004 PCG iterations over the
+  /// performance against 1,877 with one Jacobi sweep and the levels rebuilt at every setup, the
+  /// same frames to 0.5 µm): a Chebyshev smoother of degree 2, the coarse levels kept over 4
+  /// setups of a frame (a frame starts with fresh ones: FaceSimulator::advance), single-precision
+  /// 3×3-block levels (PCG itself stays in double). The Chebyshev interval comes from the Lanczos
+  /// estimate (MultigridOptions::spectrum, automatic): with the power method's, a large frame on
+  /// the HR mesh (the coarse model, neutral to a 0.6 smile) under-estimated coarse levels 2–2.7×,
+  /// the V-cycle lost definiteness and one Newton system ran PCG for minutes.
+  static physics::MultigridOptions default_multigrid() {
+    physics::MultigridOptions m;
+    m.smoother = physics::MultigridOptions::Smoother::chebyshev;
+    m.chebyshev_degree = 2;
+    m.coarse_refresh_every = 4;
+    m.storage = physics::MultigridOptions::Storage::block_single;
+    return m;
   }
   double mu10 = 4e3;            ///< Pa, Mooney–Rivlin (soft tissue: a few kPa)
   double mu01 = 1e3;            ///< Pa
@@ -130,7 +151,7 @@ struct FaceSimulationOptions {
   Index substep_levels = 3;
   physics::ConjugateGradientOptions linear{.tolerance = 1e-4};
   /// The V-cycle's options where Linear is PCG with the lattice multigrid (the default).
-  physics::MultigridOptions multigrid{};
+  physics::MultigridOptions multigrid = default_multigrid();
 };
 
 /// A quasistatic face simulator on one mesh of a FaceModel (see the file comment). Linear: the
