@@ -490,9 +490,9 @@ class Multigrid {
     p.resize(n);
     q.resize(n);
     // the start A u, u fixed: a Galerkin level can hold a DOF that almost no fine DOF reaches, whose
-    // row of A and diagonal block are ~1e-40 of the others; there B⁻¹ of a unit vector is ~1e40
-    // and swamps the recurrence (measured: a 1,539-DOF level's first ratio r·z 1e178, one step,
-    // λ 0.9 against 7.3), while B⁻¹(A u) is of the order of u everywhere
+    // row of A and diagonal block are many orders of magnitude below the others'; there B⁻¹ of a
+    // unit vector is as many above, and swamps the recurrence (measured: a 1,539-DOF level's first
+    // r·z 1e178, one step, λ 0.9 against 7.3), while B⁻¹(A u) is of the order of u everywhere
     for (Index i = 0; i < n; ++i) p[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
     multiply(policy, L, p, r);
     L.smoother.apply(policy, r, z);

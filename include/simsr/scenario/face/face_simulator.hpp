@@ -94,15 +94,15 @@ struct FaceSimulationOptions {
     o.absolute_tolerance = 0.1;
     o.max_iterations = 30;  // ordinary frames take 2–7; beyond 30 continuation is cheaper
     // Eisenstat–Walker: a frame's first systems are solved loosely (issue #17 item 1; bench_face's
-    // BM_face_performance, 120 frames at the paper's LR size: 254 PCG iterations against 1,004
-    // with PCG to 1e-4 in every system, ~0.75× the time, as close to tightly converged frames as
+    // BM_face_performance, 120 frames at the paper's LR size: 268 PCG iterations against 1,062
+    // with PCG to 1e-4 in every system, 0.79× the time, as close to tightly converged frames as
     // the tolerance allows). The HR mesh keeps `hr_forcing` below.
     o.forcing = physics::NewtonOptions::Forcing::adaptive;
     return o;
   }
-  /// The V-cycle's defaults (issue #17 item 1, the same measurement: 1,004 PCG iterations over the
+  /// The V-cycle's defaults (issue #17 item 1, the same measurement: 1,062 PCG iterations over the
   /// performance against 1,877 with one Jacobi sweep and the levels rebuilt at every setup, the
-  /// same frames to 0.5 µm): a Chebyshev smoother of degree 2, the coarse levels kept over 4
+  /// same frames to 0.7 µm): a Chebyshev smoother of degree 2, the coarse levels kept over 4
   /// setups of a frame (a frame starts with fresh ones: FaceSimulator::advance), single-precision
   /// 3×3-block levels (PCG itself stays in double). The Chebyshev interval comes from the Lanczos
   /// estimate (MultigridOptions::spectrum, automatic): with the power method's, a large frame on
