@@ -359,7 +359,7 @@ TEST_CASE("face simulator (HR): frames at the default tolerances are within 30 Â
   CHECK(s.worst < 3e-5);
 }
 
-TEST_CASE("face simulator: Eisenstat-Walker forcing on the LR mesh, hr_forcing on the HR mesh; hr_forcing is in the run's fingerprint") {
+TEST_CASE("face simulator: Eisenstat-Walker forcing on the LR mesh, hr_forcing on the HR mesh; hr_forcing and the smoother's spectrum estimate are in the run's fingerprint") {
   SIMSR_REQUIRE_FACE_INPUTS();
   const auto& face = test::coarse_face();
   const auto first_linear_tolerance = [&](scenario::FaceResolution res, const scenario::FaceSimulationOptions& o) {
