@@ -75,6 +75,49 @@ TEST_CASE("PCG: block-Jacobi needs no more iterations than Jacobi, incomplete Ch
   CHECK((x2 - x3).cwiseAbs().maxCoeff() == 0.0);
 }
 
+/// Jacobi with the sign flipped on the DOFs where `flip` is set: not positive definite.
+struct SignFlippedJacobi {
+  Jacobi<> inner;
+  std::vector<char> flip;
+  template <exec::HostPolicy P>
+  void compute(P policy, const SparseMatrix<>& A) {
+    inner.compute(policy, A);
+  }
+  template <exec::HostPolicy P>
+  void apply(P policy, const VecX<>& r, VecX<>& z) const {
+    inner.apply(policy, r, z);
+    for (Index i = 0; i < z.size(); ++i)
+      if (flip[std::size_t(i)]) z[i] = -z[i];
+  }
+};
+
+TEST_CASE("PCG stops at the first rᵀM⁻¹r ≤ 0 (a preconditioner that is not positive definite), unconverged, instead of running its whole count") {
+  auto s = make_system(3);
+  const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
+  const Index n = A.rows();
+  std::mt19937 rng(11);
+  int stopped_early = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    SignFlippedJacobi M;
+    M.flip.assign(std::size_t(n), 0);
+    // all DOFs (rᵀz < 0 at once) in the first trial, a random third of them in the others
+    for (Index i = 0; i < n; ++i) M.flip[std::size_t(i)] = trial == 0 || rng() % 3 == 0;
+    ConjugateGradient<SignFlippedJacobi> pcg({.tolerance = 1e-10}, M);
+    pcg.compute(exec::seq, A);
+    VecX<> x;
+    const auto info = pcg.solve(exec::seq, s.b, x);
+    CAPTURE(trial);
+    CHECK_FALSE(info.converged);  // with a third of the signs flipped CG cannot reach 1e-10 either way
+    CHECK(info.iterations < n);   // it stopped at rᵀz ≤ 0 or pᵀAp ≤ 0, not at the count
+    if (trial == 0) {
+      CHECK(info.iterations == 0);
+      CHECK(x.norm() == 0.0);
+    }
+    stopped_early += info.iterations < n;
+  }
+  CHECK(stopped_early == 20);
+}
+
 TEST_CASE("PCG reports non-convergence; Cholesky of a singular matrix is a ConvergenceError; b = 0 gives x = 0") {
   auto s = make_system(3);
   const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);

@@ -139,6 +139,14 @@ class ConjugateGradient {
     p_ = z_;
     S rz = physics::dot(policy, r_, z_);
     S rnorm = bnorm;
+    // rᵀM⁻¹r ≤ 0 for r ≠ 0: the preconditioner is not positive definite (a V-cycle whose smoother
+    // amplifies some modes, MultigridOptions::spectrum). CG has no meaning then and would run its
+    // whole count without meeting pᵀAp ≤ 0: report it unconverged at once, as negative curvature is
+    if (!(rz > S(0))) {
+      info.converged = false;
+      info.relative_residual = 1;
+      return info;
+    }
     for (Index it = 0; it < max_it; ++it) {
       if (blocked_)
         A_block_.multiply(policy, p_, q_);
@@ -160,6 +168,7 @@ class ConjugateGradient {
       if (rnorm <= S(options_.tolerance) * bnorm) break;
       preconditioner_.apply(policy, r_, z_);
       const S rz_new = physics::dot(policy, r_, z_);
+      if (!(rz_new > S(0))) break;  // the preconditioner is not positive definite (above): unconverged
       const S beta = rz_new / rz;
       rz = rz_new;
       exec::parallel_for(policy, n, [&](Index i) { p_[i] = z_[i] + beta * p_[i]; });
