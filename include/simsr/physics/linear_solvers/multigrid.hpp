@@ -358,7 +358,9 @@ class Multigrid {
     const BlockCsr<S, S>& blocks() const { return given_blocks ? *given_blocks : block; }
     double omega = 1;
     double lambda = 1;  ///< the padded estimate of λ_max(B⁻¹A) (the Chebyshev smoother's interval)
-    VecX<S> b, x, r, t, v;  ///< v: the power iteration's vector, kept as the next compute's start
+    /// v: the power iteration's vector, kept as the next compute's start (Spectrum::lanczos: the
+    /// CG direction, with x its product; both scratch, as b, r and t are outside the V-cycle)
+    VecX<S> b, x, r, t, v;
     VecX<S> d;              ///< the Chebyshev smoother's direction
     ElementColouring colours;  ///< the Gauss–Seidel smoother's vertex colours (greedy_graph_colouring of the blocks)
     std::uint64_t coloured_version = 0;  ///< … of the blocks of this BlockCsr::pattern_version (0: none yet)
@@ -445,6 +447,12 @@ class Multigrid {
     });
   }
 
+  /// The estimates' fixed start vector (the same for every run: a compute depends on its matrix).
+  static void fixed_start(VecX<S>& u, Index n) {
+    u.resize(n);
+    for (Index i = 0; i < n; ++i) u[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
+  }
+
   /// λ_max(B⁻¹A) by power iteration on AB⁻¹ (same eigenvalues): u ← A B⁻¹ u / ‖·‖, with the
   /// B-Rayleigh quotient of v = B⁻¹u, vᵀAv / vᵀBv = vᵀ(Av) / vᵀu, which needs B⁻¹ only. The first
   /// compute starts from a fixed vector and runs `power_iterations`; later ones start from the
@@ -456,8 +464,7 @@ class Multigrid {
     VecX<S>& u = L.v;
     int iterations = options_.warm_power_iterations;
     if (u.size() != A.rows()) {
-      u.resize(A.rows());
-      for (Index i = 0; i < u.size(); ++i) u[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
+      fixed_start(u, A.rows());
       iterations = options_.power_iterations;
     }
     double lambda = 1;
@@ -493,12 +500,14 @@ class Multigrid {
     // row of A and diagonal block are many orders of magnitude below the others'; there B⁻¹ of a
     // unit vector is as many above, and swamps the recurrence (measured: a 1,539-DOF level's first
     // r·z 1e178, one step, λ 0.9 against 7.3), while B⁻¹(A u) is of the order of u everywhere
-    for (Index i = 0; i < n; ++i) p[i] = S(1) + S(0.5) * S(std::sin(double(i) * 0.7));
+    fixed_start(p, n);
     multiply(policy, L, p, r);
     L.smoother.apply(policy, r, z);
     p = z;
     double rz = double(dot(policy, r, z));
-    std::vector<double> alpha, beta;
+    std::vector<double>&alpha = lanczos_alpha_, &beta = lanczos_beta_;  // kept: no allocation once warm
+    alpha.clear();
+    beta.clear();
     if (rz > 0)
       for (int j = 0; j < m_max; ++j) {
         multiply(policy, L, p, q);
@@ -517,14 +526,15 @@ class Multigrid {
       }
     const Index m = Index(alpha.size());
     if (m == 0) return 1.0;
-    Eigen::VectorXd diagonal(m), off(std::max<Index>(m - 1, 0));
+    Eigen::VectorXd &diagonal = lanczos_diagonal_, &off = lanczos_off_;
+    diagonal.resize(m);
+    off.resize(m - 1);
     for (Index j = 0; j < m; ++j) {
       diagonal[j] = 1 / alpha[std::size_t(j)] + (j > 0 ? beta[std::size_t(j - 1)] / alpha[std::size_t(j - 1)] : 0.0);
       if (j + 1 < m) off[j] = std::sqrt(beta[std::size_t(j)]) / alpha[std::size_t(j)];
     }
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig;
-    eig.computeFromTridiagonal(diagonal, off, Eigen::EigenvaluesOnly);
-    return std::max(1.0, 1.1 * eig.eigenvalues().maxCoeff());
+    lanczos_eigen_.computeFromTridiagonal(diagonal, off, Eigen::EigenvaluesOnly);
+    return std::max(1.0, 1.1 * lanczos_eigen_.eigenvalues().maxCoeff());
   }
 
   /// ω (Jacobi) and λ (Chebyshev) of a level whose smoother was just computed. A given damping
@@ -682,6 +692,10 @@ class Multigrid {
   std::uint64_t direct_version_ = 0;  ///< without coarse levels A's pattern is unknown here: analyze every time
   int computes_since_refresh_ = -1;   ///< computes since the coarse levels were built (-1: never, or forgotten)
   bool refreshed_ = false;
+  // the Lanczos estimate's coefficients and tridiagonal (lanczos_lambda_max), kept between computes
+  std::vector<double> lanczos_alpha_, lanczos_beta_;
+  Eigen::VectorXd lanczos_diagonal_, lanczos_off_;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> lanczos_eigen_;
   std::vector<char> decoupled_now_;  ///< a lagged compute()'s Dirichlet rows, checked against level 0's
   std::optional<SparseCholesky<S>> coarse_solver_;
 };
