@@ -128,6 +128,17 @@ class BatchNorm1d {
     load_running_stats();
     load_transform();
   }
+  /// The eval transform's per-channel values in S, as apply_eval uses them: rows μ, 1/σ, γ, β
+  /// (4×C; nn::InferenceNet copies them to its kernels). ArgumentError without running statistics.
+  Matrix<S> eval_transform() {
+    prepare_eval();
+    Matrix<S> t(4, c_);
+    t.row(0) = shift_.transpose();
+    t.row(1) = scale_.transpose();
+    t.row(2) = gamma_.transpose();
+    t.row(3) = beta_.transpose();
+    return t;
+  }
   void apply_eval(S* x, Index ld, Index rows) const {
     for (Index r = 0; r < rows; ++r) {
       Eigen::Map<Eigen::Matrix<S, 1, Eigen::Dynamic>> row(x + r * ld, c_);

@@ -151,6 +151,11 @@ class CoordinateUpsampling {
     precomputed_ = true;
   }
   bool has_precomputed_weights() const { return precomputed_; }
+  /// The weights apply gathers with (M×upK; ArgumentError before precompute_weights).
+  const Matrix<S>& inference_weights() const {
+    if (!precomputed_) throw ArgumentError("nn::CoordinateUpsampling::inference_weights: call precompute_weights(policy) first");
+    return weights_;
+  }
   /// The batch split of data-parallel training: the gather over the batch items takes part, and
   /// f_θ's rows (the queries of the rest shapes, the same for every item) are split too, in
   /// `query_groups` fixed groups of HR vertices (WorkShard's partition of M, each group its upK

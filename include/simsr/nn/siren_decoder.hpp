@@ -48,6 +48,9 @@ class SirenDecoder {
     net_.forward(policy, mode, zH, out);
   }
 
+  /// The sine layers and the linear output layer (`last_layer`), in forward order.
+  Mlp<S>& sine_layers() { return net_.template layer<0>(); }
+  Mlp<S>& output_layer() { return net_.template layer<1>(); }
   /// Width of the first sine layer (its Linear's outputs).
   Index first_layer_width() const { return net_.template layer<0>().spec(0).out; }
 

@@ -142,6 +142,12 @@ class SuperResolutionNet {
     return *fe_;
   }
   bool has_feature_embedding() const { return bool(fe_); }
+  SirenDecoder<S>& decoder() { return *decoder_; }
+  const PositionalEncoding<S>& positional_encoding() const { return *pe_; }
+  /// The residual base's M×N embedding (cfg.residual over Embedded; empty otherwise) and 3M×3N
+  /// local-linear map (empty until fitted).
+  const Eigen::SparseMatrix<S, Eigen::RowMajor>& residual_embedding() const { return embedding_; }
+  const Eigen::SparseMatrix<S, Eigen::RowMajor>& residual_map() const { return residual_map_; }
   /// The LR code z = [h⁰, h¹, …] of the last forward ((B·N)×latent_dim) and its upsampling z^H.
   /// An infer that moved the decoder's first layer before the upsampling formed no z^H:
   /// hr_code() then throws ArgumentError (forward(…, Mode::eval) forms it; its outputs are the same
