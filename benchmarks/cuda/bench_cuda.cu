@@ -13,6 +13,12 @@
 //       activations: the face's muscle material)
 //   BM_upsample_apply/<policy>            nn::NeighborUpsample::apply (the inference gather, Eq. 1):
 //       N = 15,872 LR codes, M = 35,637 HR vertices, upK = 20, C = 64 channels (float)
+//   BM_network_infer_paper_size/<policy>  the whole network's inference, official profile, upK 20,
+//       B = 1, on benchmarks/paper_network.hpp's geometry (bench_nn's BM_official_forward_paper_size):
+//       seq and omp run SuperResolutionNet::infer (the host's own path, its packed products), cuda
+//       nn::DeviceInferenceNet::infer (ldx and the prediction in device memory). The host instance of
+//       the same launches (HostInferenceNet) has no row: one entry a thread on 2 cores is the device's
+//       decomposition, not the host's (the exact double-precision feature kNN alone is ~16 G products).
 //
 // Build: part of tests/cuda/project (ctest cuda_compile compiles it); run where a GPU is:
 //   OMP_NUM_THREADS=2 build/bench_cuda --benchmark_counters_tabular=true
@@ -22,6 +28,7 @@
 #include <simsr/interp/device_embedded.hpp>
 #include <simsr/mesh/generators.hpp>
 #include <simsr/nn/device_neighbor_upsample.hpp>
+#include <simsr/nn/inference_net.hpp>
 #include <simsr/physics/device_elastic_energy.hpp>
 #include <simsr/physics/hessian.hpp>
 #include <simsr/physics/linear_solvers/device_block_csr.hpp>
@@ -29,6 +36,8 @@
 #include <simsr/physics/materials/teran_muscle.hpp>
 
 #include <cuda_runtime.h>
+
+#include "../paper_network.hpp"
 
 #include <memory>
 #include <random>
@@ -230,6 +239,34 @@ void BM_upsample_apply_cuda(benchmark::State& state) {
   });
 }
 
+// --- the whole network's inference (official, N 15,872, M 35,637, upK 20, B 1) --------------
+struct NetworkCase {
+  nn::Rng rng{0};
+  nn::SuperResolutionNet<float> net{bench::paper_config(), bench::paper_geo(), rng};
+  nn::Matrix<float> ldx = bench::paper_ldx(1), pred;
+  NetworkCase() { net.prepare_inference(exec::omp); }
+};
+
+template <class Policy>
+void BM_network_infer(benchmark::State& state) {
+  auto& c = shared_case<NetworkCase>();
+  c.net.infer(Policy{}, c.ldx, c.pred);  // warm the buffers
+  for (auto _ : state) {
+    c.net.infer(Policy{}, c.ldx, c.pred);
+    benchmark::DoNotOptimize(c.pred.data());
+  }
+}
+void BM_network_infer_cuda(benchmark::State& state) {
+  if (!have_device()) return state.SkipWithError("no CUDA device");
+  auto& c = shared_case<NetworkCase>();
+  auto d = nn::to_device(exec::omp, c.net);
+  auto ldx = upload(c.ldx.data(), c.ldx.size());
+  DeviceBuffer<float> pred(bench::kHr * 3);
+  time_on_device(state, [&] {
+    d.infer(exec::cuda, MatrixSpan<const float>{ldx.span().data, bench::kLr, 3, 3}, MatrixSpan<float>{pred.span().data, bench::kHr, 3, 3});
+  });
+}
+
 using Neo = physics::NeoHookean<double>;
 using Muscle = physics::TeranMuscle<double>;
 
@@ -250,5 +287,9 @@ BENCHMARK_TEMPLATE(BM_energy_gradient_cuda, Muscle)->Name("BM_energy_gradient_73
 BENCHMARK_TEMPLATE(BM_upsample_apply, exec::seq_t)->Name("BM_upsample_apply/seq")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_upsample_apply, exec::omp_t)->Name("BM_upsample_apply/omp")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_upsample_apply_cuda)->Name("BM_upsample_apply/cuda")->Unit(benchmark::kMicrosecond)->UseManualTime();
+
+BENCHMARK_TEMPLATE(BM_network_infer, exec::seq_t)->Name("BM_network_infer_paper_size/seq")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_network_infer, exec::omp_t)->Name("BM_network_infer_paper_size/omp")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_network_infer_cuda)->Name("BM_network_infer_paper_size/cuda")->Unit(benchmark::kMillisecond)->UseManualTime();
 
 BENCHMARK_MAIN();

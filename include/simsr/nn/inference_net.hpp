@@ -89,7 +89,8 @@ class InferenceNet {
         std::vector<S> point_b(std::size_t(2 * H), S(0));
         if (first.has_bias())
           for (Index h = 0; h < H; ++h) point_b[std::size_t(H + h)] = first.bias()[h];
-        L.point = StageLayout{C, 2 * H, append(params, point_w.data(), point_w.size()), append(params, point_b.data(), 2 * H), -1,
+        const Matrix<S> point_wt = point_w.transpose();
+        L.point = StageLayout{C, 2 * H, append(params, point_wt.data(), point_wt.size()), append(params, point_b.data(), 2 * H), -1,
                               detail::KernelAct::none, S(0)};
         L.first_tail = tail_layout(params, mlp, 0);
         L.first_tail.in = C;
@@ -220,7 +221,7 @@ class InferenceNet {
   }
 
  private:
-  /// A Linear (offsets into the parameters; -1: none) and its tail.
+  /// A Linear (offsets into the parameters, the weight transposed: in×out; -1: none) and its tail.
   struct StageLayout {
     Index in = 0, out = 0, w = -1, bias = -1, bn = -1;
     detail::KernelAct act = detail::KernelAct::none;
@@ -261,8 +262,8 @@ class InferenceNet {
     StageLayout L = tail_layout(params, mlp, s);
     Linear<S>& lin = mlp.linear(s);
     L.in = lin.in_features();
-    const auto W = lin.weight();
-    L.w = append(params, W.data(), W.size());
+    const Matrix<S> Wt = lin.weight().transpose();  // DenseEntries reads Wᵀ
+    L.w = append(params, Wt.data(), Wt.size());
     if (lin.has_bias()) L.bias = append(params, lin.bias().data(), L.out);
     return L;
   }

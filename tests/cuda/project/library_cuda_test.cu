@@ -1,13 +1,15 @@
 // The library's own kernel bodies under exec::cuda (issue #17 item 5): Embedded::apply's
 // (interp::DeviceEmbedded), BlockCsr's product (physics::DeviceBlockCsr), the elastic energy and
 // gradient (physics::DeviceElasticEnergy, isotropic and fibre materials) and the network's
-// upsampling gather (nn::DeviceNeighborUpsample): the same functors the host tests run under seq
-// and omp. Compiled by nvcc in the cuda-compile test; where a GPU
+// upsampling gather (nn::DeviceNeighborUpsample), and the whole network's inference
+// (nn::DeviceInferenceNet, against SuperResolutionNet::infer and against the same launches on the
+// host, nn::HostInferenceNet): the same functors the host tests run under seq and omp. Compiled by nvcc in the cuda-compile test; where a GPU
 // exists it runs and checks the device results against the host's (to rounding: the device may
 // fuse multiply-adds the host does not).
 #include <simsr/interp/device_embedded.hpp>
 #include <simsr/mesh/generators.hpp>
 #include <simsr/nn/device_neighbor_upsample.hpp>
+#include <simsr/nn/inference_net.hpp>
 #include <simsr/physics/device_elastic_energy.hpp>
 #include <simsr/physics/linear_solvers/device_block_csr.hpp>
 #include <simsr/physics/materials/neo_hookean.hpp>
@@ -17,6 +19,8 @@
 #include <cstdio>
 #include <random>
 #include <vector>
+
+#include "../../nn/network_fixture.hpp"
 
 namespace {
 double max_relative(const double* a, const double* b, simsr::Index n) {
@@ -78,6 +82,32 @@ double neighbor_upsample_difference(std::mt19937& rng) {
     worst = std::max(worst, scale > 0 ? diff / scale : diff);
   }
   return worst;
+}
+/// The whole network's inference (official widths, a small random geometry, B = 2, random
+/// BatchNorm statistics) on the device against the host network's own infer and against the host
+/// instance of the same launches: {vs network, vs host launches}, max relative differences.
+std::pair<double, double> network_difference(std::mt19937_64& rng) {
+  using namespace simsr;
+  const nn::NetworkConfig cfg = nn::NetworkConfig::official();
+  const Index N = 400, M = 1000, B = 2;
+  const auto geo = test::small_network_geometry(rng, N, M, cfg);
+  nn::Rng init(5);
+  nn::SuperResolutionNet<float> net(cfg, geo, init);
+  for (float& v : net.store().buffers()) v = std::uniform_real_distribution<float>(0.5f, 1.5f)(rng);
+  nn::Matrix<float> ldx(B * N, 3), expected, host, device;
+  for (Index i = 0; i < ldx.size(); ++i) ldx.data()[i] = std::uniform_real_distribution<float>(-0.5f, 0.5f)(rng);
+  net.set_decoder_first_layer_on_lr(false);
+  net.infer(exec::omp, ldx, expected);
+  nn::HostInferenceNet<float> on_host(exec::omp, net);
+  on_host.infer(exec::omp, ldx, host);
+  auto on_device = nn::to_device(exec::omp, net);
+  on_device.infer(exec::cuda, ldx, device);
+  auto rel = [](const nn::Matrix<float>& a, const nn::Matrix<float>& b) {
+    return double((a - b).cwiseAbs().maxCoeff()) / std::max(1e-30, double(b.cwiseAbs().maxCoeff()));
+  };
+  std::printf("network dynamic graph rows that differ, device vs host launches: %td of %td\n",
+              Index(((on_device.dynamic_graph(1).array() != on_host.dynamic_graph(1).array()).rowwise().any()).count()), B * N);
+  return {rel(device, expected), rel(device, host)};
 }
 }  // namespace
 
@@ -147,5 +177,11 @@ int main() {
   std::printf("ElasticEnergy energy+gradient device vs seq: NeoHookean %.3g, TeranMuscle %.3g (%td tets, %td inverted)\n", e_neo,
               e_muscle, body.num_tets(), inverted);
   std::printf("NeighborUpsample::apply (float) device vs seq: %.3g\n", e_upsample);
-  return e_embedded < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && e_upsample < 1e-5 ? 0 : 1;
+  std::mt19937_64 rng64(11);
+  const auto [e_network, e_launches] = network_difference(rng64);
+  std::printf("SuperResolutionNet inference (float, official) device vs the network's infer: %.3g, vs the same launches on the host: %.3g\n",
+              e_network, e_launches);
+  return e_embedded < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && e_upsample < 1e-5 && e_network < 1e-4 && e_launches < 1e-4
+             ? 0
+             : 1;
 }

@@ -37,11 +37,12 @@ struct StageTail {
 };
 
 /// A Linear and its tail, entry k = r·out + o: y(r, o) = tail(b_o + Σ_c x(r, c)·W(o, c)), the sum
-/// over c ascending. W is out×in row-major; `bias` may be null.
+/// over c ascending. The weight is stored transposed, Wᵀ in×out row-major, so the threads of a
+/// warp (consecutive o of one row) read consecutive addresses of it; `bias` may be null.
 template <class S>
 struct DenseEntries {
   MatrixSpan<const S> x;
-  const S* w = nullptr;
+  const S* wt = nullptr;
   const S* bias = nullptr;
   StageTail<S> tail;
   MatrixSpan<S> y;
@@ -49,9 +50,8 @@ struct DenseEntries {
   SIMSR_HOST_DEVICE void operator()(Index k) const {
     const Index out = y.cols, in = x.cols, r = k / out, o = k % out;
     const S* xr = x.data + r * x.stride;
-    const S* wo = w + o * in;
     S acc = bias ? bias[o] : S(0);
-    for (Index c = 0; c < in; ++c) acc += xr[c] * wo[c];
+    for (Index c = 0; c < in; ++c) acc += xr[c] * wt[c * out + o];
     y.data[r * y.stride + o] = tail(acc, o);
   }
 };
