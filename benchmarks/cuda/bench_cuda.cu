@@ -11,6 +11,9 @@
 //   BM_energy_gradient_73k/<material>/<policy>   ElasticEnergy::add_energy_gradient (E and ∂E/∂x in
 //       one pass) on that box at a random deformation: neo_hookean, teran_muscle (random fibres and
 //       activations: the face's muscle material)
+//   BM_hessian_73k/<material>/<policy>    the elastic Hessian on that box, gathered assembly (the
+//       element stiffnesses' bodies, then each block slot's sum): ElasticEnergy::add_hessian with
+//       HessianAssembly::gather against DeviceElasticEnergy::add_hessian
 //   BM_upsample_apply/<policy>            nn::NeighborUpsample::apply (the inference gather, Eq. 1):
 //       N = 15,872 LR codes, M = 35,637 HR vertices, upK = 20, C = 64 channels (float)
 //   BM_network_infer_paper_size/<policy>  the whole network's inference, official profile, upK 20,
@@ -197,6 +200,37 @@ void BM_energy_gradient_cuda(benchmark::State& state) {
   });
 }
 
+/// The elastic Hessian's gathered assembly (the element stiffnesses, then each block slot's
+/// sum) into the box's block pattern: the host energy's add_hessian (HessianAssembly::gather,
+/// the bodies DeviceElasticEnergy launches) against the device twin's.
+template <class M, class Policy>
+void BM_hessian(benchmark::State& state) {
+  auto& c = shared_case<BoxCase>();
+  auto elastic = box_energy<M>(c);
+  elastic.set_hessian_assembly(physics::HessianAssembly::gather, 1);
+  physics::BlockHessian<double> H(c.mesh.num_vertices(), c.mesh.T);
+  elastic.add_hessian(Policy{}, c.x, H, physics::Definiteness::project);  // warm: the gather lists, the scratch
+  for (auto _ : state) {
+    H.set_zero();
+    elastic.add_hessian(Policy{}, c.x, H, physics::Definiteness::project);
+    benchmark::DoNotOptimize(H.block(0).data());
+  }
+}
+template <class M>
+void BM_hessian_cuda(benchmark::State& state) {
+  if (!have_device()) return state.SkipWithError("no CUDA device");
+  auto& c = shared_case<BoxCase>();
+  const auto elastic = box_energy<M>(c);
+  physics::BlockHessian<double> H(c.mesh.num_vertices(), c.mesh.T);
+  auto d = physics::to_device(elastic);
+  d.set_hessian_pattern(exec::omp, elastic, H);
+  auto x = upload(c.x.data(), c.x.size());
+  DeviceBuffer<double> values(9 * H.num_blocks());
+  time_on_device(state, [&] {
+    d.add_hessian(exec::cuda, MatrixSpan<const double>{x.span().data, c.x.rows(), 3, 3}, values.span(), physics::Definiteness::project);
+  });
+}
+
 // --- NeighborUpsample::apply (N 15,872, M 35,637, upK 20, C 64) ---------------------------------
 struct UpsampleCase {
   static constexpr Index N = 15872, M = 35637, K = 20, C = 64;
@@ -284,6 +318,12 @@ BENCHMARK_TEMPLATE(BM_energy_gradient_cuda, Neo)->Name("BM_energy_gradient_73k/n
 BENCHMARK_TEMPLATE(BM_energy_gradient, Muscle, exec::seq_t)->Name("BM_energy_gradient_73k/teran_muscle/seq")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_energy_gradient, Muscle, exec::omp_t)->Name("BM_energy_gradient_73k/teran_muscle/omp")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_energy_gradient_cuda, Muscle)->Name("BM_energy_gradient_73k/teran_muscle/cuda")->Unit(benchmark::kMicrosecond)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_hessian, Neo, exec::seq_t)->Name("BM_hessian_73k/neo_hookean/seq")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_hessian, Neo, exec::omp_t)->Name("BM_hessian_73k/neo_hookean/omp")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_hessian_cuda, Neo)->Name("BM_hessian_73k/neo_hookean/cuda")->Unit(benchmark::kMillisecond)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_hessian, Muscle, exec::seq_t)->Name("BM_hessian_73k/teran_muscle/seq")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_hessian, Muscle, exec::omp_t)->Name("BM_hessian_73k/teran_muscle/omp")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_hessian_cuda, Muscle)->Name("BM_hessian_73k/teran_muscle/cuda")->Unit(benchmark::kMillisecond)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_upsample_apply, exec::seq_t)->Name("BM_upsample_apply/seq")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_upsample_apply, exec::omp_t)->Name("BM_upsample_apply/omp")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_upsample_apply_cuda)->Name("BM_upsample_apply/cuda")->Unit(benchmark::kMicrosecond)->UseManualTime();

@@ -1,6 +1,8 @@
 #include <simsr/mesh/generators.hpp>
 #include <simsr/physics/elastic_energy.hpp>
+#include <simsr/physics/materials/neo_hookean.hpp>
 #include <simsr/physics/materials/strain_limit.hpp>
+#include <simsr/physics/materials/teran_muscle.hpp>
 
 #include <doctest/doctest.h>
 
@@ -138,6 +140,52 @@ TEST_CASE("ElasticEnergy: the assembled Hessian is the sum of the element Hessia
   CHECK((g1 - g2).cwiseAbs().maxCoeff() == 0.0);
   CHECK(E.energy(exec::seq, x) == E.energy(exec::omp, x));
   CHECK(E.count_inverted(exec::seq, x) == E.count_inverted(exec::omp, x));
+}
+
+/// DeviceElasticEnergy::add_hessian's launch sequence on the host arrays it copies (the element
+/// stiffness body over every tet, then the gather body over H's block slots with
+/// hessian_gather_lists), against add_hessian's gathered assembly: bitwise, seq and omp.
+template <class M>
+void check_hessian_bodies(const TetMesh<double>& mesh, const Points<>& x, const M& material, const std::vector<typename M::Element>& elements) {
+  ElasticEnergy<M> E(mesh, material, elements);
+  E.set_hessian_assembly(HessianAssembly::gather, 1);
+  for (const Definiteness d : {Definiteness::project, Definiteness::exact}) {
+    BlockHessian<> expected(mesh.num_vertices(), mesh.T), by_bodies(mesh.num_vertices(), mesh.T);
+    E.add_hessian(exec::seq, x, expected, d);
+    const auto [offsets, entries] = E.hessian_gather_lists(exec::seq, by_bodies);
+    REQUIRE(Index(offsets.size()) == by_bodies.num_blocks() + 1);
+    CHECK(Index(entries.size()) == 16 * mesh.num_tets());  // every (tet, a, b) once
+    std::vector<double> upper(std::size_t(90 * mesh.num_tets()));
+    using Element = physics::detail::ElasticElementBody<M, physics::detail::ElementOutput::forces>;
+    const Element element{material,
+                          E.tets().data(),
+                          E.rest().Dm_inv[0].data(),
+                          E.element_shape_gradients()[0].data(),
+                          E.rest().volume.data(),
+                          E.elements().data(),
+                          MatrixSpan<const double>{x.data(), x.rows(), 3, 3},
+                          nullptr};
+    const physics::detail::ElementStiffnessBody<M> stiffness{element, d, upper.data()};
+    const physics::detail::GatherHessianBlocks<double> gather{offsets.data(), entries.data(), upper.data(), by_bodies.block(0).data()};
+    exec::parallel_for(exec::omp, mesh.num_tets(), stiffness);
+    exec::parallel_for(exec::omp, by_bodies.num_blocks(), gather);
+    for (Index s = 0; s < expected.num_blocks(); ++s) CHECK(expected.block(s) == by_bodies.block(s));
+    // a tet's stiffness from the body is element_hessian's (the same F, D and material call)
+    CHECK(stiffness.stiffness(3) == E.element_hessian(x, 3, d));
+  }
+  BlockHessian<> other(mesh.num_vertices() + 1);
+  CHECK_THROWS_AS((void)E.hessian_gather_lists(exec::seq, other), ShapeError);
+}
+
+TEST_CASE("ElasticEnergy: the Hessian bodies DeviceElasticEnergy launches give add_hessian's gathered assembly bitwise (Neo-Hookean, Teran muscle)") {
+  const auto mesh = box_tet_mesh<double>(4, 3, 3, Vec3<>(0, 0, 0), Vec3<>(0.04, 0.03, 0.03));
+  const Points<> x = perturbed(mesh.V, 0.004, 5);  // up to 40 % of a cell
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<MuscleFibre<double>> fibres(std::size_t(mesh.num_tets()));
+  for (auto& f : fibres) f = TeranMuscle<double>::element(Vec3<>(u(rng), u(rng), u(rng)), 0.5 + 0.5 * u(rng));
+  check_hessian_bodies(mesh, x, NeoHookean<double>::from_young_poisson(3e4, 0.45), std::vector<NoElementData>(std::size_t(mesh.num_tets())));
+  check_hessian_bodies(mesh, x, TeranMuscle<double>(), fibres);
 }
 
 TEST_CASE("ElasticEnergy: coloured and gathered assembly agree to rounding on random meshes and states; each is seq == omp bitwise") {

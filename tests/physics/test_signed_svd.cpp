@@ -94,3 +94,36 @@ TEST_CASE("signed_svd_from_eigen: the Jacobi SVD's conventions and values on ran
   const Mat3d F = with_singular_values(rng2, 1.3, 0.9, 0.6);
   CHECK(!(signed_svd_from_eigen(F).U == signed_svd(F).U && signed_svd_from_eigen(F).V == signed_svd(F).V));
 }
+
+TEST_CASE("signed_svd_one_sided (the device's fallback): the Jacobi SVD's conventions and values, degenerate F included") {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-2.0, 2.0), log_scale(-9, 2);
+  auto check_one_sided = [](const Mat3d& F) {
+    const SignedSvd<double> r = signed_svd_one_sided(F);
+    check_decomposition(F, r);
+    CHECK((r.sigma - signed_svd(F).sigma).cwiseAbs().maxCoeff() <= 1e-12 * std::max(F.norm(), 1e-300));
+  };
+  for (int i = 0; i < 2000; ++i) {
+    Mat3d F;
+    for (int k = 0; k < 9; ++k) F(k % 3, k / 3) = u(rng);
+    check_one_sided(F);
+    check_one_sided(-F);
+    const double s1 = std::pow(10.0, log_scale(rng) / 4), s2 = s1 * std::pow(10.0, -std::abs(log_scale(rng)) / 4),
+                 s3 = s2 * std::pow(10.0, -std::abs(log_scale(rng)) / 2);
+    check_one_sided(with_singular_values(rng, s1, s2, i % 2 ? s3 : -s3));
+    check_one_sided(1e150 * F);
+    check_one_sided(1e-150 * F);
+  }
+  for (const Sample& s : deformation_samples(19)) check_one_sided(s.F);
+  // rank-deficient, repeated, zero: where signed_svd_from_eigen falls back
+  Eigen::Vector3d a(1, 2, 3), b(-1, 0.5, 2);
+  for (const Mat3d& F : {Mat3d(Mat3d::Zero()), with_singular_values(rng, 1.5, 0.7, 0.0), with_singular_values(rng, 1.5, 0.0, 0.0),
+                         with_singular_values(rng, 1.5, 0.7, 1e-9), with_singular_values(rng, 2.0, 1.0, -1e-6), Mat3d(a * b.transpose()),
+                         with_singular_values(rng, 1.2, 1.2, 0.8), with_singular_values(rng, 1.0, 1.0, -1.0), Mat3d(Mat3d::Identity()),
+                         Mat3d(-Mat3d::Identity())}) {
+    check_one_sided(F);
+    // signed_svd_from_eigen with this fallback (what a device runs): the conventions hold there too
+    check_decomposition(F, signed_svd_from_eigen(F, [](const Mat3d& G) { return signed_svd_one_sided(G); }));
+  }
+  CHECK(signed_svd_one_sided(Mat3d(-Mat3d::Identity())).sigma.isApprox(Eigen::Vector3d(1, 1, -1)));
+}

@@ -10,9 +10,15 @@
 ///     double e = d.add_energy_gradient(exec::cuda, x, g);   // MatrixSpan N×3, device memory
 ///     d.set_elements(new_fibres);                           // this frame's activations
 ///
-/// Energy and gradient only: the element Hessians (closed-form SVD with a Jacobi fallback, the
-/// eigen-mode assembly) stay on the host. The material must be a DeviceMaterial (its energy and
-/// stress SIMSR_HOST_DEVICE).
+///     BlockHessian<double> H(mesh.num_vertices(), mesh.T);             // the pattern, on the host
+///     d.set_hessian_pattern(exec::omp, elastic, H);                      // its gather lists copied
+///     d.add_hessian(exec::cuda, x, values, Definiteness::project);       // Span, 9 per block slot
+///
+/// The Hessian is ElasticEnergy's gathered assembly (HessianAssembly::gather) with its own bodies
+/// (detail/element_stiffness_body.hpp): the material's element_stiffness per tet — the checked
+/// closed-form SVD, whose fallback on the device is signed_svd_one_sided (Eigen's JacobiSVD is
+/// host code) — then each block slot's fixed-order sum. The material must be a DeviceMaterial
+/// (energy, stress and element_stiffness SIMSR_HOST_DEVICE).
 
 #include <vector>
 
@@ -82,8 +88,41 @@ class DeviceElasticEnergy {
     return e;
   }
 
+  /// The Hessian pattern add_hessian assembles into: H's block slots and their (tet, a, b) lists
+  /// (ElasticEnergy::hessian_gather_lists of `host`, this twin's host component). ShapeError for
+  /// another vertex count.
+  template <exec::HostPolicy P>
+  void set_hessian_pattern(P policy, const ElasticEnergy<M>& host, const BlockHessian<S>& H) {
+    if (host.num_vertices() != num_vertices_ || host.num_tets() != num_tets_)
+      throw ShapeError("DeviceElasticEnergy::set_hessian_pattern: the host energy (vertices, tets)", {num_vertices_, num_tets_},
+                       {host.num_vertices(), host.num_tets()});
+    const auto [offsets, entries] = host.hessian_gather_lists(policy, H);
+    hessian_offsets_ = DeviceBuffer<Index>(Span<const Index>{offsets.data(), Index(offsets.size())});
+    hessian_entries_ = DeviceBuffer<std::int64_t>(Span<const std::int64_t>{entries.data(), Index(entries.size())});
+    hessian_blocks_ = H.num_blocks();
+    if (upper_.size() != 90 * num_tets_) upper_.resize(90 * num_tets_);
+  }
+
+  /// values += the elastic Hessian at device positions x (N×3): 9 values a block slot of the
+  /// pattern set by set_hessian_pattern, column-major (BlockHessian's values), device memory.
+  /// ArgumentError before set_hessian_pattern, ShapeError for another number of values.
+  void add_hessian(exec::cuda_t policy, MatrixSpan<const S> x, Span<S> values, Definiteness d = Definiteness::project) const {
+    static_assert(detail::HasElementStiffness<M>,
+                  "DeviceElasticEnergy::add_hessian needs a material with element_stiffness (the 9x9 route is host code)");
+    check("x", x.rows, x.cols);
+    if (hessian_blocks_ < 0) throw ArgumentError("DeviceElasticEnergy::add_hessian: call set_hessian_pattern first");
+    if (values.size != 9 * hessian_blocks_)
+      throw ShapeError("DeviceElasticEnergy::add_hessian: values (9 per block slot)", {9 * hessian_blocks_}, {values.size});
+    exec::parallel_for(policy, num_tets_,
+                       detail::ElementStiffnessBody<M>{body<detail::ElementOutput::forces>(x), d, upper_.span().data});
+    exec::parallel_for(policy, hessian_blocks_,
+                       detail::GatherHessianBlocks<S>{hessian_offsets_.span().data, hessian_entries_.span().data, upper_.span().data, values.data});
+  }
+
   Index num_vertices() const { return num_vertices_; }
   Index num_tets() const { return num_tets_; }
+  /// Block slots of the Hessian pattern (-1 before set_hessian_pattern).
+  Index hessian_blocks() const { return hessian_blocks_; }
 
  private:
   template <detail::ElementOutput Output>
@@ -115,6 +154,10 @@ class DeviceElasticEnergy {
   DeviceBuffer<std::int32_t> entries_;
   DeviceBuffer<unsigned char> elements_;
   mutable DeviceBuffer<S> forces_;  // 12 per tet, scratch
+  DeviceBuffer<Index> hessian_offsets_;
+  DeviceBuffer<std::int64_t> hessian_entries_;
+  Index hessian_blocks_ = -1;
+  mutable DeviceBuffer<S> upper_;  // 90 per tet (the element stiffnesses' upper blocks), scratch
 };
 
 /// The device twin of an ElasticEnergy whose material is a DeviceMaterial.

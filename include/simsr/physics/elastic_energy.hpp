@@ -32,6 +32,7 @@
 #include "../mesh/tet_mesh.hpp"
 #include "energy_term.hpp"
 #include "detail/elastic_element_body.hpp"
+#include "detail/element_stiffness_body.hpp"
 #include "hessian.hpp"
 #include "materials/material.hpp"
 #include "tet_elements.hpp"
@@ -42,19 +43,11 @@ namespace detail {
 /// Materials with element data to validate offer `check(element)` (throws ArgumentError).
 template <class M>
 concept ChecksElements = requires(const M& m, const typename M::Element& e) { m.check(e); };
-/// Materials that compute the element stiffness vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) without forming ∂P/∂F
-/// (the isotropic ones from their eigen-modes) offer `element_stiffness(F, element, d, D, vol)`.
-template <class M>
-concept HasElementStiffness = requires(const M& m, const Mat3<typename M::scalar_type>& F, const typename M::Element& e,
-                                       Definiteness d, const ShapeGradients<typename M::scalar_type>& D, typename M::scalar_type vol) {
-  { m.element_stiffness(F, e, d, D, vol) } -> std::convertible_to<Mat12<typename M::scalar_type>>;
-};
 /// The ten 3×3 blocks (a, b), a ≤ b, of a symmetric element stiffness, in the order
 /// (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3); block (b, a) is block (a, b)ᵀ.
 template <class S>
 using UpperBlocks12 = std::array<Mat3<S>, 10>;
-/// The position of block (a, b), a ≤ b, in UpperBlocks12.
-constexpr int upper_block(int a, int b) { return a * 4 - a * (a - 1) / 2 + (b - a); }
+/// (HasElementStiffness and upper_block, the blocks' positions: detail/element_stiffness_body.hpp.)
 /// Materials usable in the local–global solver offer the stiffness of their constant matrix.
 template <class M>
 concept HasProjectiveStiffness = requires(const M& m) { { m.projective_stiffness() } -> std::convertible_to<typename M::scalar_type>; };
@@ -215,6 +208,16 @@ class ElasticEnergy {
       add_hessian_gathered(policy, x, H, d);
   }
 
+  /// The gathered assembly's lists for H's pattern (built when stale): block slot s sums the
+  /// entries [offsets[s], offsets[s+1]) of `entries`, each 16 t + 4 a + b (block (a, b) of tet t).
+  /// DeviceElasticEnergy::set_hessian_pattern copies them.
+  template <exec::HostPolicy P>
+  std::pair<const std::vector<Index>&, const std::vector<std::int64_t>&> hessian_gather_lists(P policy, const BlockHessian<S>& H) const {
+    if (H.num_vertices() != n_) throw ShapeError("ElasticEnergy::hessian_gather_lists: Hessian vertices", {n_}, {H.num_vertices()});
+    if (gather_version_ != H.pattern_version()) build_gather(policy, H);
+    return {gather_offsets_, gather_entries_};
+  }
+
   /// The local–global solver's constant matrix (projective dynamics, Bouaziz et al. 2014 eq. 12):
   /// H += Σ_t V_t k (D_t ⊗ I)(D_t ⊗ I)ᵀ, k = material().projective_stiffness() (per unit volume),
   /// i.e. the Hessian of Σ_t V_t k/2 ‖F_t − const‖². For materials that offer that stiffness
@@ -251,28 +254,24 @@ class ElasticEnergy {
   template <exec::HostPolicy P>
   void add_hessian_gathered(P policy, const Points<S>& x, BlockHessian<S>& H, Definiteness d) const {
     if (gather_version_ != H.pattern_version()) build_gather(policy, H);
+    static_assert(sizeof(detail::UpperBlocks12<S>) == 90 * sizeof(S), "packed upper blocks");
     stiffness_.resize(std::size_t(T_.rows()));
+    S* upper = stiffness_.empty() ? nullptr : stiffness_[0][0].data();
     // only the upper blocks are kept (5/8 of the 12×12: the buffer is written and read once per
     // assembly, 53 MB instead of 84 MB on the 73k-tet face lattice)
-    exec::parallel_for(policy, T_.rows(), [&](Index t) {
-      const Mat12<S> K = element_hessian(x, t, d);
-      auto& blocks = stiffness_[std::size_t(t)];
-      for (int a = 0; a < 4; ++a)
-        for (int b = a; b < 4; ++b) blocks[std::size_t(detail::upper_block(a, b))] = K.template block<3, 3>(3 * a, 3 * b);
-    });
-    exec::parallel_for(policy, H.num_blocks(), [&](Index s) {
-      Mat3<S> sum = Mat3<S>::Zero();
-      for (Index k = gather_offsets_[std::size_t(s)]; k < gather_offsets_[std::size_t(s) + 1]; ++k) {
-        const std::int64_t e = gather_entries_[std::size_t(k)];
-        const int a = int(e & 15) >> 2, b = int(e & 3);
-        const auto& blocks = stiffness_[std::size_t(e >> 4)];
-        if (a <= b)
-          sum += blocks[std::size_t(detail::upper_block(a, b))];
-        else
-          sum += blocks[std::size_t(detail::upper_block(b, a))].transpose();
-      }
-      H.block(s) += sum;
-    });
+    if constexpr (detail::HasElementStiffness<M>) {  // the bodies DeviceElasticEnergy runs (detail/element_stiffness_body.hpp)
+      exec::parallel_for(policy, T_.rows(), stiffness_body(x, d, upper));
+    } else {  // through the material's 9×9 ∂P/∂F (host only)
+      exec::parallel_for(policy, T_.rows(), [&](Index t) {
+        const Mat12<S> K = element_hessian(x, t, d);
+        auto& blocks = stiffness_[std::size_t(t)];
+        for (int a = 0; a < 4; ++a)
+          for (int b = a; b < 4; ++b) blocks[std::size_t(detail::upper_block(a, b))] = K.template block<3, 3>(3 * a, 3 * b);
+      });
+    }
+    if (H.num_blocks() > 0)
+      exec::parallel_for(policy, H.num_blocks(),
+                         detail::GatherHessianBlocks<S>{gather_offsets_.data(), gather_entries_.data(), upper, H.block(0).data()});
   }
 
   /// HessianAssembly::coloured: the chunks of one colour share no vertex, hence no block, so
@@ -299,6 +298,14 @@ class ElasticEnergy {
         }
       });
     }
+  }
+
+  /// The element stiffness body over this object's arrays and x (element_stiffness_body.hpp; the
+  /// same body DeviceElasticEnergy::add_hessian runs on the device).
+  detail::ElementStiffnessBody<M> stiffness_body(const Points<S>& x, Definiteness d, S* upper) const
+    requires detail::HasElementStiffness<M>
+  {
+    return {element_body<detail::ElementOutput::forces>(x), d, upper};
   }
 
   /// The per-tet body over this object's arrays and x (elastic_element_body.hpp; the same body

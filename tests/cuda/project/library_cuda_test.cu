@@ -1,6 +1,7 @@
 // The library's own kernel bodies under exec::cuda (issue #17 item 5): Embedded::apply's
 // (interp::DeviceEmbedded), BlockCsr's product (physics::DeviceBlockCsr), the elastic energy and
-// gradient (physics::DeviceElasticEnergy, isotropic and fibre materials) and the network's
+// gradient and the gathered Hessian (physics::DeviceElasticEnergy, isotropic and fibre
+// materials) and the network's
 // upsampling gather (nn::DeviceNeighborUpsample), and the whole network's inference
 // (nn::DeviceInferenceNet, against SuperResolutionNet::infer and against the same launches on the
 // host, nn::HostInferenceNet): the same functors the host tests run under seq and omp. Compiled by nvcc in the cuda-compile test; where a GPU
@@ -52,6 +53,29 @@ double elastic_difference(const simsr::TetMesh<double>& mesh, const simsr::Point
   const double de = std::max(std::abs(e_device - e_host), std::abs(e_alone - e_host)) / std::abs(e_host);
   return std::max({de, max_relative(g_device.data(), g_host.data(), g_host.size()),
                    max_relative(g_twice.data(), g_host_twice.data(), g_host.size())});
+}
+
+/// The elastic Hessian (gathered assembly, project and exact) on the device against the host's
+/// add_hessian with HessianAssembly::gather: the larger max relative difference of the values.
+template <class M>
+double hessian_difference(const simsr::TetMesh<double>& mesh, const simsr::Points<double>& x, const M& material,
+                          const std::vector<typename M::Element>& elements) {
+  using namespace simsr;
+  physics::ElasticEnergy<M> host(mesh, material, elements);
+  host.set_hessian_assembly(physics::HessianAssembly::gather, 1);
+  auto device = physics::to_device(host);
+  double worst = 0;
+  for (const physics::Definiteness d : {physics::Definiteness::project, physics::Definiteness::exact}) {
+    physics::BlockHessian<double> H(mesh.num_vertices(), mesh.T);
+    host.add_hessian(exec::seq, x, H, d);
+    device.set_hessian_pattern(exec::seq, host, H);
+    std::vector<double> zeros(std::size_t(9 * H.num_blocks()), 0.0), values(zeros.size());
+    DeviceBuffer<double> d_x(Span<const double>{x.data(), x.size()}), d_values(Span<const double>{zeros.data(), Index(zeros.size())});
+    device.add_hessian(exec::cuda, MatrixSpan<const double>{d_x.span().data, x.rows(), 3, 3}, d_values.span(), d);
+    d_values.copy_to(Span<double>{values.data(), Index(values.size())});
+    worst = std::max(worst, max_relative(values.data(), H.block(0).data(), Index(values.size())));
+  }
+  return worst;
 }
 
 /// NeighborUpsample's inference gather (float) at a network's size, host (exec::seq) against its
@@ -171,17 +195,21 @@ int main() {
                                           std::vector<physics::NoElementData>(std::size_t(body.num_tets())));
   const double e_muscle = elastic_difference(body, deformed, physics::TeranMuscle<double>(), fibres);
   const double e_upsample = neighbor_upsample_difference(rng);
+  const double h_neo = hessian_difference(body, deformed, physics::NeoHookean<double>::from_young_poisson(3e4, 0.45),
+                                          std::vector<physics::NoElementData>(std::size_t(body.num_tets())));
+  const double h_muscle = hessian_difference(body, deformed, physics::TeranMuscle<double>(), fibres);
   std::printf("Embedded::apply device vs seq: %.3g; BlockCsr product device vs seq: %.3g\n", e_embedded, e_blocks);
   const Index inverted = physics::ElasticEnergy<physics::NeoHookean<double>>(body, physics::NeoHookean<double>::from_young_poisson(3e4, 0.45))
                              .count_inverted(exec::seq, deformed);
   std::printf("ElasticEnergy energy+gradient device vs seq: NeoHookean %.3g, TeranMuscle %.3g (%td tets, %td inverted)\n", e_neo,
               e_muscle, body.num_tets(), inverted);
   std::printf("NeighborUpsample::apply (float) device vs seq: %.3g\n", e_upsample);
+  std::printf("ElasticEnergy Hessian (gathered, project and exact) device vs seq: NeoHookean %.3g, TeranMuscle %.3g\n", h_neo, h_muscle);
   std::mt19937_64 rng64(11);
   const auto [e_network, e_launches] = network_difference(rng64);
   std::printf("SuperResolutionNet inference (float, official) device vs the network's infer: %.3g, vs the same launches on the host: %.3g\n",
               e_network, e_launches);
-  return e_embedded < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && e_upsample < 1e-5 && e_network < 1e-4 && e_launches < 1e-4
+  return e_embedded < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && e_upsample < 1e-5 && h_neo < 1e-10 && h_muscle < 1e-10 && e_network < 1e-4 && e_launches < 1e-4
              ? 0
              : 1;
 }

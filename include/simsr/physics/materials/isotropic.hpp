@@ -92,7 +92,7 @@ Mat3<S> isotropic_stress(const SignedSvd<S>& svd, const Vec3<S>& g) {
 /// A positive definite H (Sylvester: its leading minors positive; most elements' principal
 /// Hessian away from compression) is returned as it is, without an eigen-decomposition.
 template <class S>
-Mat3<S> psd_part(const Mat3<S>& H) {
+SIMSR_HOST_DEVICE Mat3<S> psd_part(const Mat3<S>& H) {
   const S minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
   if (H(0, 0) > S(0) && minor2 > S(0) && H.determinant() > S(0)) return H;
   const Eigen::SelfAdjointEigenSolver<Mat3<S>> eig(H);
@@ -101,7 +101,7 @@ Mat3<S> psd_part(const Mat3<S>& H) {
 
 /// A flip or twist eigenvalue as `definiteness` takes it (clamped at 0 for `project`).
 template <class S>
-S mode_eigenvalue(S e, Definiteness definiteness) {
+SIMSR_HOST_DEVICE S mode_eigenvalue(S e, Definiteness definiteness) {
   return definiteness == Definiteness::project ? std::max(e, S(0)) : e;
 }
 
@@ -144,7 +144,7 @@ Mat9<S> isotropic_stress_derivative(const SignedSvd<S>& svd, const PrincipalDeri
 /// ten blocks a ≤ b, the others their transposes): the Newton Hessian of the 73k-tet LR face is
 /// assembled four times a frame (issue #17).
 template <class S>
-Mat12<S> isotropic_element_stiffness(const SignedSvd<S>& svd, const PrincipalDerivatives<S>& d, Definiteness definiteness,
+SIMSR_HOST_DEVICE Mat12<S> isotropic_element_stiffness(const SignedSvd<S>& svd, const PrincipalDerivatives<S>& d, Definiteness definiteness,
                                      const ShapeGradients<S>& D, S vol) {
   const bool project = definiteness == Definiteness::project;
   const Mat3<S> H = project ? psd_part(d.H) : d.H;
@@ -195,7 +195,7 @@ SIMSR_HOST_DEVICE Invariants<S> invariants(const Mat3<S>& F) {
 
 /// Invariants from signed singular values.
 template <class S>
-Invariants<S> invariants(const Vec3<S>& sigma) {
+SIMSR_HOST_DEVICE Invariants<S> invariants(const Vec3<S>& sigma) {
   const Vec3<S> s2 = sigma.cwiseAbs2();
   return {s2.sum(), s2(0) * s2(1) + s2(0) * s2(2) + s2(1) * s2(2), sigma.prod()};
 }
@@ -230,7 +230,7 @@ SIMSR_HOST_DEVICE Mat3<S> invariant_stress(const Mat3<S>& F, const Invariants<S>
 /// (g_i − g_j)/(σ_i − σ_j) = 2Ψ_1 + 2Ψ_2(σ_k² − σ_iσ_j) − Ψ_J σ_k and
 /// (g_i + g_j)/(σ_i + σ_j) = 2Ψ_1 + 2Ψ_2(σ_k² + σ_iσ_j) + Ψ_J σ_k.
 template <class S>
-PrincipalDerivatives<S> principal_from_invariants(const Vec3<S>& s, const InvariantPartials<S>& p) {
+SIMSR_HOST_DEVICE PrincipalDerivatives<S> principal_from_invariants(const Vec3<S>& s, const InvariantPartials<S>& p) {
   Mat3<S> grad;  // grad(a, i) = ∂(invariant a)/∂σ_i
   Vec3<S> s2 = s.cwiseAbs2();
   for (int i = 0; i < 3; ++i) {
@@ -277,16 +277,16 @@ class InvariantMaterial {
 
   /// vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) straight from the eigen-modes (isotropic_element_stiffness), on the
   /// checked closed-form SVD (signed_svd_from_eigen: the Jacobi SVD where it cannot resolve F).
-  Mat12<S> element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
+  SIMSR_HOST_DEVICE Mat12<S> element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
     return element_stiffness(signed_svd_from_eigen(F), e, definiteness, D, vol);
   }
   /// The same from a signed SVD of F the caller made (bench_physics's Jacobi-SVD baseline).
-  Mat12<S> element_stiffness(const SignedSvd<S>& svd, const Element&, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
+  SIMSR_HOST_DEVICE Mat12<S> element_stiffness(const SignedSvd<S>& svd, const Element&, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
     return isotropic_element_stiffness(svd, principal_derivatives(svd.sigma), definiteness, D, vol);
   }
 
   /// Ψ's derivatives in the signed singular values σ (principal_from_invariants of its partials).
-  PrincipalDerivatives<S> principal_derivatives(const Vec3<S>& sigma) const {
+  SIMSR_HOST_DEVICE PrincipalDerivatives<S> principal_derivatives(const Vec3<S>& sigma) const {
     return principal_from_invariants(sigma, self().partials(invariants(sigma)));
   }
 

@@ -85,8 +85,9 @@ constexpr bool assert_material() {
   return true;
 }
 
-/// A Material whose energy and stress are SIMSR_HOST_DEVICE, so that DeviceElasticEnergy can call
-/// them in a CUDA kernel: it says so with `static constexpr bool device_callable = true;`
+/// A Material whose energy and stress (and element_stiffness, for DeviceElasticEnergy::add_hessian)
+/// are SIMSR_HOST_DEVICE, so that DeviceElasticEnergy can call them in a CUDA kernel: it says so
+/// with `static constexpr bool device_callable = true;`
 /// (NeoHookean, MooneyRivlin, TeranMuscle). An opt-in, since a C++ concept cannot see whether a
 /// function is callable on the device; its element data must be plain bytes (copied as such).
 template <class M>

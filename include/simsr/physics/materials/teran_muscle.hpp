@@ -99,7 +99,7 @@ class TeranMuscle {
   /// vol·(D⊗I)ᵀ ∂P/∂F (D⊗I) without the 9×9 matrix: the Mooney–Rivlin part from its eigen-modes
   /// (isotropic_element_stiffness), the fibre part as vol g_a g_b (ψ_f'/λ I + (ψ_f'' − ψ_f'/λ) n nᵀ)
   /// for block (a,b) with g = D a (both terms of stress_derivative's fibre part pushed through D⊗I).
-  Mat12<S> element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
+  SIMSR_HOST_DEVICE Mat12<S> element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol) const {
     Mat12<S> K = iso_.element_stiffness(F, {}, definiteness, D, vol);
     add_fibre_element_stiffness(F, e, definiteness, D, vol, K);
     return K;
@@ -107,7 +107,7 @@ class TeranMuscle {
 
   /// K += the fibre term's part of element_stiffness (the Mooney–Rivlin part is the isotropic
   /// material's own: a caller may compute it another way, as bench_physics's SVD baseline does).
-  void add_fibre_element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol,
+  SIMSR_HOST_DEVICE void add_fibre_element_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness, const ShapeGradients<S>& D, S vol,
                                    Mat12<S>& K) const {
     const FibreStiffness f = fibre_stiffness(F, e, definiteness);
     if (!f.active) return;
@@ -131,7 +131,7 @@ class TeranMuscle {
     Vec3<S> n;
     S d1 = 0, d2 = 0;
   };
-  FibreStiffness fibre_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness) const {
+  SIMSR_HOST_DEVICE FibreStiffness fibre_stiffness(const Mat3<S>& F, const Element& e, Definiteness definiteness) const {
     const Vec3<S> Fa = F * e.fibre;
     const S lambda = Fa.norm();
     if (lambda < flat_below()) return {};
