@@ -6,6 +6,9 @@
 //
 //   BM_embedded_apply/<policy>          interp::Embedded::apply, N = 15,872 LR lattice vertices
 //       (32×31×16, 6 tets a cube: 83,700 tets), M = 35,637 HR points (double)
+//   BM_gather_apply/{idw,mls}/<policy>  IDW::apply and MLS::apply (NeighborGather: k = 20 Euclidean
+//       neighbours, MLS's per-coordinate weights) on EmbeddedCase's N and M, against their device
+//       twin (interp::DeviceNeighborGather)
 //   BM_block_csr_multiply_73k/<policy>   physics::BlockCsr product y = A x, A the projected
 //       Neo-Hookean Hessian of a 72,576-tet box (25×25×22 vertices; double)
 //   BM_energy_gradient_73k/<material>/<policy>   ElasticEnergy::add_energy_gradient (E and ∂E/∂x in
@@ -29,7 +32,9 @@
 #include <benchmark/benchmark.h>
 
 #include <simsr/interp/device_embedded.hpp>
+#include <simsr/interp/device_neighbor_gather.hpp>
 #include <simsr/mesh/generators.hpp>
+#include <simsr/neighbors/kd_tree.hpp>
 #include <simsr/nn/device_neighbor_upsample.hpp>
 #include <simsr/nn/inference_net.hpp>
 #include <simsr/physics/device_elastic_energy.hpp>
@@ -125,6 +130,61 @@ void BM_embedded_apply_cuda(benchmark::State& state) {
   if (!have_device()) return state.SkipWithError("no CUDA device");
   auto& c = shared_case<EmbeddedCase>();
   const auto d = interp::to_device(c.embedded);
+  auto lr = upload(c.lr_disp.data(), c.lr_disp.size());
+  DeviceBuffer<double> hr(c.hr_disp.size());
+  time_on_device(state, [&] {
+    d.apply(exec::cuda, MatrixSpan<const double>{lr.span().data, c.lr_disp.rows(), 3, 3}, MatrixSpan<double>{hr.span().data, c.hr_disp.rows(), 3, 3});
+  });
+}
+
+// --- IDW's and MLS's gather (the same N, M; k 20) ----------------------------------------------
+struct GatherCase {
+  interp::UpsamplingProblem<double> problem;
+  interp::IDW<double> idw;
+  interp::MLS<double> mls;
+  Points<double> lr_disp, hr_disp;
+  GatherCase() {
+    std::mt19937 rng(7);  // EmbeddedCase's points
+    std::uniform_real_distribution<double> u(0, 1);
+    problem.lr = box_tet_mesh<double>(31, 30, 15, Vec3<>(0, 0, 0), Vec3<>(31, 30, 15));
+    problem.hr.V.resize(35637, 3);
+    for (Index i = 0; i < problem.hr.V.rows(); ++i) problem.hr.V.row(i) << 31 * u(rng), 30 * u(rng), 15 * u(rng);
+    const neighbors::KdTree<double> tree(problem.lr.V);  // Euclidean neighbourhoods (the HR points have no surface)
+    const auto nearest = tree.query(exec::omp, problem.hr.V, 20);
+    neighbors::UpsamplingNeighborhoods nb;
+    nb.indices = nearest.indices;
+    nb.distances = nearest.distances;
+    problem.neighborhoods = std::move(nb);
+    idw.fit(exec::omp, problem);
+    mls.fit(exec::omp, problem);
+    lr_disp.resize(problem.num_lr(), 3);
+    for (Index i = 0; i < lr_disp.size(); ++i) lr_disp.data()[i] = u(rng) - 0.5;
+    hr_disp.resize(problem.num_hr(), 3);
+  }
+};
+
+template <class I>
+I& gather_interpolator(GatherCase& c) {
+  if constexpr (std::is_same_v<I, interp::IDW<double>>)
+    return c.idw;
+  else
+    return c.mls;
+}
+
+template <class I, class Policy>
+void BM_gather_apply(benchmark::State& state) {
+  auto& c = shared_case<GatherCase>();
+  const I& interpolator = gather_interpolator<I>(c);
+  for (auto _ : state) {
+    interpolator.apply(Policy{}, c.lr_disp, c.hr_disp);
+    benchmark::DoNotOptimize(c.hr_disp.data());
+  }
+}
+template <class I>
+void BM_gather_apply_cuda(benchmark::State& state) {
+  if (!have_device()) return state.SkipWithError("no CUDA device");
+  auto& c = shared_case<GatherCase>();
+  const auto d = interp::to_device(gather_interpolator<I>(c));
   auto lr = upload(c.lr_disp.data(), c.lr_disp.size());
   DeviceBuffer<double> hr(c.hr_disp.size());
   time_on_device(state, [&] {
@@ -309,6 +369,12 @@ using Muscle = physics::TeranMuscle<double>;
 BENCHMARK_TEMPLATE(BM_embedded_apply, exec::seq_t)->Name("BM_embedded_apply/seq")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_embedded_apply, exec::omp_t)->Name("BM_embedded_apply/omp")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_embedded_apply_cuda)->Name("BM_embedded_apply/cuda")->Unit(benchmark::kMicrosecond)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_gather_apply, interp::IDW<double>, exec::seq_t)->Name("BM_gather_apply/idw/seq")->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_gather_apply, interp::IDW<double>, exec::omp_t)->Name("BM_gather_apply/idw/omp")->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_gather_apply_cuda, interp::IDW<double>)->Name("BM_gather_apply/idw/cuda")->Unit(benchmark::kMicrosecond)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_gather_apply, interp::MLS<double>, exec::seq_t)->Name("BM_gather_apply/mls/seq")->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_gather_apply, interp::MLS<double>, exec::omp_t)->Name("BM_gather_apply/mls/omp")->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_gather_apply_cuda, interp::MLS<double>)->Name("BM_gather_apply/mls/cuda")->Unit(benchmark::kMicrosecond)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_block_csr_multiply, exec::seq_t)->Name("BM_block_csr_multiply_73k/seq")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_block_csr_multiply, exec::omp_t)->Name("BM_block_csr_multiply_73k/omp")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_block_csr_multiply_cuda)->Name("BM_block_csr_multiply_73k/cuda")->Unit(benchmark::kMicrosecond)->UseManualTime();

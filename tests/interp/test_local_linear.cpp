@@ -214,3 +214,32 @@ TEST_CASE("LocalLinear: vertices whose neighbours never move get a zero map; bad
   CHECK_THROWS_AS(wide.fit(exec::seq, p), ArgumentError);  // neighbourhoods have only k columns
   CHECK_THROWS_AS(interp::LocalLinear<>(interp::LocalLinearOptions{.k = 0}), ArgumentError);
 }
+
+TEST_CASE("LocalLinear::apply's body over strided MatrixSpans (DeviceLocalLinear's accessor) equals apply, bitwise, seq and omp") {
+  std::mt19937 rng(21);
+  const Index n = 30, m = 25, k = 4;
+  auto p = make_problem(n, m, k, rng);
+  const Eigen::MatrixXd truth = random_truth(m, k, rng);
+  const auto train = make_frames(p, k, truth, 60, 0.01, 0, rng);
+  interp::LocalLinear<> ll(interp::LocalLinearOptions{.k = k});
+  ll.fit(exec::omp, p);
+  CHECK_FALSE(ll.trained());
+  ll.train(exec::omp, train, {.lambda = 1e-6});
+  REQUIRE(ll.trained());
+  const Points<> x = train.lr(3);
+  Points<> ref(m, 3);
+  ll.apply(exec::seq, x, ref);
+  Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> wide_lr(n, 4), wide_hr(m, 4);
+  wide_lr.leftCols(3) = x;
+  for (const bool omp : {false, true}) {
+    wide_hr.setConstant(5.0);
+    const interp::detail::LocalLinearRow<double> body{ll.neighbor_indices().data(), ll.vertex_maps().data(), k, {wide_lr.data(), n, 3, 4},
+                                                      {wide_hr.data(), m, 3, 4}};
+    if (omp)
+      exec::parallel_for(exec::omp, m, body);
+    else
+      exec::parallel_for(exec::seq, m, body);
+    CHECK(Points<>(wide_hr.leftCols(3)) == ref);
+    CHECK((wide_hr.col(3).array() == 5.0).all());
+  }
+}

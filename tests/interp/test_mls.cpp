@@ -236,3 +236,41 @@ TEST_CASE("MLS on the bunny: both variants beat the rest shape") {
             mls.info().systems_at_degree[0] + mls.info().systems_at_degree[1] + mls.info().rank_deficient);
   }
 }
+
+TEST_CASE("NeighborGather's body over strided MatrixSpans (DeviceNeighborGather's accessor) equals MLS's and IDW's apply, bitwise, seq and omp") {
+  std::mt19937 rng(13);
+  auto p = point_problem(jittered_lattice(6, 5, 4, 1.0, 0.3, rng), random_points(250, 0.5, 3.5, rng), 20);
+  MLS<> per_coordinate, linear(MLSOptions{.basis = MlsBasis::linear_3d});
+  per_coordinate.fit(exec::seq, p);
+  linear.fit(exec::seq, p);
+  IDW<> idw;
+  idw.fit(exec::seq, p);
+  CHECK(per_coordinate.gather().per_component);
+  CHECK_FALSE(idw.gather().per_component);
+  std::normal_distribution<double> N;
+  Points<> lr(p.num_lr(), 3);
+  for (Index i = 0; i < lr.size(); ++i) lr.data()[i] = N(rng);
+  // the LR input and HR output in wider rows (stride 5), as a device array may be laid out
+  Eigen::Matrix<double, Eigen::Dynamic, 5, Eigen::RowMajor> wide_lr(p.num_lr(), 5), wide_hr(p.num_hr(), 5);
+  wide_lr.leftCols(3) = lr;
+  for (const interp::detail::NeighborGather<double>* g : {&per_coordinate.gather(), &linear.gather(), &idw.gather()}) {
+    Points<> ref(p.num_hr(), 3);
+    g->apply(exec::seq, lr, ref);
+    for (const bool omp : {false, true}) {
+      wide_hr.setConstant(-7.0);
+      const interp::detail::NeighborGatherRow<double> body{g->indices.data(), g->weights.data(), g->k(), g->per_component,
+                                                           {wide_lr.data(), p.num_lr(), 3, 5}, {wide_hr.data(), p.num_hr(), 3, 5}};
+      if (omp)
+        exec::parallel_for(exec::omp, p.num_hr(), body);
+      else
+        exec::parallel_for(exec::seq, p.num_hr(), body);
+      CHECK(Points<>(wide_hr.leftCols(3)) == ref);
+      CHECK((wide_hr.rightCols(2).array() == -7.0).all());  // the padding untouched
+    }
+  }
+  Points<> a(p.num_hr(), 3);
+  idw.apply(exec::omp, lr, a);
+  Points<> b(p.num_hr(), 3);
+  idw.gather().apply(exec::seq, lr, b);
+  CHECK(a == b);
+}

@@ -74,6 +74,8 @@ class IDW {
 
   Index num_lr() const { return n_; }
   Index num_hr() const { return gather_.rows(); }
+  /// The fitted gather apply runs (DeviceNeighborGather copies it).
+  const detail::NeighborGather<S>& gather() const { return gather_; }
   const IDWOptions& options() const { return options_; }
   /// M×k LR ids and M×k weights (rows sum to 1) after fit.
   const auto& indices() const { return gather_.indices; }

@@ -81,6 +81,33 @@ struct LocalLinearTrainInfo {
 };
 
 /// The local linear upsampler (S = double or float). Satisfies interp::TrainableInterpolator.
+namespace detail {
+/// LocalLinear::apply's body, HR vertex v: Δx^H_v = Σ_k W_vk Δx^L_{i(v,k)}, each 3×3 W_vk applied
+/// column by column, k ascending. SIMSR_HOST_DEVICE over raw arrays: apply runs it under seq and
+/// omp, DeviceLocalLinear under exec::cuda.
+template <class S>
+struct LocalLinearRow {
+  const VIndex* indices;  ///< M×K row-major
+  const S* maps;          ///< M × 9K: row v, entry (3k + a)·3 + c
+  Index K;
+  MatrixSpan<const S> lr;  ///< N×3
+  MatrixSpan<S> hr;        ///< M×3
+
+  SIMSR_HOST_DEVICE void operator()(Index v) const {
+    S out[3] = {0, 0, 0};
+    const S* Wv = maps + v * 9 * K;
+    for (Index k = 0; k < K; ++k) {
+      const Index j = indices[v * K + k];
+      for (Index a = 0; a < 3; ++a) {
+        const S x = lr(j, a);
+        for (Index c = 0; c < 3; ++c) out[c] += x * Wv[3 * (3 * k + a) + c];
+      }
+    }
+    for (Index c = 0; c < 3; ++c) hr(v, c) = out[c];
+  }
+};
+}  // namespace detail
+
 template <class S = Scalar>
 class LocalLinear {
  public:
@@ -161,19 +188,17 @@ class LocalLinear {
     if (!trained_) throw ArgumentError("LocalLinear::apply before train");
     if (lr_displacement.rows() != n_) throw ShapeError("LocalLinear::apply: LR displacement", {n_, 3}, {lr_displacement.rows(), 3});
     if (hr_displacement.rows() != m_) throw ShapeError("LocalLinear::apply: HR displacement", {m_, 3}, {hr_displacement.rows(), 3});
-    const Index K = options_.k;
-    exec::parallel_for(policy, m_, [&](Index v) {
-      S out[3] = {0, 0, 0};
-      for (Index k = 0; k < K; ++k) {
-        const Index j = idx_(v, k);
-        for (Index a = 0; a < 3; ++a) {
-          const S x = lr_displacement(j, a);
-          for (Index c = 0; c < 3; ++c) out[c] += x * W_(v, 3 * (3 * k + a) + c);
-        }
-      }
-      for (Index c = 0; c < 3; ++c) hr_displacement(v, c) = out[c];
-    });
+    exec::parallel_for(policy, m_,
+                       detail::LocalLinearRow<S>{idx_.data(), W_.data(), options_.k,
+                                                 {lr_displacement.data(), n_, 3, lr_displacement.outerStride()},
+                                                 {hr_displacement.data(), m_, 3, hr_displacement.outerStride()}});
   }
+
+  /// M×k LR neighbour ids and the M × 9k per-vertex 3×3 maps (row v, entry (3k + a)·3 + c: (W_vk)_{ca})
+  /// after train: what apply gathers with (DeviceLocalLinear copies them).
+  const auto& neighbor_indices() const { return idx_; }
+  const auto& vertex_maps() const { return W_; }
+  bool trained() const { return trained_; }
 
   /// The whole map as a 3M×3N sparse matrix on displacements flattened row by row (x, y, z of
   /// vertex 0, then vertex 1, …): row 3i + c, column 3j + a holds (W_ij)_{ca}.

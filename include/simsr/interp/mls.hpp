@@ -130,6 +130,8 @@ class MLS {
 
   Index num_lr() const { return n_; }
   Index num_hr() const { return gather_.rows(); }
+  /// The fitted gather apply runs (DeviceNeighborGather copies it).
+  const detail::NeighborGather<S>& gather() const { return gather_; }
   const MLSOptions& options() const { return options_; }
   const MLSFitInfo& info() const { return info_; }
   /// M×k LR ids; coefficients α: M×3k (per_coordinate, component c in columns [c·k, c·k+k)) or M×k.

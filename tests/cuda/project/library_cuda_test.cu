@@ -1,5 +1,6 @@
 // The library's own kernel bodies under exec::cuda (issue #17 item 5): Embedded::apply's
-// (interp::DeviceEmbedded), BlockCsr's product (physics::DeviceBlockCsr), the elastic energy and
+// (interp::DeviceEmbedded), IDW's, MLS's and LocalLinear's apply (interp::DeviceNeighborGather,
+// interp::DeviceLocalLinear), BlockCsr's product (physics::DeviceBlockCsr), the elastic energy and
 // gradient and the gathered Hessian (physics::DeviceElasticEnergy, isotropic and fibre
 // materials) and the network's
 // upsampling gather (nn::DeviceNeighborUpsample), and the whole network's inference
@@ -8,7 +9,10 @@
 // exists it runs and checks the device results against the host's (to rounding: the device may
 // fuse multiply-adds the host does not).
 #include <simsr/interp/device_embedded.hpp>
+#include <simsr/interp/device_local_linear.hpp>
+#include <simsr/interp/device_neighbor_gather.hpp>
 #include <simsr/mesh/generators.hpp>
+#include <simsr/neighbors/kd_tree.hpp>
 #include <simsr/nn/device_neighbor_upsample.hpp>
 #include <simsr/nn/inference_net.hpp>
 #include <simsr/physics/device_elastic_energy.hpp>
@@ -148,6 +152,45 @@ int main() {
   Points<double> lr_disp(lr.num_vertices(), 3), hr_host(hr.rows(), 3), hr_device(hr.rows(), 3);
   for (Index i = 0; i < lr_disp.size(); ++i) lr_disp.data()[i] = U(rng);
   embedded.apply(exec::seq, lr_disp, hr_host);
+  // IDW, MLS and LocalLinear on the box and HR points (fitted here: the host part runs without a device)
+  interp::UpsamplingProblem<double> problem;
+  problem.lr = lr;
+  problem.hr.V = hr;
+  {  // Euclidean neighbourhoods (the HR points have no surface for the geodesic ones)
+    const neighbors::KdTree<double> tree(lr.V);
+    const auto nearest = tree.query(exec::seq, hr, 20);  // IDW's and MLS's default k
+    neighbors::UpsamplingNeighborhoods nb;
+    nb.indices = nearest.indices;
+    nb.distances = nearest.distances;
+    problem.neighborhoods = std::move(nb);
+  }
+  interp::IDW<double> idw;
+  idw.fit(exec::seq, problem);
+  interp::MLS<double> mls;
+  mls.fit(exec::seq, problem);
+  interp::LocalLinear<double> local(interp::LocalLinearOptions{.k = 4});
+  local.fit(exec::seq, problem);
+  {
+    const Index F = 40;  // frames: random LR displacements, their IDW interpolation plus noise
+    data::PairedFrames<double> frames;
+    frames.lowres.resize(F, 3 * lr.num_vertices());
+    frames.highres.resize(F, 3 * hr.rows());
+    Points<double> a(lr.num_vertices(), 3), b(hr.rows(), 3);
+    for (Index f = 0; f < F; ++f) {
+      for (Index i = 0; i < a.size(); ++i) a.data()[i] = U(rng);
+      idw.apply(exec::seq, a, b);
+      for (Index i = 0; i < b.size(); ++i) b.data()[i] += 0.01 * U(rng);
+      frames.lowres.row(f) = Eigen::Map<const Eigen::RowVectorXd>(a.data(), a.size());
+      frames.highres.row(f) = Eigen::Map<const Eigen::RowVectorXd>(b.data(), b.size());
+      frames.ids.push_back(f);
+    }
+    frames.controls.resize(F, 0);
+    local.train(exec::seq, frames, {.lambda = 1e-6});
+  }
+  Points<double> idw_host(hr.rows(), 3), mls_host(hr.rows(), 3), local_host(hr.rows(), 3);
+  idw.apply(exec::seq, lr_disp, idw_host);
+  mls.apply(exec::seq, lr_disp, mls_host);
+  local.apply(exec::seq, lr_disp, local_host);
   // BlockCsr: a random block-sparse matrix
   const Index nb = 300;
   std::vector<Eigen::Triplet<double, int>> t;
@@ -184,6 +227,15 @@ int main() {
   d_embedded.apply(exec::cuda, MatrixSpan<const double>{d_lr.span().data, lr_disp.rows(), 3, 3}, MatrixSpan<double>{d_hr.span().data, hr_device.rows(), 3, 3});
   d_hr.copy_to(Span<double>{hr_device.data(), hr_device.size()});
   const double e_embedded = max_relative(hr_device.data(), hr_host.data(), hr_host.size());
+  // IDW, MLS and LocalLinear on the device
+  auto gather_difference = [&](const auto& twin, const Points<double>& host) {
+    Points<double> out(hr.rows(), 3);
+    twin.apply(exec::cuda, MatrixSpan<const double>{d_lr.span().data, lr_disp.rows(), 3, 3}, MatrixSpan<double>{d_hr.span().data, out.rows(), 3, 3});
+    d_hr.copy_to(Span<double>{out.data(), out.size()});
+    return max_relative(out.data(), host.data(), host.size());
+  };
+  const double e_idw = gather_difference(interp::to_device(idw), idw_host), e_mls = gather_difference(interp::to_device(mls), mls_host),
+               e_local = gather_difference(interp::to_device(local), local_host);
   // BlockCsr on the device
   const auto d_blocks = physics::to_device(blocks);
   DeviceBuffer<double> d_x(Span<const double>{x.data(), x.size()}), d_y(y_device.size());
@@ -199,6 +251,7 @@ int main() {
                                           std::vector<physics::NoElementData>(std::size_t(body.num_tets())));
   const double h_muscle = hessian_difference(body, deformed, physics::TeranMuscle<double>(), fibres);
   std::printf("Embedded::apply device vs seq: %.3g; BlockCsr product device vs seq: %.3g\n", e_embedded, e_blocks);
+  std::printf("IDW::apply %.3g, MLS::apply %.3g, LocalLinear::apply %.3g device vs seq\n", e_idw, e_mls, e_local);
   const Index inverted = physics::ElasticEnergy<physics::NeoHookean<double>>(body, physics::NeoHookean<double>::from_young_poisson(3e4, 0.45))
                              .count_inverted(exec::seq, deformed);
   std::printf("ElasticEnergy energy+gradient device vs seq: NeoHookean %.3g, TeranMuscle %.3g (%td tets, %td inverted)\n", e_neo,
@@ -209,7 +262,7 @@ int main() {
   const auto [e_network, e_launches] = network_difference(rng64);
   std::printf("SuperResolutionNet inference (float, official) device vs the network's infer: %.3g, vs the same launches on the host: %.3g\n",
               e_network, e_launches);
-  return e_embedded < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && e_upsample < 1e-5 && h_neo < 1e-10 && h_muscle < 1e-10 && e_network < 1e-4 && e_launches < 1e-4
+  return e_embedded < 1e-13 && e_idw < 1e-13 && e_mls < 1e-13 && e_local < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && e_upsample < 1e-5 && h_neo < 1e-10 && h_muscle < 1e-10 && e_network < 1e-4 && e_launches < 1e-4
              ? 0
              : 1;
 }

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <string>
 
+#include "../../core/device_buffer.hpp"
 #include "../../core/error.hpp"
+#include "../../core/host_device.hpp"
 #include "../../core/parallel.hpp"
 #include "../../core/types.hpp"
 #include "../../mesh/topology.hpp"
@@ -36,6 +38,43 @@ void check_apply_shapes(const std::string& who, Index n, Index m, const LR& lr, 
   if (hr.rows() != m) throw ShapeError(who + ": hr_displacement", {m, 3}, {hr.rows(), hr.cols()});
 }
 
+/// NeighborGather's body, one HR row j (all three components): hr(j, ·) = Σ_n w_jn lr(i(j, n), ·),
+/// the sum over n ascending. SIMSR_HOST_DEVICE over raw arrays: NeighborGather::apply runs it
+/// under seq and omp, DeviceNeighborGather (IDW's and MLS's device twin) under exec::cuda.
+template <class S>
+struct NeighborGatherRow {
+  const VIndex* indices;  ///< M×k row-major
+  const S* weights;       ///< M×k, or M×3k when per_component
+  Index k;
+  bool per_component;
+  MatrixSpan<const S> lr;  ///< N×3
+  MatrixSpan<S> hr;        ///< M×3
+
+  SIMSR_HOST_DEVICE void operator()(Index j) const {
+    const VIndex* ij = indices + j * k;
+    if (per_component) {
+      const S* wj = weights + j * 3 * k;
+      for (int c = 0; c < 3; ++c) {
+        S acc = 0;
+        for (Index n = 0; n < k; ++n) acc += wj[c * k + n] * lr(Index(ij[n]), c);
+        hr(j, c) = acc;
+      }
+    } else {
+      const S* wj = weights + j * k;
+      S a0 = 0, a1 = 0, a2 = 0;
+      for (Index n = 0; n < k; ++n) {
+        const S* xi = lr.data + Index(ij[n]) * lr.stride;
+        a0 += wj[n] * xi[0];
+        a1 += wj[n] * xi[1];
+        a2 += wj[n] * xi[2];
+      }
+      hr(j, 0) = a0;
+      hr(j, 1) = a1;
+      hr(j, 2) = a2;
+    }
+  }
+};
+
 /// A fitted linear map LR → HR displacements with k LR vertices per HR row.
 /// `indices` M×k LR ids; `weights` M×k (one weight per neighbour for all three components) or
 /// M×3k (per component c, entries [c·k, c·k + k)). Each row is computed alone, in neighbour
@@ -52,37 +91,9 @@ struct NeighborGather {
   /// hr.row(j) = Σ_n weights(j, ·n) lr.row(indices(j, n)); hr must already be M×3.
   template <exec::HostPolicy Policy>
   void apply(Policy policy, const ConstPointsRef<S>& lr, PointsRef<S> hr) const {
-    const Index kk = k();
-    const VIndex* idx = indices.data();
-    const S* w = weights.data();
-    const S* x = lr.data();
-    S* y = hr.data();
-    if (per_component) {
-      exec::parallel_for(policy, rows(), [=](Index j) {
-        const VIndex* ij = idx + j * kk;
-        const S* wj = w + j * 3 * kk;
-        for (int c = 0; c < 3; ++c) {
-          S acc = 0;
-          for (Index n = 0; n < kk; ++n) acc += wj[c * kk + n] * x[3 * Index(ij[n]) + c];
-          y[3 * j + c] = acc;
-        }
-      });
-    } else {
-      exec::parallel_for(policy, rows(), [=](Index j) {
-        const VIndex* ij = idx + j * kk;
-        const S* wj = w + j * kk;
-        S a0 = 0, a1 = 0, a2 = 0;
-        for (Index n = 0; n < kk; ++n) {
-          const S* xi = x + 3 * Index(ij[n]);
-          a0 += wj[n] * xi[0];
-          a1 += wj[n] * xi[1];
-          a2 += wj[n] * xi[2];
-        }
-        y[3 * j] = a0;
-        y[3 * j + 1] = a1;
-        y[3 * j + 2] = a2;
-      });
-    }
+    exec::parallel_for(policy, rows(),
+                       NeighborGatherRow<S>{indices.data(), weights.data(), k(), per_component, {lr.data(), lr.rows(), 3, lr.outerStride()},
+                                            {hr.data(), hr.rows(), 3, hr.outerStride()}});
   }
 };
 
