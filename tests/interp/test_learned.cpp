@@ -2,6 +2,7 @@
 // geometry, training, inference and model files owned by the library, not the tool).
 #include <simsr/interp/embedded.hpp>
 #include <simsr/interp/learned.hpp>
+#include <simsr/interp/learned_inference.hpp>
 #include <simsr/interp/network_recipe.hpp>
 #include <simsr/mesh/generators.hpp>
 
@@ -281,4 +282,43 @@ TEST_CASE("NetworkRecipe: the residual base by name; only a non-Embedded base en
   CHECK_THROWS_AS(r.config(), ArgumentError);
   r.residual_base = "embedded";
   CHECK(interp::Learned<>::neighborhoods_needed(r.config()) == 10);
+}
+
+TEST_CASE("LearnedInference (host memory): the device path's launches give Learned::apply's prediction; its checks name the vertex") {
+  auto s = net_scene(8, 6);
+  interp::Learned<> net(residual_config(), 7);
+  net.fit(exec::omp, s.problem);
+  net.train(exec::omp, s.frames, quick(1));
+  interp::HostLearned<> plan(exec::omp, net);
+  CHECK(plan.num_lr() == s.problem.num_lr());
+  CHECK(plan.num_hr() == s.problem.num_hr());
+  Points<> expected(s.problem.num_hr(), 3), got_seq(s.problem.num_hr(), 3), got_omp(s.problem.num_hr(), 3);
+  for (Index f = 0; f < 3; ++f) {
+    const Points<> in = s.frames.lr(f);
+    net.apply(exec::seq, in, expected);
+    plan.apply(exec::seq, in, got_seq);
+    plan.apply(exec::omp, in, got_omp);
+    CHECK(got_seq == got_omp);
+    // the network's float rounding (InferenceNet sums in another order), scaled to mesh units
+    CHECK((got_seq - expected).cwiseAbs().maxCoeff() <= 1e-5 * (1e-3 + expected.cwiseAbs().maxCoeff()));
+  }
+  // Learned::apply's input checks, the same vertex named
+  Points<> in(s.problem.num_lr(), 3), out(s.problem.num_hr(), 3);
+  in.setZero();
+  in(7, 1) = std::nan("");
+  CHECK_THROWS_WITH_AS(plan.apply(exec::seq, in, out), doctest::Contains("vertex 7 is nan: not finite"), ArgumentError);
+  in(7, 1) = 1e300;
+  CHECK_THROWS_WITH_AS(plan.apply(exec::omp, in, out), doctest::Contains("float range"), ArgumentError);
+  in.setZero();
+  Points<> wrong(s.problem.num_hr() + 1, 3);
+  CHECK_THROWS_AS(plan.apply(exec::seq, in, wrong), ShapeError);
+  // a non-finite prediction is a NumericalError, as Learned::apply's
+  auto& store = net.network().store();
+  store.values(store.at("net_decoder.decoder.last_layer.fc.bias"))[1] = std::numeric_limits<float>::infinity();
+  net.network().parameters_changed();
+  CHECK_THROWS_AS(net.apply(exec::seq, in, out), NumericalError);
+  interp::HostLearned<> broken(exec::seq, net);
+  CHECK_THROWS_WITH_AS(broken.apply(exec::seq, in, out), doctest::Contains("HR vertex 0"), NumericalError);
+  interp::Learned<> unfitted;
+  CHECK_THROWS_AS(interp::HostLearned<>(exec::seq, unfitted), ArgumentError);
 }

@@ -103,6 +103,13 @@ class DeviceBuffer {
     if (host.size != size_) throw ShapeError("DeviceBuffer::copy_to", {size_}, {host.size});
     if (size_) check(cudaMemcpy(host.data, data_, std::size_t(size_) * sizeof(T), cudaMemcpyDeviceToHost), "cudaMemcpy to the host");
   }
+  /// Element i copied to the host (a message's value; ArgumentError outside [0, size)).
+  T value_at(Index i) const {
+    if (i < 0 || i >= size_) throw ArgumentError("DeviceBuffer::value_at: index " + std::to_string(i) + " of " + std::to_string(size_));
+    T v;
+    check(cudaMemcpy(&v, data_ + i, sizeof(T), cudaMemcpyDeviceToHost), "cudaMemcpy to the host");
+    return v;
+  }
   Span<T> span() { return {data_, size_}; }
   Span<const T> span() const { return {data_, size_}; }
   Index size() const { return size_; }

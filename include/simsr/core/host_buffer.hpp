@@ -45,6 +45,11 @@ class HostBuffer {
     if (host.size != size()) throw ShapeError("HostBuffer::copy_to", {size()}, {host.size});
     std::copy_n(values_.data(), host.size, host.data);
   }
+  /// Element i (ArgumentError outside [0, size)).
+  T value_at(Index i) const {
+    if (i < 0 || i >= size()) throw ArgumentError("HostBuffer::value_at: index " + std::to_string(i) + " of " + std::to_string(size()));
+    return values_[std::size_t(i)];
+  }
   Span<T> span() { return {values_.data(), size()}; }
   Span<const T> span() const { return {values_.data(), size()}; }
   Index size() const { return Index(values_.size()); }

@@ -1,16 +1,17 @@
 // The library's own kernel bodies under exec::cuda (issue #17 item 5): Embedded::apply's
 // (interp::DeviceEmbedded), IDW's, MLS's and LocalLinear's apply (interp::DeviceNeighborGather,
-// interp::DeviceLocalLinear), BlockCsr's product (physics::DeviceBlockCsr), the elastic energy and
-// gradient and the gathered Hessian (physics::DeviceElasticEnergy, isotropic and fibre
-// materials) and the network's
-// upsampling gather (nn::DeviceNeighborUpsample), and the whole network's inference
-// (nn::DeviceInferenceNet, against SuperResolutionNet::infer and against the same launches on the
-// host, nn::HostInferenceNet): the same functors the host tests run under seq and omp. Compiled by nvcc in the cuda-compile test; where a GPU
-// exists it runs and checks the device results against the host's (to rounding: the device may
-// fuse multiply-adds the host does not).
+// interp::DeviceLocalLinear), BlockCsr's product (physics::DeviceBlockCsr), the elastic energy,
+// gradient and gathered Hessian (physics::DeviceElasticEnergy, isotropic and fibre materials),
+// the network's upsampling gather (nn::DeviceNeighborUpsample), the whole network's inference
+// (nn::DeviceInferenceNet, against SuperResolutionNet::infer and against the same launches on
+// the host, nn::HostInferenceNet) and Learned::apply around it (interp::DeviceLearned): the same
+// functors the host tests run under seq and omp. Compiled by nvcc in the cuda-compile test; where
+// a GPU exists it runs and checks the device results against the host's (to rounding: the device
+// may fuse multiply-adds the host does not). The host part (fits, training) runs without one.
 #include <simsr/interp/device_embedded.hpp>
 #include <simsr/interp/device_local_linear.hpp>
 #include <simsr/interp/device_neighbor_gather.hpp>
+#include <simsr/interp/learned_inference.hpp>
 #include <simsr/mesh/generators.hpp>
 #include <simsr/neighbors/kd_tree.hpp>
 #include <simsr/nn/device_neighbor_upsample.hpp>
@@ -137,6 +138,29 @@ std::pair<double, double> network_difference(std::mt19937_64& rng) {
               Index(((on_device.dynamic_graph(1).array() != on_host.dynamic_graph(1).array()).rowwise().any()).count()), B * N);
   return {rel(device, expected), rel(device, host)};
 }
+/// Learned::apply (the official residual network over Embedded, fitted on a box and a sphere,
+/// untrained but for random decoder output weights) on the device against the host's.
+double learned_difference(std::mt19937_64& rng) {
+  using namespace simsr;
+  interp::UpsamplingProblem<double> problem;
+  problem.lr = box_tet_mesh<double>(4, 4, 4, Vec3<>(-0.1, -0.1, -0.1), Vec3<>(0.1, 0.1, 0.1));
+  problem.hr = icosphere<double>(3, 0.08);
+  problem.ensure_neighborhoods(exec::seq, 20);
+  nn::NetworkConfig cfg = nn::NetworkConfig::official();
+  cfg.residual = true;
+  interp::Learned<> learned(cfg, 3);
+  learned.fit(exec::omp, problem);
+  auto& store = learned.network().store();
+  for (const char* n : {"net_decoder.decoder.last_layer.fc.weight", "net_decoder.decoder.last_layer.fc.bias"})
+    for (float& v : store.values(store.at(n))) v = std::uniform_real_distribution<float>(-0.5f, 0.5f)(rng);
+  learned.network().parameters_changed();
+  Points<double> lr(problem.num_lr(), 3), host(problem.num_hr(), 3), device(problem.num_hr(), 3);
+  for (Index i = 0; i < lr.size(); ++i) lr.data()[i] = std::uniform_real_distribution<double>(-0.01, 0.01)(rng);
+  learned.apply(exec::omp, lr, host);
+  auto twin = interp::to_device(exec::omp, learned);
+  twin.apply(exec::cuda, lr, device);
+  return max_relative(device.data(), host.data(), host.size());
+}
 }  // namespace
 
 int main() {
@@ -260,9 +284,12 @@ int main() {
   std::printf("ElasticEnergy Hessian (gathered, project and exact) device vs seq: NeoHookean %.3g, TeranMuscle %.3g\n", h_neo, h_muscle);
   std::mt19937_64 rng64(11);
   const auto [e_network, e_launches] = network_difference(rng64);
+  const double e_learned = learned_difference(rng64);
   std::printf("SuperResolutionNet inference (float, official) device vs the network's infer: %.3g, vs the same launches on the host: %.3g\n",
               e_network, e_launches);
-  return e_embedded < 1e-13 && e_idw < 1e-13 && e_mls < 1e-13 && e_local < 1e-13 && e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && e_upsample < 1e-5 && h_neo < 1e-10 && h_muscle < 1e-10 && e_network < 1e-4 && e_launches < 1e-4
-             ? 0
-             : 1;
+  std::printf("Learned::apply (mesh units) device vs the host's: %.3g\n", e_learned);
+  const bool interpolators = e_embedded < 1e-13 && e_idw < 1e-13 && e_mls < 1e-13 && e_local < 1e-13;
+  const bool physics = e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && h_neo < 1e-10 && h_muscle < 1e-10;
+  const bool network = e_upsample < 1e-5 && e_network < 1e-4 && e_launches < 1e-4 && e_learned < 1e-4;
+  return interpolators && physics && network ? 0 : 1;
 }
