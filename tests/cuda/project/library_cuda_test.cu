@@ -126,10 +126,10 @@ std::pair<double, double> network_difference(std::mt19937_64& rng) {
   nn::Matrix<float> ldx(B * N, 3), expected, host, device;
   for (Index i = 0; i < ldx.size(); ++i) ldx.data()[i] = std::uniform_real_distribution<float>(-0.5f, 0.5f)(rng);
   net.set_decoder_first_layer_on_lr(false);
-  net.infer(exec::omp, ldx, expected);
-  nn::HostInferenceNet<float> on_host(exec::omp, net);
-  on_host.infer(exec::omp, ldx, host);
-  auto on_device = nn::to_device(exec::omp, net);
+  net.infer(exec::seq, ldx, expected);
+  nn::HostInferenceNet<float> on_host(exec::seq, net);
+  on_host.infer(exec::seq, ldx, host);
+  auto on_device = nn::to_device(exec::seq, net);
   on_device.infer(exec::cuda, ldx, device);
   auto rel = [](const nn::Matrix<float>& a, const nn::Matrix<float>& b) {
     return double((a - b).cwiseAbs().maxCoeff()) / std::max(1e-30, double(b.cwiseAbs().maxCoeff()));
@@ -149,15 +149,15 @@ double learned_difference(std::mt19937_64& rng) {
   nn::NetworkConfig cfg = nn::NetworkConfig::official();
   cfg.residual = true;
   interp::Learned<> learned(cfg, 3);
-  learned.fit(exec::omp, problem);
+  learned.fit(exec::seq, problem);
   auto& store = learned.network().store();
   for (const char* n : {"net_decoder.decoder.last_layer.fc.weight", "net_decoder.decoder.last_layer.fc.bias"})
     for (float& v : store.values(store.at(n))) v = std::uniform_real_distribution<float>(-0.5f, 0.5f)(rng);
   learned.network().parameters_changed();
   Points<double> lr(problem.num_lr(), 3), host(problem.num_hr(), 3), device(problem.num_hr(), 3);
   for (Index i = 0; i < lr.size(); ++i) lr.data()[i] = std::uniform_real_distribution<double>(-0.01, 0.01)(rng);
-  learned.apply(exec::omp, lr, host);
-  auto twin = interp::to_device(exec::omp, learned);
+  learned.apply(exec::seq, lr, host);
+  auto twin = interp::to_device(exec::seq, learned);
   twin.apply(exec::cuda, lr, device);
   return max_relative(device.data(), host.data(), host.size());
 }
