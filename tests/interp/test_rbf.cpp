@@ -499,3 +499,36 @@ TEST_CASE("RBF on the bunny: geodesic (one surface metric) and Euclidean beat th
     if (dist == RbfDistance::geodesic) CHECK(at_centres < 1e-9);  // Δx^H at lr_to_hr[i] is ΔX^L_i
   }
 }
+
+TEST_CASE("RBF::apply's operator body over strided MatrixSpans (DeviceRbf's accessor) equals apply, bitwise, seq and omp") {
+  std::mt19937 rng(31);
+  auto p = make_problem(lattice_tets(4, 4, 3, 1.0, 0.3, rng), random_points(60, 0.2, 2.8, rng), 20);
+  RBFOptions o;
+  o.distance = RbfDistance::lr_mesh_geodesic;
+  o.sigma = 1.1;
+  RBF<> rbf(o);
+  rbf.fit(exec::seq, p);
+  REQUIRE(rbf.info().precomputed_operator);
+  CHECK(rbf.evaluation_operator().rows() == p.num_hr());
+  CHECK(rbf.evaluation_operator().cols() == p.num_lr());
+  const Points<> dX = random_points(p.num_lr(), -1, 1, rng);
+  Points<> ref(p.num_hr(), 3);
+  rbf.apply(exec::seq, dX, ref);
+  Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> wide_lr(p.num_lr(), 4), wide_hr(p.num_hr(), 4);
+  wide_lr.leftCols(3) = dX;
+  for (const bool omp : {false, true}) {
+    wide_hr.setConstant(3.0);
+    const interp::detail::DenseOperatorRow<double> body{rbf.evaluation_operator().data(), p.num_lr(), {wide_lr.data(), p.num_lr(), 3, 4},
+                                                        {wide_hr.data(), p.num_hr(), 3, 4}};
+    if (omp)
+      exec::parallel_for(exec::omp, p.num_hr(), body);
+    else
+      exec::parallel_for(exec::seq, p.num_hr(), body);
+    CHECK(Points<>(wide_hr.leftCols(3)) == ref);
+    CHECK((wide_hr.col(3).array() == 3.0).all());
+  }
+  o.max_operator_bytes = 0;  // the factor kept: no operator to copy
+  RBF<> solve(o);
+  solve.fit(exec::seq, p);
+  CHECK(solve.evaluation_operator().size() == 0);
+}

@@ -333,18 +333,9 @@ class RBF {
     const S* x = lr_displacement.data();
     S* y = hr_displacement.data();
     if (info_.precomputed_operator) {
-      const Index n = n_;
-      const S* a = A_.data();
-      exec::parallel_for(policy, m_, [=](Index j) {
-        const S* aj = a + j * n;
-        S a0 = 0, a1 = 0, a2 = 0;
-        for (Index i = 0; i < n; ++i) {
-          a0 += aj[i] * x[3 * i];
-          a1 += aj[i] * x[3 * i + 1];
-          a2 += aj[i] * x[3 * i + 2];
-        }
-        y[3 * j] = a0, y[3 * j + 1] = a1, y[3 * j + 2] = a2;
-      });
+      exec::parallel_for(policy, m_,
+                         detail::DenseOperatorRow<S>{A_.data(), n_, {x, n_, 3, lr_displacement.outerStride()},
+                                                     {y, m_, 3, hr_displacement.outerStride()}});
       return;
     }
     exec::parallel_for(policy, 3, [&](Index c) { solve_component(lr_displacement, int(c)); });
@@ -366,6 +357,9 @@ class RBF {
 
   Index num_lr() const { return n_; }
   Index num_hr() const { return m_; }
+  /// The M×N evaluation operator apply multiplies by (empty unless info().precomputed_operator;
+  /// DeviceRbf copies it).
+  const auto& evaluation_operator() const { return A_; }
   const RBFOptions& options() const { return options_; }
   const RBFFitInfo& info() const { return info_; }
 

@@ -1,7 +1,7 @@
 // The library's own kernel bodies under exec::cuda (issue #17 item 5): Embedded::apply's
-// (interp::DeviceEmbedded), IDW's, MLS's and LocalLinear's apply (interp::DeviceNeighborGather,
-// interp::DeviceLocalLinear), BlockCsr's product (physics::DeviceBlockCsr), the elastic energy,
-// gradient and gathered Hessian (physics::DeviceElasticEnergy, isotropic and fibre materials),
+// (interp::DeviceEmbedded), IDW's, MLS's, LocalLinear's and RBF's apply
+// (interp::DeviceNeighborGather, interp::DeviceLocalLinear, interp::DeviceRbf), BlockCsr's
+// product (physics::DeviceBlockCsr), the elastic energy, gradient and gathered Hessian (physics::DeviceElasticEnergy, isotropic and fibre materials),
 // the network's upsampling gather (nn::DeviceNeighborUpsample), the whole network's inference
 // (nn::DeviceInferenceNet, against SuperResolutionNet::infer and against the same launches on
 // the host, nn::HostInferenceNet) and Learned::apply around it (interp::DeviceLearned): the same
@@ -11,6 +11,7 @@
 #include <simsr/interp/device_embedded.hpp>
 #include <simsr/interp/device_local_linear.hpp>
 #include <simsr/interp/device_neighbor_gather.hpp>
+#include <simsr/interp/device_rbf.hpp>
 #include <simsr/interp/learned_inference.hpp>
 #include <simsr/mesh/generators.hpp>
 #include <simsr/neighbors/kd_tree.hpp>
@@ -211,7 +212,12 @@ int main() {
     frames.controls.resize(F, 0);
     local.train(exec::seq, frames, {.lambda = 1e-6});
   }
-  Points<double> idw_host(hr.rows(), 3), mls_host(hr.rows(), 3), local_host(hr.rows(), 3);
+  interp::RBFOptions rbf_options;
+  rbf_options.distance = interp::RbfDistance::lr_mesh_geodesic;  // the HR points have no surface
+  interp::RBF<double> rbf(rbf_options);
+  rbf.fit(exec::seq, problem);
+  Points<double> idw_host(hr.rows(), 3), mls_host(hr.rows(), 3), local_host(hr.rows(), 3), rbf_host(hr.rows(), 3);
+  rbf.apply(exec::seq, lr_disp, rbf_host);
   idw.apply(exec::seq, lr_disp, idw_host);
   mls.apply(exec::seq, lr_disp, mls_host);
   local.apply(exec::seq, lr_disp, local_host);
@@ -259,7 +265,7 @@ int main() {
     return max_relative(out.data(), host.data(), host.size());
   };
   const double e_idw = gather_difference(interp::to_device(idw), idw_host), e_mls = gather_difference(interp::to_device(mls), mls_host),
-               e_local = gather_difference(interp::to_device(local), local_host);
+               e_local = gather_difference(interp::to_device(local), local_host), e_rbf = gather_difference(interp::to_device(rbf), rbf_host);
   // BlockCsr on the device
   const auto d_blocks = physics::to_device(blocks);
   DeviceBuffer<double> d_x(Span<const double>{x.data(), x.size()}), d_y(y_device.size());
@@ -275,7 +281,7 @@ int main() {
                                           std::vector<physics::NoElementData>(std::size_t(body.num_tets())));
   const double h_muscle = hessian_difference(body, deformed, physics::TeranMuscle<double>(), fibres);
   std::printf("Embedded::apply device vs seq: %.3g; BlockCsr product device vs seq: %.3g\n", e_embedded, e_blocks);
-  std::printf("IDW::apply %.3g, MLS::apply %.3g, LocalLinear::apply %.3g device vs seq\n", e_idw, e_mls, e_local);
+  std::printf("IDW::apply %.3g, MLS::apply %.3g, LocalLinear::apply %.3g, RBF::apply %.3g device vs seq\n", e_idw, e_mls, e_local, e_rbf);
   const Index inverted = physics::ElasticEnergy<physics::NeoHookean<double>>(body, physics::NeoHookean<double>::from_young_poisson(3e4, 0.45))
                              .count_inverted(exec::seq, deformed);
   std::printf("ElasticEnergy energy+gradient device vs seq: NeoHookean %.3g, TeranMuscle %.3g (%td tets, %td inverted)\n", e_neo,
@@ -288,7 +294,7 @@ int main() {
   std::printf("SuperResolutionNet inference (float, official) device vs the network's infer: %.3g, vs the same launches on the host: %.3g\n",
               e_network, e_launches);
   std::printf("Learned::apply (mesh units) device vs the host's: %.3g\n", e_learned);
-  const bool interpolators = e_embedded < 1e-13 && e_idw < 1e-13 && e_mls < 1e-13 && e_local < 1e-13;
+  const bool interpolators = e_embedded < 1e-13 && e_idw < 1e-13 && e_mls < 1e-13 && e_local < 1e-13 && e_rbf < 1e-13;
   const bool physics = e_blocks < 1e-13 && e_neo < 1e-12 && e_muscle < 1e-12 && h_neo < 1e-10 && h_muscle < 1e-10;
   const bool network = e_upsample < 1e-5 && e_network < 1e-4 && e_launches < 1e-4 && e_learned < 1e-4;
   return interpolators && physics && network ? 0 : 1;

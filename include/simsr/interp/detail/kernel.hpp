@@ -75,6 +75,29 @@ struct NeighborGatherRow {
   }
 };
 
+/// A dense M×N operator's row j applied to the three components: hr(j, ·) = Σ_i A(j, i) lr(i, ·),
+/// the sum over i ascending (RBF's precomputed operator). SIMSR_HOST_DEVICE over raw arrays: RBF's
+/// apply runs it under seq and omp, DeviceRbf under exec::cuda.
+template <class S>
+struct DenseOperatorRow {
+  const S* op;  ///< M×N row-major
+  Index n;
+  MatrixSpan<const S> lr;  ///< N×3
+  MatrixSpan<S> hr;        ///< M×3
+
+  SIMSR_HOST_DEVICE void operator()(Index j) const {
+    const S* aj = op + j * n;
+    S a0 = 0, a1 = 0, a2 = 0;
+    for (Index i = 0; i < n; ++i) {
+      const S* xi = lr.data + i * lr.stride;
+      a0 += aj[i] * xi[0];
+      a1 += aj[i] * xi[1];
+      a2 += aj[i] * xi[2];
+    }
+    hr(j, 0) = a0, hr(j, 1) = a1, hr(j, 2) = a2;
+  }
+};
+
 /// A fitted linear map LR → HR displacements with k LR vertices per HR row.
 /// `indices` M×k LR ids; `weights` M×k (one weight per neighbour for all three components) or
 /// M×3k (per component c, entries [c·k, c·k + k)). Each row is computed alone, in neighbour
