@@ -21,9 +21,11 @@
 /// What it computes is SuperResolutionNet::infer's values up to rounding: the bodies sum each
 /// product in one chain (the host net's packed kernels block the sums), and the decoder's first
 /// layer stays after the upsampling (infer may move it before: the same values up to rounding).
-/// The dynamic graphs are BruteForceKnn's exactly (its ranking key: the direct distance in double,
-/// rounded to S; ties by index), whatever Search the net was built with. Not for training: the
-/// weights are copied at construction (build a new one after the parameters change).
+/// The dynamic graphs are the exact k nearest by BruteForceKnn's ranking key (the direct distance
+/// in double, rounded to S; ties by index), whatever Search the net was built with; BruteForceKnn
+/// itself agrees except where an item's feature rows nearly coincide (its candidate pass cannot
+/// resolve them: README). Not for training: the weights are copied at construction (build a new
+/// one after the parameters change).
 
 #include <string>
 #include <vector>
@@ -93,7 +95,6 @@ class InferenceNet {
         L.point = StageLayout{C, 2 * H, append(params, point_wt.data(), point_wt.size()), append(params, point_b.data(), 2 * H), -1,
                               detail::KernelAct::none, S(0)};
         L.first_tail = tail_layout(params, mlp, 0);
-        L.first_tail.in = C;
         for (Index s = 1; s < mlp.stages(); ++s) L.edge_rest.push_back(stage_layout(params, mlp, s));
         Mlp<S>& fc = block.fc_out();
         for (Index s = 0; s < fc.stages(); ++s) L.fc_out.push_back(stage_layout(params, fc, s));
