@@ -126,4 +126,10 @@ TEST_CASE("signed_svd_one_sided (the device's fallback): the Jacobi SVD's conven
     check_decomposition(F, signed_svd_from_eigen(F, [](const Mat3d& G) { return signed_svd_one_sided(G); }));
   }
   CHECK(signed_svd_one_sided(Mat3d(-Mat3d::Identity())).sigma.isApprox(Eigen::Vector3d(1, 1, -1)));
+  // a NaN or infinite entry gives NaN values (as Eigen's Jacobi SVD), never a made-up decomposition
+  Mat3d bad = Mat3d::Identity();
+  bad(1, 2) = std::nan("");
+  CHECK(signed_svd_one_sided(bad).sigma.array().isNaN().all());
+  bad(1, 2) = std::numeric_limits<double>::infinity();
+  CHECK(signed_svd_one_sided(bad).sigma.array().isNaN().all());
 }

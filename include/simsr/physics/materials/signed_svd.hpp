@@ -54,8 +54,12 @@ SIMSR_HOST_DEVICE SignedSvd<S> signed_svd_one_sided(const Mat3<S>& F) {
   constexpr S eps = std::numeric_limits<S>::epsilon();
   // F scaled by a power of two to entries in [½, 1) (exact): the squared column norms neither
   // overflow nor underflow whatever F's magnitude; σ scaled back at the end
+  bool finite = true;  // (Eigen's allFinite is host code)
+  for (int i = 0; i < 9; ++i) finite = finite && std::isfinite(F(i % 3, i / 3));
+  if (!finite)  // a NaN or infinite entry: NaN values, as the Jacobi SVD's (nothing hidden)
+    return {Mat3<S>::Identity(), Vec3<S>::Constant(std::numeric_limits<S>::quiet_NaN()), Mat3<S>::Identity()};
   const S largest = F.cwiseAbs().maxCoeff();
-  if (!(largest > S(0))) return {Mat3<S>::Identity(), Vec3<S>::Zero(), Mat3<S>::Identity()};  // F = 0
+  if (largest == S(0)) return {Mat3<S>::Identity(), Vec3<S>::Zero(), Mat3<S>::Identity()};  // F = 0
   int exponent = 0;
   (void)std::frexp(largest, &exponent);
   const Mat3<S> G = F * std::ldexp(S(1), -exponent);
