@@ -7,6 +7,7 @@
 #include <numeric>
 
 using namespace simsr;
+using nn::ConstView;
 using nn::Matrix;
 
 namespace {
@@ -189,6 +190,17 @@ TEST_CASE("nn::InferenceNet: bad shapes and strides are refused; a warm infer al
   const long before = simsr_test_malloc_count();
   plan.infer(exec::omp, in, MatrixSpan<float>{pred.data(), 80, 3, 3});
   SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before);
+  // the host-array call: warm, it allocates nothing either; a column block (row stride 5) is packed
+  Matrix<float> host_pred;
+  plan.infer(exec::omp, ldx, host_pred);
+  const long before_host = simsr_test_malloc_count();
+  plan.infer(exec::omp, ldx, host_pred);
+  SIMSR_CHECK_NO_ALLOCATION(exec::omp, simsr_test_malloc_count() - before_host);
+  CHECK(host_pred == pred);
+  Matrix<float> wide(60, 5), strided_pred;
+  wide.leftCols(3) = ldx;
+  plan.infer(exec::seq, ConstView<float>(wide.leftCols(3)), strided_pred);
+  CHECK(strided_pred == pred);
   Matrix<float> expected;
   net->set_decoder_first_layer_on_lr(false);
   net->infer(exec::seq, ldx, expected);

@@ -11,6 +11,7 @@
 #include "../core/device_buffer.hpp"
 #include "../core/error.hpp"
 #include "../core/parallel.hpp"
+#include "detail/kernel.hpp"
 #include "local_linear.hpp"
 
 #if defined(__CUDACC__)
@@ -30,8 +31,7 @@ class DeviceLocalLinear {
 
   /// hr = the local linear maps applied to lr: row-major device arrays, N×3 and M×3 (ShapeError otherwise).
   void apply(exec::cuda_t policy, MatrixSpan<const S> lr, MatrixSpan<S> hr) const {
-    if (lr.rows != num_lr_ || lr.cols != 3) throw ShapeError("DeviceLocalLinear::apply: LR displacement", {num_lr_, 3}, {lr.rows, lr.cols});
-    if (hr.rows != num_hr_ || hr.cols != 3) throw ShapeError("DeviceLocalLinear::apply: HR displacement", {num_hr_, 3}, {hr.rows, hr.cols});
+    detail::check_apply_spans("DeviceLocalLinear::apply", num_lr_, num_hr_, lr, hr);
     exec::parallel_for(policy, num_hr_, detail::LocalLinearRow<S>{indices_.span().data, maps_.span().data, k_, lr, hr});
   }
   Index num_lr() const { return num_lr_; }

@@ -27,8 +27,7 @@ class DeviceRbf {
 
   /// hr = the operator times lr: row-major device arrays, N×3 and M×3 (ShapeError otherwise).
   void apply(exec::cuda_t policy, MatrixSpan<const S> lr, MatrixSpan<S> hr) const {
-    if (lr.rows != num_lr_ || lr.cols != 3) throw ShapeError("DeviceRbf::apply: LR displacement", {num_lr_, 3}, {lr.rows, lr.cols});
-    if (hr.rows != num_hr_ || hr.cols != 3) throw ShapeError("DeviceRbf::apply: HR displacement", {num_hr_, 3}, {hr.rows, hr.cols});
+    detail::check_apply_spans("DeviceRbf::apply", num_lr_, num_hr_, lr, hr);
     exec::parallel_for(policy, num_hr_, detail::DenseOperatorRow<S>{op_.span().data, num_lr_, lr, hr});
   }
   Index num_lr() const { return num_lr_; }

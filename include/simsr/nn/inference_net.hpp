@@ -183,15 +183,20 @@ class InferenceNet {
   }
 
   /// infer on host arrays: copies ldx in and the prediction out (the device instance's transfers;
-  /// the host instance's copies too, so both are called alike).
+  /// the host instance's copies too, so both are called alike). Allocates nothing once warm for
+  /// the same B and a pred already (B·M)×3.
   template <class Policy>
   void infer(Policy policy, const ConstView<S>& ldx, Matrix<S>& pred) {
     if (ldx.cols() != 3 || ldx.rows() < 1 || ldx.rows() % n_)
       throw ShapeError("nn::InferenceNet::infer: LR displacements (B·" + std::to_string(n_) + " rows)", {-1, 3}, {ldx.rows(), ldx.cols()});
     const Index B = ldx.rows() / n_;
-    const Matrix<S> packed = ldx;  // a column block has a row stride of its own
-    ldx_.resize(packed.size());
-    ldx_.copy_from(Span<const S>{packed.data(), packed.size()});
+    const S* rows = ldx.data();
+    if (ldx.outerStride() != 3) {  // a column block has a row stride of its own: packed first
+      packed_ = ldx;
+      rows = packed_.data();
+    }
+    ldx_.resize(3 * ldx.rows());
+    ldx_.copy_from(Span<const S>{rows, 3 * ldx.rows()});
     pred_.resize(B * m_ * 3);
     infer(policy, MatrixSpan<const S>{ldx_.span().data, B * n_, 3, 3}, MatrixSpan<S>{pred_.span().data, B * m_, 3, 3});
     if (pred.rows() != B * m_ || pred.cols() != 3) pred.resize(B * m_, 3);
@@ -369,6 +374,7 @@ class InferenceNet {
   Memory<S> residual_values_;
   Memory<S> z_, point_, edges_a_, edges_b_, edge_out_, e_, pool_max_, pool_mean_, cat_, fc_a_, fc_b_, knn_d_, zh_, dec_a_, dec_b_;
   Memory<S> ldx_, pred_;  ///< infer on host arrays: the transfers' buffers
+  Matrix<S> packed_;      ///< infer on host arrays with a row stride other than 3: the rows packed
   Index batch_ = 0;       ///< B the buffers are sized for (0: none yet)
   Index graph_slot_ = 0;  ///< entries of one dynamic graph's slot in dyn_graph_ (B·N·max k)
 };

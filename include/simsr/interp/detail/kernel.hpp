@@ -75,6 +75,13 @@ struct NeighborGatherRow {
   }
 };
 
+/// The device twins' check of apply's arrays: lr N×3 and hr M×3 (ShapeError naming `who`).
+template <class S>
+void check_apply_spans(const std::string& who, Index n, Index m, const MatrixSpan<const S>& lr, const MatrixSpan<S>& hr) {
+  if (lr.rows != n || lr.cols != 3) throw ShapeError(who + ": LR displacement", {n, 3}, {lr.rows, lr.cols});
+  if (hr.rows != m || hr.cols != 3) throw ShapeError(who + ": HR displacement", {m, 3}, {hr.rows, hr.cols});
+}
+
 /// A dense M×N operator's row j applied to the three components: hr(j, ·) = Σ_i A(j, i) lr(i, ·),
 /// the sum over i ascending (RBF's precomputed operator). SIMSR_HOST_DEVICE over raw arrays: RBF's
 /// apply runs it under seq and omp, DeviceRbf under exec::cuda.
