@@ -16,7 +16,8 @@
 //   BM_face_frame/hr_default_{previous,defaults}_sequence   the same at HR (hr_forcing: fixed)
 //   BM_face_performance/lr_paper_size_…   the whole 120-frame amazement performance at the paper's
 //       LR size, stepped as `simsr datagen` does, timed as one (counter ms_per_frame), with the
-//       same three settings; counters diff_vs_previous_* and diff_vs_converged_* (max and mean
+//       same three settings and `defaults_doubling` (the defaults with the lattice hierarchy of
+//       before 2026-12-07, the cell size doubling per level); counters diff_vs_previous_* and diff_vs_converged_* (max and mean
 //       vertex distance over all frames, mm) against the previous defaults' frames and against
 //       the frames converged to ‖g‖ ≤ 1e-9 × the forces' scale (both solved untimed first)
 //
@@ -66,14 +67,18 @@ const scenario::FaceModel& face_model(const std::string& preset) {
 enum class Solver {
   /// FaceSimulationOptions' defaults before issue #17 item 1 switched them (2026-12-06), the
   /// rows' baseline: fixed forcing, one Jacobi sweep, the levels rebuilt at every setup, no
-  /// carried first step
+  /// carried first step, the cell size doubling per level
   previous,
   /// the defaults with each Newton system solved to linear.tolerance (fixed forcing), the
   /// Eisenstat–Walker forcing's baseline
   fixed_forcing,
   /// FaceSimulationOptions{} as it is: Eisenstat–Walker forcing at LR, a Chebyshev smoother of
-  /// degree 2, coarse levels kept over 4 setups, single-precision levels
+  /// degree 2, coarse levels kept over 4 setups, single-precision levels, each coarse level at
+  /// most 1/8 of the one before
   defaults,
+  /// the defaults with the lattice hierarchy as before 2026-12-07 (the cell size doubling per
+  /// level: LatticeHierarchyOptions::coarsening = 0), the coarsening's baseline
+  doubling,
 };
 
 /// FaceSimulationOptions for `solver` (with the multigrid's `storage`; csr also runs PCG's own
@@ -83,6 +88,8 @@ scenario::FaceSimulationOptions solver_options(Solver solver, physics::Multigrid
   options.multigrid.storage = storage;
   options.linear.block_products = storage != physics::MultigridOptions::Storage::csr;
   if (solver == Solver::defaults) return options;
+  if (solver == Solver::doubling || solver == Solver::previous) options.hierarchy.coarsening = 0;
+  if (solver == Solver::doubling) return options;
   options.newton.forcing = physics::NewtonOptions::Forcing::fixed;
   if (solver == Solver::previous) {
     options.multigrid.coarse_refresh_every = 1;
@@ -229,6 +236,11 @@ BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_fixed_forcing, std::string(
     ->Iterations(1);
 BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_defaults, std::string("paper-lr"), Solver::defaults)
     ->Name("BM_face_performance/lr_paper_size_defaults")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_face_performance, lr_paper_size_defaults_doubling, std::string("paper-lr"), Solver::doubling)
+    ->Name("BM_face_performance/lr_paper_size_defaults_doubling")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);

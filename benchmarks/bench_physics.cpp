@@ -303,11 +303,14 @@ using Smoother = MultigridOptions::Smoother;
 /// `storage`: the multigrid's MultigridOptions (ignored by the other solvers); Storage::csr also
 /// runs PCG's own products on the scalar CSR (ConjugateGradientOptions::block_products = false):
 /// the baseline of every 3×3-block product. `smoother`, `chebyshev_degree`: the V-cycle's smoother
-/// (MultigridOptions::Smoother; the degree for the Chebyshev one).
+/// (MultigridOptions::Smoother; the degree for the Chebyshev one). `coarsening`: the lattice
+/// hierarchy's LatticeHierarchyOptions::coarsening (0: the cell size doubles per level, as before
+/// 2026-12-07).
 template <class Linear>
-Linear make_linear(int coarse_refresh_every = 1, Storage storage = Storage::block, Smoother smoother = Smoother::jacobi, int chebyshev_degree = 2) {
+Linear make_linear(int coarse_refresh_every = 1, Storage storage = Storage::block, Smoother smoother = Smoother::jacobi, int chebyshev_degree = 2,
+                   double coarsening = LatticeHierarchyOptions{}.coarsening) {
   return make_linear_solver<Linear>(
-      exec::omp, scene().mesh, {.tolerance = kCgTolerance, .block_products = storage != Storage::csr}, {},
+      exec::omp, scene().mesh, {.tolerance = kCgTolerance, .block_products = storage != Storage::csr}, {.coarsening = coarsening},
       {.coarse_refresh_every = coarse_refresh_every,
        .storage = storage,
        .smoother = smoother,
@@ -358,7 +361,7 @@ void multigrid_counters(benchmark::State& state, Linear& linear) {
 template <class Linear, class Policy, class Material = TeranMuscle<>, int CoarseRefreshEvery = 1,
           NewtonOptions::Forcing Forcing = NewtonOptions::Forcing::fixed, Storage MultigridStorage = Storage::block, bool Extrapolate = false,
           bool ForcingSafeguard = true, HessianAssembly Assembly = HessianAssembly::gather, Smoother FrameSmoother = Smoother::jacobi, int ChebyshevDegree = 2, int ChordDrop = 0,
-          bool SolveAFirst = false, bool ChordFirst = false>
+          bool SolveAFirst = false, bool ChordFirst = false, int Coarsening = 8>
 void BM_frame(benchmark::State& state) {
   const Scene& s = scene();
   ElasticEnergy<Material> elastic(s.mesh, Material(), s.elements_a);
@@ -369,7 +372,7 @@ void BM_frame(benchmark::State& state) {
   options.forcing_safeguard = ForcingSafeguard;
   options.chord_below = ChordDrop > 0 ? 1.0 / ChordDrop : 0.0;  // a chord step after a ChordDrop-fold drop of ‖g‖
   options.chord_first = ChordFirst;
-  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage, FrameSmoother, ChebyshevDegree));
+  QuasistaticSolver<Linear> newton(s.mesh.num_vertices(), s.mesh.T, options, make_linear<Linear>(CoarseRefreshEvery, MultigridStorage, FrameSmoother, ChebyshevDegree, Coarsening));
   Points<> x(s.mesh.num_vertices(), 3);
   NewtonReport report;
   // x solved under one frame's activations, track targets and jaw (its Dirichlet boundary)
@@ -417,6 +420,12 @@ void BM_frame(benchmark::State& state) {
   state.counters["chord"] = double(std::count_if(report.history.begin(), report.history.end(), [](const NewtonIteration& it) { return it.chord; }));
   state.counters["fps"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
   multigrid_counters(state, newton.linear_solver());
+  // the last frame's time breakdown (NewtonReport::seconds), ms
+  state.counters["ms_energy"] = 1e3 * report.seconds.energy;
+  state.counters["ms_gradient"] = 1e3 * report.seconds.gradient;
+  state.counters["ms_hessian"] = 1e3 * report.seconds.hessian;
+  state.counters["ms_setup"] = 1e3 * report.seconds.linear_setup;
+  state.counters["ms_solve"] = 1e3 * report.seconds.linear_solve;
   if (std::getenv("SIMSR_BENCH_NEWTON_HISTORY"))  // the last frame's Newton iterations, on stderr
     for (const NewtonIteration& it : report.history)
       std::fprintf(stderr, "BM_frame (%s, coarse levels every %d, forcing %s): iteration %lld |g| %.3e step %.3g backtracks %lld PCG %lld eta %.3g%s\n",
@@ -440,6 +449,9 @@ BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky, exec::seq_t)->Name("BM_frame
 BENCHMARK_TEMPLATE(BM_frame, PcgIncompleteCholesky, exec::omp_t)->Name("BM_frame_73k/pcg_ichol/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::seq_t)->Name("BM_frame_73k/pcg_multigrid/seq")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t)->Name("BM_frame_73k/pcg_multigrid/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+// the configuration of the day issue #17 was filed (587 ms then): the default solver with the
+// lattice hierarchy as it was, the cell size doubling per level (coarsening 0)
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 1, NewtonOptions::Forcing::fixed, Storage::block, false, true, HessianAssembly::gather, Smoother::jacobi, 2, 0, false, false, 0)->Name("BM_frame_73k/pcg_multigrid_doubling/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 // issue #17's baseline beside it: element Hessians through the 9×9 ∂P/∂F, coarse levels rebuilt every Newton iteration
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, NineByNine<TeranMuscle<>>, 1)->Name("BM_frame_73k/pcg_multigrid_9x9/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 2)->Name("BM_frame_73k/pcg_multigrid_coarse_every_2/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
@@ -469,6 +481,7 @@ BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, Newton
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::jacobi, 2, 100, true, true)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chord_first_chord_single_coarse_every_4_extrapolated_after_a/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::chebyshev, 2, 0, true)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_single_coarse_every_4_extrapolated_after_a/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::chebyshev, 2, 0, true, true)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_chord_first_single_coarse_every_4_extrapolated_after_a/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::chebyshev, 2, 0, true, true, 0)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_chebyshev2_chord_first_single_coarse_every_4_extrapolated_after_a_doubling/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, TeranMuscle<>, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true, true, HessianAssembly::coloured, Smoother::gauss_seidel)->Name("BM_frame_73k/pcg_multigrid_inexact_coloured_gauss_seidel_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK_TEMPLATE(BM_frame, PcgMultigrid, exec::omp_t, JacobiSvdMuscle, 4, NewtonOptions::Forcing::adaptive, Storage::block_single, true)->Name("BM_frame_73k/pcg_multigrid_inexact_jacobi_svd_single_coarse_every_4_extrapolated/omp")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 #if defined(SIMSR_HAVE_CHOLMOD)

@@ -1,4 +1,5 @@
 #include <simsr/discretize/bcc_lattice.hpp>
+#include <simsr/discretize/embedding.hpp>
 #include <simsr/mesh/generators.hpp>
 #include <simsr/physics/elastic_energy.hpp>
 #include <simsr/physics/forces/bone_attachment.hpp>
@@ -55,6 +56,72 @@ TEST_CASE("lattice_hierarchy: levels shrink, weights sum to 1 and reproduce affi
   }
   CHECK_THROWS_AS(lattice_hierarchy(exec::seq, TetMesh<double>{}), ArgumentError);
   CHECK_THROWS_AS(lattice_hierarchy(exec::seq, box_tet_mesh<double>(2, 2, 2), {.h = -1}), ArgumentError);
+  for (double bad : {-1.0, 0.5, 1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()})
+    CHECK_THROWS_AS(lattice_hierarchy(exec::seq, box_tet_mesh<double>(2, 2, 2), {.coarsening = bad}), ArgumentError);
+  CHECK_THROWS_AS(lattice_hierarchy(exec::seq, box_tet_mesh<double>(2, 2, 2), {.coarsening_tries = -1}), ArgumentError);
+}
+
+TEST_CASE("lattice_hierarchy: coarsening keeps each level at most 1/coarsening of the one before where the tries allow; 0 doubles the cell size, as bcc_lattice at h, 2h, 4h") {
+  // a lattice body whose coarse lattices keep many boundary cells (a thin, curved slab): doubling
+  // the cell size alone keeps far more than 1/8 of the vertices
+  const auto box = box_tet_mesh<double>(24, 12, 3, Vec3<>(0, 0, 0), Vec3<>(2, 1, 0.25));
+  const TetMesh<double> mesh = discretize::bcc_lattice(box, 0.05).mesh;
+  const double h0 = 0.1;
+  // coarsening 0: level 1 is exactly the used vertices of bcc_lattice(mesh, h0), and level l ≥ 1
+  // lies on the BCC lattice of cell size h0·2^(l−1) anchored at 0 (corners h·ℤ³, centres h·(ℤ+½)³)
+  const auto doubling = lattice_hierarchy(exec::seq, mesh, {.h = h0, .max_coarse_vertices = 50, .coarsening = 0});
+  REQUIRE(doubling.num_levels() >= 3);
+  {
+    const TetMesh<double> lattice = discretize::bcc_lattice(mesh, h0).mesh;
+    const Embedding<double> emb = embed(exec::seq, lattice, mesh.V);
+    std::vector<char> used(std::size_t(lattice.num_vertices()), 0);
+    for (Index q = 0; q < emb.size(); ++q)
+      for (int k = 0; k < 4; ++k)
+        if (emb.weights(q, k) != 0) used[std::size_t(lattice.T(emb.tet[q], k))] = 1;
+    CHECK(doubling.vertices[1].rows() == Index(std::count(used.begin(), used.end(), char(1))));
+  }
+  double h = h0;
+  for (std::size_t l = 1; l < doubling.vertices.size(); ++l, h *= 2) {
+    CAPTURE(l);
+    const Points<double>& V = doubling.vertices[l];
+    Index off_lattice = 0;
+    for (Index v = 0; v < V.rows(); ++v) {
+      const Vec3<> c = V.row(v).transpose() / (0.5 * h);  // doubled lattice coordinates: all even or all odd
+      const Vec3<> r = c.array().round();
+      const bool whole = (c - r).cwiseAbs().maxCoeff() < 1e-6;
+      const long p0 = std::lround(r.x()) & 1;
+      off_lattice += !(whole && (std::lround(r.y()) & 1) == p0 && (std::lround(r.z()) & 1) == p0);
+    }
+    CHECK(off_lattice == 0);
+  }
+  // the first doubled level keeps more than 1/8 here (what the option is for)
+  REQUIRE(8 * doubling.vertices[1].rows() > doubling.vertices[0].rows());
+  for (const double target : {4.0, 8.0, 12.0}) {
+    CAPTURE(target);
+    const auto levels = lattice_hierarchy(exec::seq, mesh, {.h = h0, .max_coarse_vertices = 50, .coarsening = target, .coarsening_tries = 12});
+    REQUIRE(levels.num_levels() >= 3);
+    if (target * double(doubling.vertices[1].rows()) > double(doubling.vertices[0].rows())) CHECK(levels.vertices[1].rows() < doubling.vertices[1].rows());
+    for (std::size_t l = 0; l + 1 < levels.vertices.size(); ++l) {
+      CAPTURE(l);
+      // every level but the coarsest meets the target (the coarsest may stop early: a cell size
+      // past the level's extent keeps no cell, and the last lattice that did stands)
+      if (l + 2 < levels.vertices.size())
+        CHECK(target * double(levels.vertices[l + 1].rows()) <= double(levels.vertices[l].rows()));
+      else
+        CHECK(double(levels.vertices[l + 1].rows()) <= 0.6 * double(levels.vertices[l].rows()));
+      // and the prolongation still reproduces affine fields and sums to 1 (the first test's checks)
+      const auto& P = levels.prolongations[l];
+      CHECK((P * VecX<>::Ones(P.cols()) - VecX<>::Ones(P.rows())).cwiseAbs().maxCoeff() < 1e-12);
+      VecX<> uc(P.cols()), uf(P.rows());
+      for (Index v = 0; v < levels.vertices[l + 1].rows(); ++v) uc.segment<3>(3 * v) = 2.0 * levels.vertices[l + 1].row(v).transpose() + Vec3<>(1, -2, 3);
+      for (Index v = 0; v < levels.vertices[l].rows(); ++v) uf.segment<3>(3 * v) = 2.0 * levels.vertices[l].row(v).transpose() + Vec3<>(1, -2, 3);
+      CHECK((P * uc - uf).cwiseAbs().maxCoeff() < 1e-11);
+    }
+  }
+  // no tries: the cell size doubles, whatever the target
+  const auto untried = lattice_hierarchy(exec::seq, mesh, {.h = h0, .max_coarse_vertices = 50, .coarsening = 8, .coarsening_tries = 0});
+  REQUIRE(untried.num_levels() == doubling.num_levels());
+  for (std::size_t l = 0; l < untried.vertices.size(); ++l) CHECK(untried.vertices[l] == doubling.vertices[l]);
 }
 
 /// Checks that `mg` (computed) is symmetric and positive on `trials` pairs of random vectors: PCG's
@@ -101,7 +168,9 @@ Index check_smoother(const std::vector<SparseMatrix<>>& levels, const MultigridO
 TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG's requirement); seq == omp bitwise") {
   auto s = stiffness_system(16, 4, 3);
   const SparseMatrix<>& A = s.A();
-  Multigrid<> mg(lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations);
+  // the cell size doubling per level (coarsening 0) keeps this small beam at 3+ levels: the V-cycle
+  // is checked through more than one coarse level (the default coarsening would stop at two)
+  Multigrid<> mg(lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40, .coarsening = 0}).prolongations);
   mg.compute(exec::seq, A);
   REQUIRE(mg.num_levels() >= 3);
   for (Index l = 0; l + 1 < mg.num_levels(); ++l) {
@@ -111,7 +180,7 @@ TEST_CASE("Multigrid: the V-cycle is a symmetric positive definite operator (PCG
   std::mt19937 rng(11);
   const Index n = A.rows();
   check_symmetric_positive(mg, n, rng, 20);
-  const auto levels_omp = lattice_hierarchy(exec::omp, s.mesh, {.max_coarse_vertices = 40});
+  const auto levels_omp = lattice_hierarchy(exec::omp, s.mesh, {.max_coarse_vertices = 40, .coarsening = 0});
   Multigrid<> mg_omp(levels_omp.prolongations);
   mg_omp.compute(exec::omp, A);
   VecX<> z_seq, z_omp;
@@ -174,7 +243,7 @@ TEST_CASE("Multigrid: the Lanczos estimate of λ_max(B⁻¹A) (the Chebyshev smo
   for (unsigned seed = 1; seed <= 4; ++seed) {
     auto s = stiffness_system(5 + seed, 3, seed);
     const SparseMatrix<> A = s.A();
-    const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 30}).prolongations;
+    const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 30, .coarsening = 0}).prolongations;
     REQUIRE(prolongations.size() >= 2);
     // a vertex whose rows and columns are 1e-20 of the others' (a Galerkin level's DOF that almost no
     // fine DOF reaches): D A D has B⁻¹A's spectrum (D B D)⁻¹(D A D) = D⁻¹ B⁻¹A D, so the same λ
@@ -212,7 +281,7 @@ TEST_CASE("Multigrid: the Lanczos estimate of λ_max(B⁻¹A) (the Chebyshev smo
 TEST_CASE("Multigrid: the Lanczos estimate starts cold at every compute (no history, no forget_estimates needed), seq == omp bitwise") {
   auto s = stiffness_system(12, 4, 3);
   const SparseMatrix<>& A = s.A();
-  const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
+  const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40, .coarsening = 0}).prolongations;
   SparseMatrix<> B = A;
   B *= 1.5;
   MultigridOptions o;
@@ -467,7 +536,7 @@ TEST_CASE("Multigrid, Gauss-Seidel smoother: the V-cycle equals a dense multicol
   const Eigen::SimplicialLDLT<SparseMatrix<>> ldlt(A);
   REQUIRE(ldlt.info() == Eigen::Success);
   const VecX<> ref = ldlt.solve(s.b);
-  const auto levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
+  const auto levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40, .coarsening = 0}).prolongations;
   REQUIRE(levels.size() >= 2);
   ConjugateGradient<Multigrid<>> pcg_jacobi({.tolerance = 1e-10}, Multigrid<>(levels));
   pcg_jacobi.compute(exec::omp, A);

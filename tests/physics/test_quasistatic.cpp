@@ -12,7 +12,9 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <random>
+#include <thread>
 #include <stdexcept>
 
 #include "stvk_material.hpp"
@@ -351,6 +353,65 @@ TEST_CASE("Newton progress: every iteration is reported, with the Hessian it use
     for (std::size_t k = 1; k < seen.size(); ++k) CHECK(seen[k].energy <= seen[k - 1].energy);
     if (mode == NewtonOptions::Hessian::projected)
       for (const auto& it : seen) CHECK(it.projected);
+  }
+}
+
+namespace {
+/// An EnergyTerm that forwards to `inner` and sleeps a fixed time in each call kind, counting the
+/// calls: NewtonReport::seconds must put at least calls × sleep in each call kind's bucket.
+template <class Inner>
+struct SlowTerm {
+  const Inner* inner;
+  std::chrono::milliseconds energy_sleep, gradient_sleep, hessian_sleep;
+  mutable int energies = 0, gradients = 0, hessians = 0;
+  template <class P>
+  double energy(P policy, const Points<>& x) const {
+    ++energies;
+    std::this_thread::sleep_for(energy_sleep);
+    return inner->energy(policy, x);
+  }
+  template <class P>
+  void add_gradient(P policy, const Points<>& x, Points<>& g) const {
+    ++gradients;
+    std::this_thread::sleep_for(gradient_sleep);
+    inner->add_gradient(policy, x, g);
+  }
+  template <class P>
+  void add_hessian(P policy, const Points<>& x, BlockHessian<>& H, Definiteness d) const {
+    ++hessians;
+    std::this_thread::sleep_for(hessian_sleep);
+    inner->add_hessian(policy, x, H, d);
+  }
+};
+}  // namespace
+
+TEST_CASE("NewtonReport::seconds: each call's time lands in its own part; the parts add up to at most the total") {
+  const auto mesh = box_tet_mesh<double>(4, 1, 1, Vec3<>(0, 0, 0), Vec3<>(0.4, 0.1, 0.1));
+  ElasticEnergy<NeoHookean<>> elastic(mesh, NeoHookean<>::from_young_poisson(1e5, 0.3));
+  Gravity<> gravity(mesh, 1000.0, Vec3<>(0, 0, -9.81));
+  BoneAttachments<> wall(mesh.V);
+  wall.add_bone("wall", select_vertices(mesh.V, [](const Vec3<>& p) { return p.x() < 1e-12; }));
+  using namespace std::chrono_literals;
+  // one part made slow at a time: only its bucket may hold the sleeps
+  for (int slow = 0; slow < 3; ++slow) {
+    CAPTURE(slow);
+    SlowTerm<ElasticEnergy<NeoHookean<>>> term{&elastic, slow == 0 ? 3ms : 0ms, slow == 1 ? 3ms : 0ms, slow == 2 ? 3ms : 0ms};
+    QuasistaticSolver<ConjugateGradient<BlockJacobi<>>> newton(mesh.num_vertices(), mesh.T, {}, ConjugateGradient<BlockJacobi<>>({.tolerance = 1e-8}));
+    Points<> x = mesh.V;
+    const NewtonReport r = newton.solve(exec::seq, x, wall.boundary(), term, gravity);
+    REQUIRE(r.converged);
+    REQUIRE(r.iterations >= 2);
+    const NewtonSeconds& t = r.seconds;
+    const double parts = t.energy + t.gradient + t.hessian + t.linear_setup + t.linear_solve;
+    for (double part : {t.energy, t.gradient, t.hessian, t.linear_setup, t.linear_solve}) CHECK(part >= 0);
+    CHECK(t.linear_solve > 0);
+    CHECK(parts <= t.total);
+    const double slept = 0.003 * (slow == 0 ? term.energies : slow == 1 ? term.gradients : term.hessians);
+    const double bucket = slow == 0 ? t.energy : slow == 1 ? t.gradient : t.hessian;
+    CHECK(bucket >= slept);
+    // the other buckets did not get the sleeps (each is far below one sleep per call here)
+    for (int other = 0; other < 3; ++other)
+      if (other != slow) CHECK((other == 0 ? t.energy : other == 1 ? t.gradient : t.hessian) < slept);
   }
 }
 

@@ -16,6 +16,7 @@
 /// gradient and Hessian, the assembly, and the linear solver's compute and solve.
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -146,6 +147,16 @@ inline const char* hessian_name(NewtonOptions::Hessian h) {
   return "unknown";
 }
 
+/// Where a solve's time went (wall-clock seconds, steady_clock): the terms' energies (the first
+/// iterate's and every line-search trial's), their gradients, the Hessian assembly (every term's
+/// blocks and BlockHessian::assemble), the linear solver's setup (a factorization, a
+/// preconditioner's compute) and its solves. What is left of the solve's total is the
+/// iteration's own vector work (the trial point, the step).
+struct NewtonSeconds {
+  double energy = 0, gradient = 0, hessian = 0, linear_setup = 0, linear_solve = 0;
+  double total = 0;  ///< the whole solve
+};
+
 /// What a solve did.
 struct NewtonReport {
   bool converged = false;
@@ -155,6 +166,7 @@ struct NewtonReport {
   double gradient_norm = 0;
   Index linear_iterations = 0;
   std::vector<NewtonIteration> history;
+  NewtonSeconds seconds;  ///< where the time went
 };
 
 /// Newton with line search over a sum of EnergyTerms (see the file comment).
@@ -195,9 +207,17 @@ class QuasistaticSolver {
   /// The Newton loop of solve(), once every term is known to be an EnergyTerm.
   template <class P, class... Terms>
   NewtonReport newton(P policy, Points<S>& x, const DirichletBoundary<S>& boundary, const Terms&... terms) {
+    const auto started = Clock::now();
+    seconds_ = {};
+    NewtonReport report;
+    // every return hands the report its time breakdown
+    const auto done = [&]() -> NewtonReport& {
+      report.seconds = seconds_;
+      report.seconds.total = std::chrono::duration<double>(Clock::now() - started).count();
+      return report;
+    };
     detail::require_positions("QuasistaticSolver::solve: x", x, n_);
     apply_boundary(x, boundary);
-    NewtonReport report;
     detail::GradientTest test(options_.relative_tolerance, options_.absolute_tolerance, options_.reference_force);
     ForcingTerm forcing(*this);
     const double size = double((x.colwise().maxCoeff() - x.colwise().minCoeff()).norm());
@@ -209,9 +229,9 @@ class QuasistaticSolver {
     for (Index it = 0;; ++it) {
       // the line search evaluated the energy at this x already (the same sum of the same terms:
       // the same bits), so an iteration after the first does not evaluate it again
-      const double E = it == 0 ? total_energy(policy, x, terms...) : accepted;
+      const double E = it == 0 ? timed(seconds_.energy, [&] { return total_energy(policy, x, terms...); }) : accepted;
       if (!std::isfinite(E)) throw ConvergenceError("quasistatic Newton (energy is not finite at iteration " + std::to_string(it) + ")", it, E);
-      const double balance = compute_gradient(policy, x, terms...);
+      const double balance = timed(seconds_.gradient, [&] { return compute_gradient(policy, x, terms...); });
       const double gnorm = double(g_.norm());
       if (it == 0) report.initial_gradient_norm = gnorm;
       report.iterations = it;
@@ -219,10 +239,10 @@ class QuasistaticSolver {
       report.gradient_norm = gnorm;
       if (test.converged(it, gnorm, balance)) {
         report.converged = true;
-        return report;
+        return done();
       }
       if (it >= options_.max_iterations) {
-        if (options_.accept_at_max_iterations) return report;
+        if (options_.accept_at_max_iterations) return done();
         throw ConvergenceError("quasistatic Newton", it, gnorm);
       }
 
@@ -244,7 +264,7 @@ class QuasistaticSolver {
       if (chord) {
         // the previous iteration's matrix and setup (NewtonOptions::chord_below); a solve that does
         // not converge or does not descend makes this a full Newton iteration after all
-        info = linear_.solve(policy, rhs_, d_);
+        info = timed(seconds_.linear_solve, [&] { return linear_.solve(policy, rhs_, d_); });
         slope = double(g_.dot(d_));
         if (info.converged && slope < 0 && d_.allFinite()) {
           projected = setup_projected_;
@@ -288,7 +308,7 @@ class QuasistaticSolver {
         slope = -double(g_.squaredNorm());
       } else if (info.converged && double(d_.cwiseAbs().maxCoeff()) <= options_.step_tolerance * size) {
         report.converged = true;
-        return report;
+        return done();
       }
 
       // Backtracking on the total energy; differences below round-off of the terms' magnitudes
@@ -299,7 +319,7 @@ class QuasistaticSolver {
       for (;; ++backtracks) {
         trial_ = x;
         Eigen::Map<VecX<S>>(trial_.data(), 3 * n_) += S(alpha) * d_;
-        const double Et = total_energy(policy, trial_, terms...);
+        const double Et = timed(seconds_.energy, [&] { return total_energy(policy, trial_, terms...); });
         trial_energy = Et;
         if (std::isfinite(Et) && Et <= E + options_.armijo * alpha * slope + noise) break;
         if (backtracks >= options_.max_backtracks)
@@ -393,14 +413,14 @@ class QuasistaticSolver {
   bool newton_direction(P policy, const Points<S>& x, Definiteness d, LinearSolveInfo& info, const Terms&... terms) {
     const SparseMatrix<S>& A = assemble_hessian(policy, x, d, terms...);
     try {
-      linear_.compute(policy, A, H_.pattern_version());
+      timed(seconds_.linear_setup, [&] { linear_.compute(policy, A, H_.pattern_version()); });
     } catch (const ConvergenceError&) {
       if (d == Definiteness::project) throw;
       return false;
     }
     if constexpr (requires { linear_.positive_definite(); })
       if (d == Definiteness::exact && !linear_.positive_definite()) return false;
-    const LinearSolveInfo one = linear_.solve(policy, rhs_, d_);
+    const LinearSolveInfo one = timed(seconds_.linear_solve, [&] { return linear_.solve(policy, rhs_, d_); });
     info.iterations += one.iterations;
     info.relative_residual = one.relative_residual;
     info.converged = one.converged;
@@ -410,9 +430,11 @@ class QuasistaticSolver {
   /// Every term's Hessian blocks at x (definiteness d) into H_, assembled over the free DOFs.
   template <class P, class... Terms>
   const SparseMatrix<S>& assemble_hessian(P policy, const Points<S>& x, Definiteness d, const Terms&... terms) {
-    H_.set_zero();
-    (terms.add_hessian(policy, x, H_, d), ...);
-    return H_.assemble(policy, fixed_);
+    return timed(seconds_.hessian, [&]() -> const SparseMatrix<S>& {
+      H_.set_zero();
+      (terms.add_hessian(policy, x, H_, d), ...);
+      return H_.assemble(policy, fixed_);
+    });
   }
 
   /// Hessian::regularized: with the exact Hessian H (the matrix H_ last assembled) not positive
@@ -439,13 +461,13 @@ class QuasistaticSolver {
     for (double tau = first; tau <= 1e2 * (1 + 1e-9); tau *= 10) {
       for (auto& [entry, exact] : shifted_diagonal_) *entry = exact + S(tau * m);
       try {
-        linear_.compute(policy, shifted_, H_.pattern_version());
+        timed(seconds_.linear_setup, [&] { linear_.compute(policy, shifted_, H_.pattern_version()); });
       } catch (const ConvergenceError&) {
         continue;
       }
       if constexpr (requires { linear_.positive_definite(); })
         if (!linear_.positive_definite()) continue;
-      const LinearSolveInfo one = linear_.solve(policy, rhs_, d_);
+      const LinearSolveInfo one = timed(seconds_.linear_solve, [&] { return linear_.solve(policy, rhs_, d_); });
       info.iterations += one.iterations;
       info.relative_residual = one.relative_residual;
       info.converged = one.converged;
@@ -454,8 +476,21 @@ class QuasistaticSolver {
     return 0;
   }
 
+  using Clock = std::chrono::steady_clock;
+  /// f(), its wall time added to `seconds` (also when it throws).
+  template <class F>
+  static decltype(auto) timed(double& seconds, F&& f) {
+    struct Add {
+      double& to;
+      Clock::time_point from = Clock::now();
+      ~Add() { to += std::chrono::duration<double>(Clock::now() - from).count(); }
+    } add{seconds};
+    return f();
+  }
+
   Index n_;
   NewtonOptions options_;
+  NewtonSeconds seconds_;  ///< the running solve's breakdown (NewtonReport::seconds)
   Linear linear_;
   BlockHessian<S> H_;
   std::vector<char> fixed_;

@@ -232,6 +232,10 @@ inline std::string face_run_fingerprint(const FaceModel& face, const FaceSimulat
   // the smoother's spectrum estimate (MultigridOptions::spectrum: Lanczos for Chebyshev since
   // 2026-12-06, the power method's before) changes frames by PCG's tolerance
   f.add(std::int64_t(o.multigrid.spectrum)).add(std::int64_t(o.multigrid.lanczos_iterations));
+  // the multigrid's levels (LatticeHierarchyOptions; coarsened to 1/8 per level since 2026-12-07)
+  // change frames by PCG's tolerance
+  f.add(o.hierarchy.h).add(std::int64_t(o.hierarchy.max_coarse_vertices)).add(std::int64_t(o.hierarchy.max_levels));
+  f.add(o.hierarchy.coarsening).add(std::int64_t(o.hierarchy.coarsening_tries));
   f.add(std::int64_t(o.newton.forcing)).add(o.newton.forcing_max).add(std::int64_t(o.newton.forcing_safeguard)).add(std::int64_t(o.newton.hessian));
   f.add(o.newton.chord_below).add(o.newton.step_tolerance).add(o.newton.reference_force);
   if (o.newton.chord_first) f.add(std::int64_t(1));  // only when on: runs made before the option keep their fingerprint

@@ -152,6 +152,10 @@ struct FaceSimulationOptions {
   physics::ConjugateGradientOptions linear{.tolerance = 1e-4};
   /// The V-cycle's options where Linear is PCG with the lattice multigrid (the default).
   physics::MultigridOptions multigrid = default_multigrid();
+  /// Its levels (physics::lattice_hierarchy). The default coarsens each level to at most 1/8 of
+  /// the one before (LatticeHierarchyOptions::coarsening, 2026-12-07); `coarsening = 0` gives the
+  /// earlier hierarchy, the cell size doubling per level.
+  physics::LatticeHierarchyOptions hierarchy{};
 };
 
 /// A quasistatic face simulator on one mesh of a FaceModel (see the file comment). Linear: the
@@ -168,7 +172,7 @@ class FaceSimulator {
         elastic_(part_of_mesh(face, false), physics::MooneyRivlin<>(opt_.mu10, opt_.mu01, opt_.kappa, opt_.inversion_threshold)),
         muscle_(part_of_mesh(face, true), physics::TeranMuscle<>(physics::MooneyRivlin<>(opt_.mu10, opt_.mu01, opt_.kappa, opt_.inversion_threshold), opt_.muscle_max_stress),
                 fibres_),
-        newton_(mesh_.num_vertices(), mesh_.T, newton_options(opt_, resolution), physics::make_linear_solver<Linear>(policy, mesh_, opt_.linear, {}, opt_.multigrid)),
+        newton_(mesh_.num_vertices(), mesh_.T, newton_options(opt_, resolution), physics::make_linear_solver<Linear>(policy, mesh_, opt_.linear, opt_.hierarchy, opt_.multigrid)),
         tracks_(make_tracks()) {
     const bool high = resolution == FaceResolution::high;
     bone_ = high ? face.hr_bone : face.lr_bone;
