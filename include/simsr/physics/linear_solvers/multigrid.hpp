@@ -5,10 +5,11 @@
 ///
 /// - The levels are BCC lattices of cell size 2h, 4h, … covering the mesh (discretize::bcc_lattice,
 ///   the same lattices the LR simulator uses), each coarsened further where it would keep more
-///   than 1/8 of the vertices of the level before (LatticeHierarchyOptions::coarsening). Level ℓ's vertices are embedded barycentrically in
-///   level ℓ+1's tets, so the prolongation P interpolates linearly: it reproduces every affine
-///   displacement, rigid motions included — the near-null space of elasticity that coarse levels
-///   must carry. (Vertices of a coarse level that no finer vertex uses are dropped.)
+///   than 1/8 of the vertices of the level before (LatticeHierarchyOptions::coarsening). Level
+///   ℓ's vertices are embedded barycentrically in level ℓ+1's tets, so the prolongation P
+///   interpolates linearly: it reproduces every affine displacement, rigid motions included — the
+///   near-null space of elasticity that coarse levels must carry. (Vertices of a coarse level that
+///   no finer vertex uses are dropped.)
 /// - The coarse matrices are Galerkin products A_{ℓ+1} = Pᵀ A_ℓ P, recomputed at every compute(),
 ///   so whatever is in the Hessian (materials, springs, contact, bones) is in them too; in 3×3
 ///   blocks (BlockGalerkin) where P is vertex weights ⊗ I₃, as lattice_hierarchy's are. Rows of
