@@ -38,7 +38,13 @@
 //       pcg_multigrid_single (the V-cycle's level matrices in single precision), cholmod
 //       (CHOLMOD's supernodal LLᵀ; built with -DSIMSR_WITH_CHOLMOD=ON). Counters:
 //       newton_iterations, linear_iterations (PCG iterations summed over the frame), projected
-//       (Newton iterations whose exact Hessian was not positive definite: assembled twice), fps.
+//       (Newton iterations whose exact Hessian was not positive definite: assembled twice), fps,
+//       and the last frame's NewtonReport::seconds as ms_energy, ms_gradient, ms_hessian,
+//       ms_setup (the linear solver's compute) and ms_solve.
+//   `_doubling` rows: the multigrid's lattice hierarchy with the cell size doubling per level
+//       (LatticeHierarchyOptions::coarsening = 0, as before 2026-12-07), the baseline of the
+//       coarsened default; `pcg_multigrid_doubling` is the options of the day issue #17 was filed
+//       (scripts/bench_frame_vs_filing.sh runs that day's code itself beside these rows)
 //   BM_frame_73k/pcg_multigrid_inexact…/omp   NewtonOptions::Forcing::adaptive (Eisenstat–Walker's
 //       forcing, each Newton system solved to η_k instead of kCgTolerance) with Kelley's safeguard
 //       η_k ≥ ½ τ/‖g_k‖ (forcing_safeguard, default); `_unguarded` without it (the baseline);
