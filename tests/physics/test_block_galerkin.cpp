@@ -52,7 +52,10 @@ TEST_CASE("BlockGalerkin equals the dense D(W⊗I)ᵀ A D(W⊗I) on stiffness sy
   for (unsigned seed = 1; seed <= 4; ++seed) {
     auto s = stiffness_system(6 + 2 * seed, 3, seed);
     const SparseMatrix<>& A = s.A();
-    const auto levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 20});
+    // the cell size doubling per level (coarsening 0): these small beams keep a second coarse
+    // level, whose weights the end of the case multiplies with
+    const auto levels = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 20, .coarsening = 0});
+    REQUIRE(levels.prolongations.size() > 1);
     const SparseMatrix<> W = *vertex_weights(levels.prolongations[0]);
     // dropped: the system's fixed DOFs and random single DOFs (partly dropped vertices)
     std::vector<char> dropped(std::size_t(A.rows()));
@@ -110,7 +113,8 @@ TEST_CASE("BlockGalerkin: bad input is a typed error") {
 TEST_CASE("Multigrid: block and scalar Galerkin levels give the same V-cycle to rounding, with Dirichlet rows") {
   for (unsigned seed = 1; seed <= 3; ++seed) {
     auto s = stiffness_system(16, 4, seed);
-    const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40}).prolongations;
+    // coarsening 0: three levels or more on this beam (the default coarsening stops at two)
+    const auto prolongations = lattice_hierarchy(exec::seq, s.mesh, {.max_coarse_vertices = 40, .coarsening = 0}).prolongations;
     Multigrid<> scalar(prolongations, {.storage = MultigridOptions::Storage::csr}), blocks(prolongations, {.storage = MultigridOptions::Storage::block});
     scalar.compute(exec::omp, s.A());
     blocks.compute(exec::omp, s.A());
