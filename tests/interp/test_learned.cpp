@@ -8,6 +8,8 @@
 
 #include <doctest/doctest.h>
 
+#include "../support/allocation_check.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -302,6 +304,18 @@ TEST_CASE("LearnedInference (host memory): the device path's launches give Learn
     // the network's float rounding (InferenceNet sums in another order), scaled to mesh units
     CHECK((got_seq - expected).cwiseAbs().maxCoeff() <= 1e-5 * (1e-3 + expected.cwiseAbs().maxCoeff()));
   }
+  // the host-array call warm allocates nothing; a column block (row stride 5) reaches it through
+  // ConstPointsRef's temporary, the same frame
+  const Points<> frame = s.frames.lr(0);
+  net.apply(exec::seq, frame, expected);
+  plan.apply(exec::seq, frame, got_seq);
+  const long before = simsr_test_malloc_count();
+  plan.apply(exec::seq, frame, got_seq);
+  SIMSR_CHECK_NO_ALLOCATION(exec::seq, simsr_test_malloc_count() - before);
+  Eigen::Matrix<double, Eigen::Dynamic, 5, Eigen::RowMajor> wide = Eigen::Matrix<double, Eigen::Dynamic, 5, Eigen::RowMajor>::Zero(frame.rows(), 5);
+  wide.leftCols(3) = frame;
+  plan.apply(exec::seq, wide.leftCols(3), got_omp);
+  CHECK(got_omp == got_seq);
   // Learned::apply's input checks, the same vertex named
   Points<> in(s.problem.num_lr(), 3), out(s.problem.num_hr(), 3);
   in.setZero();

@@ -135,28 +135,19 @@ class LearnedInference {
     exec::parallel_for(policy, out, scale);
   }
 
-  /// apply on host arrays (copies in and out: the device instance's transfers). Allocates nothing
-  /// once warm for arrays of rows of 3.
+  /// apply on host arrays (copies in and out: the device instance's transfers). Both arrays are
+  /// contiguous rows of 3 (ConstPointsRef / PointsRef fix the row stride at 3; Eigen packs any
+  /// other layout of lr into a temporary before the call), so each is one copy. Allocates nothing
+  /// once warm.
   template <class Policy>
   void apply(Policy policy, const ConstPointsRef<double>& lr_displacement, PointsRef<double> hr_displacement) {
     if (lr_displacement.rows() != n_) throw ShapeError("LearnedInference::apply: LR displacement", {n_, 3}, {lr_displacement.rows(), 3});
     if (hr_displacement.rows() != m_) throw ShapeError("LearnedInference::apply: HR displacement", {m_, 3}, {hr_displacement.rows(), 3});
-    const double* rows = lr_displacement.data();
-    if (lr_displacement.outerStride() != 3) {  // rows of a wider array: packed first
-      packed_in_ = lr_displacement;
-      rows = packed_in_.data();
-    }
     lr_in_.resize(3 * n_);
-    lr_in_.copy_from(Span<const double>{rows, 3 * n_});
+    lr_in_.copy_from(Span<const double>{lr_displacement.data(), 3 * n_});
     hr_out_.resize(3 * m_);
     apply(policy, MatrixSpan<const double>{lr_in_.span().data, n_, 3, 3}, MatrixSpan<double>{hr_out_.span().data, m_, 3, 3});
-    if (hr_displacement.outerStride() == 3) {
-      hr_out_.copy_to(Span<double>{hr_displacement.data(), 3 * m_});
-    } else {
-      packed_out_.resize(m_, 3);
-      hr_out_.copy_to(Span<double>{packed_out_.data(), 3 * m_});
-      hr_displacement = packed_out_;
-    }
+    hr_out_.copy_to(Span<double>{hr_displacement.data(), 3 * m_});
   }
 
  private:
@@ -186,7 +177,6 @@ class LearnedInference {
   Index n_, m_;
   Memory<S> ldx_, pred_;
   Memory<double> lr_in_, hr_out_;  ///< apply on host arrays: the transfers' buffers
-  Points<double> packed_in_, packed_out_;  ///< apply on host arrays with another row stride
 };
 
 /// The host instance (the device path's launches under exec::seq / exec::omp).
